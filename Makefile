@@ -1,0 +1,56 @@
+# Open 77 GHz FMCW TDM-MIMO radar array processor.
+#   make demo   run the Table I scene end to end and write figures to out/
+#   make test   the whole regression (Python model/host/gnn tests + every RTL testbench)
+# Both create .venv and install the pinned toolchain on first use.
+
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV   := .venv
+STAMP  := $(VENV)/.installed
+RUN    := tools/venv-run
+JOBS   ?= auto
+OUT    ?= out
+
+.PHONY: all setup demo test test-python sim lint bench clean help
+all: test
+
+help:
+	@echo "make setup           create .venv and install the pinned toolchain (idempotent)"
+	@echo "make demo            Table I scene end to end, figures in $(OUT)/"
+	@echo "make test            whole regression (pytest -n $(JOBS))"
+	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
+	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
+	@echo "make bench           benchmark scripts (print tables)"
+	@echo "make clean           remove build products (keeps .venv)"
+
+setup: $(STAMP)
+
+$(STAMP): pyproject.toml
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
+	touch $@
+
+demo: $(STAMP)
+	$(RUN) radar demo --out $(OUT)
+
+test: $(STAMP)
+	$(RUN) pytest -n $(JOBS)
+
+test-python: $(STAMP)
+	$(RUN) pytest -n $(JOBS) tests
+
+sim: $(STAMP)
+	@test -n "$(BLOCK)" || { echo "usage: make sim BLOCK=<name> (a folder of tb/)"; exit 2; }
+	@test -d tb/$(BLOCK) || { echo "no testbench tb/$(BLOCK)"; exit 2; }
+	$(RUN) pytest -n $(JOBS) tb/$(BLOCK)
+
+lint: $(STAMP)
+	$(RUN) tools/lint.sh
+
+bench: $(STAMP)
+	$(RUN) python -m model.bench_simulate
+
+clean:
+	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache
+	find . -name __pycache__ -not -path './$(VENV)/*' -prune -exec rm -rf {} +
+	find . -name '*.result.xml' -not -path './$(VENV)/*' -delete
