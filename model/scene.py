@@ -1,0 +1,364 @@
+"""Radar scenes: point targets, extended objects (sets of scatterers) and the scene JSON.
+
+Conventions (DESIGN.md section 2): x forward (boresight), y left, azimuth positive towards +y
+(counter-clockwise), radial velocity positive = receding. Angles in degrees at interfaces.
+Kinematics are given at the **centre of the frame** (the middle of the coherent processing
+interval), so a target's measured range is its scene range even when it moves metres during
+a frame.
+
+Scene JSON (DESIGN.md section 4)::
+
+    {"preset": "full", "seed": 1, "tx_beamforming": true,
+     "targets": [{"range_m": 40.0, "azimuth_deg": -10.0, "radial_velocity_mps": -12.5,
+                  "rcs_m2": 20.0}],
+     "objects": [{"x_m": 30, "y_m": 2, "length_m": 4.5, "width_m": 1.8, "heading_deg": 0,
+                  "vx_mps": -5, "vy_mps": 0, "rcs_m2": 10, "n_scatterers": 12,
+                  "label": "car"}]}
+
+``{"scene": "table1", "preset": "full"}`` names the built-in paper scene instead.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from model.config import PRESETS, RadarConfig, get_preset
+
+KMH = 1.0 / 3.6
+"""m/s per km/h."""
+
+
+def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = None) -> float:
+    if key not in d:
+        if default is None:
+            raise ValueError(f"{where}: missing required field {key!r}")
+        return default
+    value = d[key]
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ValueError(f"{where}.{key}: must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _check_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    if not isinstance(d, Mapping):
+        raise ValueError(f"{where}: must be a JSON object, got {type(d).__name__}")
+    unknown = set(d) - allowed
+    if unknown:
+        raise ValueError(f"{where}: unknown field(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+
+
+@dataclass(frozen=True)
+class Scatterers:
+    """A flat set of point scatterers, all arrays of shape (n,).
+
+    ``range_m`` (m), ``azimuth_deg`` (deg), ``radial_velocity_mps`` (m/s, + receding),
+    ``rcs_m2`` (m^2), and ``object_id`` (int, -1 for free point targets) linking each
+    scatterer to the scene object it belongs to (for labelled datasets).
+    """
+
+    range_m: np.ndarray
+    azimuth_deg: np.ndarray
+    radial_velocity_mps: np.ndarray
+    rcs_m2: np.ndarray
+    object_id: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.range_m.shape[0])
+
+    @staticmethod
+    def concat(parts: list[Scatterers]) -> Scatterers:
+        """All scatterers of ``parts`` in order."""
+        if not parts:
+            e = np.zeros(0)
+            return Scatterers(e, e, e, e, np.zeros(0, dtype=int))
+        return Scatterers(*(np.concatenate([getattr(p, f) for p in parts]) for f in (
+            "range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2", "object_id")))
+
+
+@dataclass(frozen=True)
+class PointTarget:
+    """One point scatterer: range (m), azimuth (deg), radial velocity (m/s), RCS (m^2)."""
+
+    range_m: float
+    azimuth_deg: float
+    radial_velocity_mps: float
+    rcs_m2: float
+
+    FIELDS = ("range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2")
+
+    def __post_init__(self) -> None:
+        if self.range_m <= 0:
+            raise ValueError(f"range_m: must be positive, got {self.range_m}")
+        if not -90.0 < self.azimuth_deg < 90.0:
+            raise ValueError(f"azimuth_deg: must be inside (-90, 90), got {self.azimuth_deg}")
+        if self.rcs_m2 <= 0:
+            raise ValueError(f"rcs_m2: must be positive, got {self.rcs_m2}")
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], where: str = "target") -> PointTarget:
+        _check_keys(d, set(cls.FIELDS), where)
+        vals = {k: _number(d, k, where) for k in cls.FIELDS}
+        try:
+            return cls(**vals)
+        except ValueError as exc:
+            raise ValueError(f"{where}.{exc}") from None
+
+    @property
+    def x_m(self) -> float:
+        return self.range_m * math.cos(math.radians(self.azimuth_deg))
+
+    @property
+    def y_m(self) -> float:
+        return self.range_m * math.sin(math.radians(self.azimuth_deg))
+
+
+@dataclass(frozen=True)
+class ExtendedObject:
+    """A rigid box-shaped object (vehicle, pedestrian, ...) made of point scatterers.
+
+    Centre ``(x_m, y_m)`` (m), footprint ``length_m`` x ``width_m`` (m) rotated by
+    ``heading_deg`` (deg, from +x towards +y), velocity over ground relative to the radar
+    ``(vx_mps, vy_mps)`` (m/s), total ``rcs_m2`` (m^2) shared by ``n_scatterers`` points on
+    the box outline that face the radar. ``label`` names the class for the GNN datasets.
+    """
+
+    x_m: float
+    y_m: float
+    length_m: float
+    width_m: float
+    heading_deg: float
+    vx_mps: float
+    vy_mps: float
+    rcs_m2: float
+    n_scatterers: int = 12
+    label: str = "car"
+
+    NUMBERS = ("x_m", "y_m", "length_m", "width_m", "heading_deg", "vx_mps", "vy_mps", "rcs_m2")
+
+    def __post_init__(self) -> None:
+        if self.x_m <= 0:
+            raise ValueError(f"x_m: object must be in front of the radar (x > 0), got {self.x_m}")
+        if self.length_m <= 0 or self.width_m <= 0:
+            raise ValueError("length_m/width_m: must be positive")
+        if self.rcs_m2 <= 0:
+            raise ValueError(f"rcs_m2: must be positive, got {self.rcs_m2}")
+        if not isinstance(self.n_scatterers, int) or self.n_scatterers < 1:
+            raise ValueError(f"n_scatterers: must be a positive integer, got {self.n_scatterers}")
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], where: str = "object") -> ExtendedObject:
+        _check_keys(d, set(cls.NUMBERS) | {"n_scatterers", "label"}, where)
+        vals: dict[str, Any] = {k: _number(d, k, where, 0.0 if k in ("heading_deg", "vx_mps",
+                                                                  "vy_mps") else None)
+                                for k in cls.NUMBERS}
+        n = d.get("n_scatterers", 12)
+        if isinstance(n, bool) or not isinstance(n, int):
+            raise ValueError(f"{where}.n_scatterers: must be an integer, got {n!r}")
+        label = d.get("label", "car")
+        if not isinstance(label, str):
+            raise ValueError(f"{where}.label: must be a string, got {label!r}")
+        try:
+            return cls(**vals, n_scatterers=n, label=label)
+        except ValueError as exc:
+            raise ValueError(f"{where}.{exc}") from None
+
+    def corners(self) -> np.ndarray:
+        """Box corners, float (4, 2) as (x, y) in m, counter-clockwise."""
+        h = math.radians(self.heading_deg)
+        u = np.array([math.cos(h), math.sin(h)])        # along the length
+        w = np.array([-math.sin(h), math.cos(h)])       # along the width
+        c = np.array([self.x_m, self.y_m])
+        hl, hw = self.length_m / 2, self.width_m / 2
+        return np.array([c + hl * u - hw * w, c + hl * u + hw * w,
+                         c - hl * u + hw * w, c - hl * u - hw * w])
+
+    def scatterers(self, rng: np.random.Generator, object_id: int) -> Scatterers:
+        """Scatterers on the radar-facing edges of the box (shape (n_scatterers,) each).
+
+        Points are drawn uniformly along the visible edges (outward normal towards the
+        radar); the RCS is split among them with exponential (Swerling-1-like) weights that
+        sum to ``rcs_m2``. Radial velocity is the object velocity projected on each point's
+        line of sight.
+        """
+        corners = self.corners()
+        edges = [(corners[i], corners[(i + 1) % 4]) for i in range(4)]
+        centre = np.array([self.x_m, self.y_m])
+        visible = []
+        for a, b in edges:
+            mid = (a + b) / 2
+            normal = mid - centre
+            if np.dot(normal, -mid) > 0:  # faces the radar at the origin
+                visible.append((a, b))
+        lengths = np.array([np.linalg.norm(b - a) for a, b in visible])
+        pick = rng.choice(len(visible), size=self.n_scatterers, p=lengths / lengths.sum())
+        t = rng.random(self.n_scatterers)
+        pts = np.array([visible[k][0] + ti * (visible[k][1] - visible[k][0])
+                        for k, ti in zip(pick, t, strict=True)])
+        rng_m = np.hypot(pts[:, 0], pts[:, 1])
+        az = np.degrees(np.arctan2(pts[:, 1], pts[:, 0]))
+        vr = (pts[:, 0] * self.vx_mps + pts[:, 1] * self.vy_mps) / rng_m
+        w = rng.exponential(size=self.n_scatterers)
+        rcs = self.rcs_m2 * w / w.sum()
+        return Scatterers(rng_m, az, vr, rcs, np.full(self.n_scatterers, object_id))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A radar scene: preset name, random seed, TX beamforming switch, targets and objects.
+
+    ``noise=False`` switches thermal noise off (for model tests). Frame k of a scene (see
+    ``model.simulate.simulate_scene``) moves each target radially by ``v * k * frame_time``.
+    """
+
+    preset: str = "full"
+    seed: int = 0
+    tx_beamforming: bool = True
+    targets: tuple[PointTarget, ...] = ()
+    objects: tuple[ExtendedObject, ...] = ()
+    noise: bool = True
+    name: str = "custom"
+
+    def __post_init__(self) -> None:
+        get_preset(self.preset)  # validates the name
+
+    @property
+    def config(self) -> RadarConfig:
+        """The radar configuration of the scene's preset."""
+        return get_preset(self.preset)
+
+    def scatterers(self) -> Scatterers:
+        """All scatterers of the scene: point targets (object_id -1) then each object's."""
+        rng = np.random.default_rng(self.seed)
+        parts = []
+        if self.targets:
+            t = self.targets
+            parts.append(Scatterers(
+                np.array([x.range_m for x in t]), np.array([x.azimuth_deg for x in t]),
+                np.array([x.radial_velocity_mps for x in t]), np.array([x.rcs_m2 for x in t]),
+                np.full(len(t), -1)))
+        for i, obj in enumerate(self.objects):
+            parts.append(obj.scatterers(rng, i))
+        return Scatterers.concat(parts)
+
+    # ---- JSON -----------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Scene:
+        """Parse scene JSON (already decoded); ValueError naming the bad field."""
+        if not isinstance(d, Mapping):
+            raise ValueError(f"scene: must be a JSON object, got {type(d).__name__}")
+        preset = d.get("preset", "full")
+        if not isinstance(preset, str) or preset not in PRESETS:
+            raise ValueError(f"preset: unknown preset {preset!r}; choose one of "
+                             f"{', '.join(PRESETS)}")
+        if "scene" in d:
+            _check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise"}, "scene")
+            builtin = d["scene"]
+            if builtin not in BUILTIN_SCENES:
+                raise ValueError(f"scene: unknown built-in scene {builtin!r}; choose one of "
+                                 f"{', '.join(BUILTIN_SCENES)}")
+            base = BUILTIN_SCENES[builtin](preset)
+            return Scene(preset=preset, seed=_int(d, "seed", base.seed),
+                         tx_beamforming=_bool(d, "tx_beamforming", base.tx_beamforming),
+                         targets=base.targets, objects=base.objects,
+                         noise=_bool(d, "noise", True), name=builtin)
+        _check_keys(d, {"preset", "seed", "tx_beamforming", "targets", "objects", "noise",
+                        "name"}, "scene")
+        targets = d.get("targets", [])
+        objects = d.get("objects", [])
+        if not isinstance(targets, list):
+            raise ValueError("targets: must be a list")
+        if not isinstance(objects, list):
+            raise ValueError("objects: must be a list")
+        if not targets and not objects:
+            raise ValueError("scene: needs at least one entry in 'targets' or 'objects'")
+        name = d.get("name", "custom")
+        return Scene(
+            preset=preset, seed=_int(d, "seed", 0),
+            tx_beamforming=_bool(d, "tx_beamforming", True),
+            targets=tuple(PointTarget.from_dict(t, f"targets[{i}]")
+                          for i, t in enumerate(targets)),
+            objects=tuple(ExtendedObject.from_dict(o, f"objects[{i}]")
+                          for i, o in enumerate(objects)),
+            noise=_bool(d, "noise", True), name=str(name))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Scene JSON (explicit targets and objects, never a built-in name)."""
+        return {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
+                "noise": self.noise, "name": self.name,
+                "targets": [asdict(t) for t in self.targets],
+                "objects": [asdict(o) for o in self.objects]}
+
+
+def _int(d: Mapping[str, Any], key: str, default: int) -> int:
+    v = d.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+        raise ValueError(f"{key}: must be a non-negative integer, got {v!r}")
+    return v
+
+
+def _bool(d: Mapping[str, Any], key: str, default: bool) -> bool:
+    v = d.get(key, default)
+    if not isinstance(v, bool):
+        raise ValueError(f"{key}: must be true or false, got {v!r}")
+    return v
+
+
+# ---- the paper's Table I scene -------------------------------------------------------------
+EGO_SPEED_KMH = 100.0
+"""Ego vehicle speed of the paper's Table I scene, km/h."""
+
+TABLE1_VEHICLES: tuple[tuple[float, float, float, float], ...] = (
+    # (RCS m^2, own speed km/h, azimuth deg, range m) -- paper Table I
+    (10.0, 50.0, 30.0, 100.0),
+    (40.0, 96.0, 10.0, 50.0),
+    (20.0, -80.0, -10.0, 40.0),
+    (10.0, 25.0, -30.0, 20.0),
+)
+
+
+def table1_scene(preset: str = "full", seed: int = 1, tx_beamforming: bool = True) -> Scene:
+    """The paper's Table I scene: ego at 100 km/h, four vehicles.
+
+    Each vehicle closes at (ego speed - own speed): 13.89, 1.11, 50.0 and 20.83 m/s (the
+    paper's Table III "actual speed"), so its radial velocity is minus that (approaching).
+    Vehicle 3 (-50 m/s) exceeds the +-27.78 m/s unambiguous velocity and aliases to
+    +5.56 m/s in every preset: a real limitation of the waveform, reported, not hidden.
+    """
+    targets = tuple(
+        PointTarget(range_m=r, azimuth_deg=az,
+                    radial_velocity_mps=-(EGO_SPEED_KMH - own) * KMH, rcs_m2=rcs)
+        for rcs, own, az, r in TABLE1_VEHICLES)
+    return Scene(preset=preset, seed=seed, tx_beamforming=tx_beamforming, targets=targets,
+                 name="table1")
+
+
+BUILTIN_SCENES = {"table1": table1_scene}
+
+
+def load_scene(spec: str | Path, preset: str | None = None) -> Scene:
+    """A scene from a JSON file path or a built-in name (``table1``).
+
+    ``preset`` overrides the preset of a built-in scene given by name. Raises ValueError
+    with a one-line reason on a missing file, invalid JSON or an invalid field.
+    """
+    spec_s = str(spec)
+    if spec_s in BUILTIN_SCENES:
+        return Scene.from_dict({"scene": spec_s, "preset": preset or "full"})
+    path = Path(spec_s)
+    if not path.is_file():
+        raise ValueError(f"scene: no such file {spec_s!r} and not a built-in scene "
+                         f"({', '.join(BUILTIN_SCENES)})")
+    try:
+        data = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"scene: {spec_s} is not valid JSON: {exc}") from None
+    if preset is not None and isinstance(data, dict):
+        data = {**data, "preset": preset}
+    return Scene.from_dict(data)
