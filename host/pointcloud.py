@@ -1,0 +1,110 @@
+"""Radar point cloud: one detection per row, the fields of DESIGN.md section 4 and more.
+
+A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per point:
+
+- ``range_m`` (m), ``azimuth_deg`` (deg, + towards +y), ``radial_velocity_mps`` (m/s,
+  + receding), ``x_m``/``y_m`` (m; x forward, y left)
+- ``vx_mps``/``vy_mps``: the radial velocity projected on the line of sight (m/s)
+- ``power_db``: cell power after angle FFT, dB re 1 LSB^2; ``snr_db``: over the local noise
+- ``rcs_dbsm``: RCS estimate from the radar equation, dB re 1 m^2
+- ``range_bin``, ``doppler_bin`` (signed), ``ambiguous`` (bool: the velocity may be aliased,
+  i.e. it lies within one velocity bin of +-vmax or the detection is otherwise flagged)
+
+JSON (``to_json_dict``) follows DESIGN.md section 4: ``{"preset", "frames", "points": [...]}``
+with the required fields range_m, azimuth_deg, radial_velocity_mps, x_m, y_m, power_db,
+snr_db plus the extra ones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+FLOAT_FIELDS = ("range_m", "azimuth_deg", "radial_velocity_mps", "x_m", "y_m", "vx_mps",
+                "vy_mps", "power_db", "snr_db", "rcs_dbsm")
+INT_FIELDS = ("range_bin", "doppler_bin", "frame")
+BOOL_FIELDS = ("ambiguous",)
+
+
+@dataclass(frozen=True)
+class PointCloud:
+    """Detections of one or more frames; every field is an array of shape (n,)."""
+
+    range_m: np.ndarray
+    azimuth_deg: np.ndarray
+    radial_velocity_mps: np.ndarray
+    x_m: np.ndarray
+    y_m: np.ndarray
+    vx_mps: np.ndarray
+    vy_mps: np.ndarray
+    power_db: np.ndarray
+    snr_db: np.ndarray
+    rcs_dbsm: np.ndarray
+    range_bin: np.ndarray
+    doppler_bin: np.ndarray
+    frame: np.ndarray
+    ambiguous: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.range_m)
+        for f in fields(self):
+            if len(getattr(self, f.name)) != n:
+                raise ValueError(f"PointCloud.{f.name}: length {len(getattr(self, f.name))} "
+                                 f"!= {n}")
+
+    def __len__(self) -> int:
+        return int(len(self.range_m))
+
+    @classmethod
+    def from_polar(cls, range_m: np.ndarray, azimuth_deg: np.ndarray,
+                   radial_velocity_mps: np.ndarray, power_db: np.ndarray, snr_db: np.ndarray,
+                   rcs_dbsm: np.ndarray, range_bin: np.ndarray, doppler_bin: np.ndarray,
+                   ambiguous: np.ndarray, frame: int | np.ndarray = 0) -> PointCloud:
+        """Build a cloud from polar measurements; x, y, vx, vy are derived."""
+        r = np.asarray(range_m, dtype=float)
+        az = np.radians(np.asarray(azimuth_deg, dtype=float))
+        vr = np.asarray(radial_velocity_mps, dtype=float)
+        n = r.shape[0]
+        return cls(
+            range_m=r, azimuth_deg=np.degrees(az), radial_velocity_mps=vr,
+            x_m=r * np.cos(az), y_m=r * np.sin(az), vx_mps=vr * np.cos(az),
+            vy_mps=vr * np.sin(az), power_db=np.asarray(power_db, dtype=float),
+            snr_db=np.asarray(snr_db, dtype=float), rcs_dbsm=np.asarray(rcs_dbsm, dtype=float),
+            range_bin=np.asarray(range_bin, dtype=int), doppler_bin=np.asarray(doppler_bin,
+                                                                               dtype=int),
+            frame=np.broadcast_to(np.asarray(frame, dtype=int), (n,)).copy(),
+            ambiguous=np.asarray(ambiguous, dtype=bool))
+
+    @classmethod
+    def empty(cls) -> PointCloud:
+        z = np.zeros(0)
+        return cls.from_polar(z, z, z, z, z, z, z.astype(int), z.astype(int),
+                              z.astype(bool))
+
+    @staticmethod
+    def concat(clouds: list[PointCloud]) -> PointCloud:
+        """All points of ``clouds`` in order."""
+        if not clouds:
+            return PointCloud.empty()
+        return PointCloud(**{f.name: np.concatenate([getattr(c, f.name) for c in clouds])
+                             for f in fields(PointCloud)})
+
+    def select(self, mask: np.ndarray) -> PointCloud:
+        """The points where ``mask`` (bool (n,) or index array) selects."""
+        return PointCloud(**{f.name: getattr(self, f.name)[mask] for f in fields(self)})
+
+    def records(self) -> list[dict[str, Any]]:
+        """One JSON-ready dict per point (floats rounded to 4 decimals)."""
+        out = []
+        for i in range(len(self)):
+            rec: dict[str, Any] = {k: round(float(getattr(self, k)[i]), 4) for k in FLOAT_FIELDS}
+            rec.update({k: int(getattr(self, k)[i]) for k in INT_FIELDS})
+            rec["ambiguous"] = bool(self.ambiguous[i])
+            out.append(rec)
+        return out
+
+    def to_json_dict(self, preset: str, frames: int) -> dict[str, Any]:
+        """The DESIGN.md section 4 point cloud JSON object."""
+        return {"preset": preset, "frames": int(frames), "points": self.records()}
