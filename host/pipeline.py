@@ -1,0 +1,206 @@
+"""Host processing of one frame: radar cube -> detections -> angles -> point cloud.
+
+Steps (DESIGN.md section 1, host side):
+
+1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
+   integrated non-coherently over all virtual channels, or the paper's threshold on channel
+   0; peak grouping keeps local maxima.
+2. Range and Doppler refined by log-parabolic (Gaussian) interpolation around each peak.
+3. TDM Doppler phase compensation per TX slot, with velocity unfolding: the Doppler of a
+   target beyond +-vmax is aliased, and the compensation for the true (unfolded) Doppler
+   gives a sharper angle spectrum than the aliased one. Hypotheses m in {-1, 0, +1} (velocity
+   + 2 m vmax) are compared when num_tx > 1 and the cell is strong enough to decide; the
+   winner is used and ``ambiguous`` is set whenever the measured Doppler was aliased
+   (unfolded) or the test could not decide.
+4. Angle: zero-padded angle FFT with interpolated peaks, RELAX-style so several targets in
+   a cell give several points (``host.angle``).
+5. Point cloud: range corrected for range-Doppler coupling, x/y, vx/vy, power, coherent
+   SNR and an RCS estimate from the radar equation (``host.pointcloud``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from host.angle import AngleParams, estimate_angles, peak_power
+from host.cfar import CfarParams, cfar_threshold, local_peaks, paper_threshold
+from host.pointcloud import PointCloud
+from model.config import RadarConfig, dbm_to_w
+from model.reference import (
+    hann_periodic,
+    radar_cube,
+    range_doppler_power,
+    signed_bins,
+    tdm_phase_compensation,
+)
+from model.simulate import rx_gain, tx_gain
+
+DETECTORS = ("ca", "os", "paper")
+
+
+@dataclass(frozen=True)
+class DetectionParams:
+    """Host processing settings.
+
+    ``detector``: ``ca`` / ``os`` CFAR on the non-coherent map, or ``paper`` (threshold
+    ``paper_threshold_db`` above the median of channel 0's map). ``cfar``: window and Pfa.
+    ``range_window``/``doppler_window``: whether the FPGA chain applied Hann windows (for the
+    CFAR cell correlation, scalloping and RCS corrections). ``tx_beamforming``: TX gain
+    model used for the RCS estimate. ``unfold_velocity``: TDM Doppler hypothesis test.
+    ``unfold_min_snr_db`` / ``unfold_margin_db``: a hypothesis other than the aliased one
+    wins only in cells at least this strong and by at least this margin.
+    ``min_range_bin``: bins below it are ignored (DC / TX leakage).
+    """
+
+    detector: str = "ca"
+    cfar: CfarParams = field(default_factory=CfarParams)
+    paper_threshold_db: float = 15.0
+    angle: AngleParams = field(default_factory=AngleParams)
+    range_window: bool = True
+    doppler_window: bool = True
+    tx_beamforming: bool = True
+    unfold_velocity: bool = True
+    unfold_min_snr_db: float = 30.0
+    unfold_margin_db: float = 0.45
+    min_range_bin: int = 1
+
+    def __post_init__(self) -> None:
+        if self.detector not in DETECTORS:
+            raise ValueError(f"detector: must be one of {', '.join(DETECTORS)}, got "
+                             f"{self.detector!r}")
+
+
+def _window_response(n: int, offset: float, windowed: bool) -> float:
+    """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins off a bin centre."""
+    w = hann_periodic(n) if windowed else np.ones(n)
+    return float(abs(np.sum(w * np.exp(-2j * np.pi * offset * np.arange(n) / n))) / w.sum())
+
+
+def _interp(lm: float, c: float, lp: float) -> float:
+    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation)."""
+    den = lm - 2 * c + lp
+    if den >= 0:
+        return 0.0
+    return float(np.clip(0.5 * (lm - lp) / den, -0.5, 0.5))
+
+
+def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Detected range-Doppler cells of a cube.
+
+    cube: complex (n_virtual, n_range, n_doppler). Returns (cells int (n, 2) of
+    (range_bin, doppler_bin natural order), noise float (n,) mean noise power per cell of the
+    non-coherent map, nci float (n_range, n_doppler) the non-coherent map).
+    """
+    nci = range_doppler_power(cube)
+    windowed = (params.range_window, params.doppler_window)
+    cf = params.cfar if params.detector != "os" else CfarParams(
+        pfa=params.cfar.pfa, guard=params.cfar.guard, train=params.cfar.train, kind="os",
+        os_rank=params.cfar.os_rank)
+    if params.detector == "paper":
+        mask, p0 = paper_threshold(cube, params.paper_threshold_db)
+        cells = local_peaks(p0, mask)
+        noise_map = np.full(nci.shape, np.median(nci))
+    else:
+        if params.detector == "ca":
+            cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
+        threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
+        cells = local_peaks(nci, nci > threshold)
+    cells = cells[cells[:, 0] >= params.min_range_bin]
+    return cells, noise_map[cells[:, 0], cells[:, 1]], nci
+
+
+def _choose_fold(x: np.ndarray, cfg: RadarConfig, d: int, snr_db: float,
+                 params: DetectionParams) -> tuple[int, bool]:
+    """TDM Doppler hypothesis m for a cell: (m, ambiguous)."""
+    if cfg.num_tx == 1 or not params.unfold_velocity:
+        return 0, False
+    n_fft = params.angle.n_fft
+    k = int(signed_bins(cfg.n_doppler)[d])
+    powers = {m: peak_power(x * tdm_phase_compensation(cfg, k + m * cfg.n_doppler), n_fft)
+              for m in (-1, 0, 1)}
+    best = max(powers, key=powers.__getitem__)
+    margin_db = 10 * np.log10(powers[best] / powers[0]) if best != 0 else 0.0
+    if best != 0 and snr_db >= params.unfold_min_snr_db and margin_db >= params.unfold_margin_db:
+        return best, True
+    # aliased hypothesis kept; ambiguous when another explains the cell (almost) as well
+    second = max(p for m, p in powers.items() if m != 0)
+    undecided = 10 * np.log10(powers[0] / second) < params.unfold_margin_db
+    return 0, bool(undecided and snr_db < params.unfold_min_snr_db)
+
+
+def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.ndarray,
+                      azimuth_deg: np.ndarray, beamforming: bool) -> np.ndarray:
+    """Radar-equation inverse: RCS (dBsm) from the ADC-referred tone amplitude (LSB)."""
+    pr = (np.asarray(amplitude_adc) / cfg.adc_full_scale) ** 2 * dbm_to_w(cfg.adc_full_scale_dbm)
+    lam = cfg.wavelength_m
+    g = dbm_to_w(cfg.tx_power_dbm) * tx_gain(cfg, azimuth_deg, beamforming) \
+        * rx_gain(cfg, azimuth_deg) * lam**2
+    loss = 10 ** (cfg.system_loss_db / 10)
+    with np.errstate(divide="ignore"):
+        sigma = pr * (4 * np.pi) ** 3 * np.asarray(range_m) ** 4 * loss / np.maximum(g, 1e-30)
+        return 10 * np.log10(np.maximum(sigma, 1e-30))
+
+
+def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
+                 frame: int = 0) -> PointCloud:
+    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
+    params = params or DetectionParams()
+    expected = (cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    if cube.shape != expected:
+        raise ValueError(f"cube: expected shape {expected} for preset {cfg.name!r}, got "
+                         f"{cube.shape}")
+    cells, noise, nci = detect_cells(cube, cfg, params)
+    logp = np.log(np.maximum(nci, 1e-30))
+    nr, nd = cfg.n_range, cfg.n_doppler
+    sbins = signed_bins(nd)
+    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
+    rows: dict[str, list[float]] = {k: [] for k in (
+        "range_m", "azimuth_deg", "radial_velocity_mps", "power_db", "snr_db", "amp_adc",
+        "range_bin", "doppler_bin", "ambiguous")}
+    for (r, d), noise_cell in zip(cells, noise, strict=True):
+        dr = _interp(logp[r - 1, d], logp[r, d], logp[r + 1, d]) if 0 < r < nr - 1 else 0.0
+        dd = _interp(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
+        x = cube[:, r, d]
+        noise_ch = noise_cell / cfg.n_virtual
+        cell_snr_db = 10 * np.log10(max(nci[r, d] - noise_cell, 1e-30) / noise_cell) \
+            + 10 * np.log10(cfg.n_virtual)
+        fold, ambiguous = _choose_fold(x, cfg, d, cell_snr_db, params)
+        k = int(sbins[d]) + fold * nd
+        comps = estimate_angles(x * tdm_phase_compensation(cfg, k), noise_ch, params.angle)
+        velocity = (k + dd) * cfg.velocity_bin_mps
+        # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
+        coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
+        range_m = (r + dr - coupling) * cfg.range_bin_m
+        scallop = _window_response(nr, dr, params.range_window) * _window_response(
+            nd, dd, params.doppler_window)
+        for c in comps:
+            rows["range_m"].append(range_m)
+            rows["azimuth_deg"].append(c.azimuth_deg)
+            rows["radial_velocity_mps"].append(velocity)
+            rows["power_db"].append(20 * np.log10(max(abs(c.amplitude), 1e-30)))
+            rows["snr_db"].append(c.snr_db)
+            rows["amp_adc"].append(abs(c.amplitude) / (cg * scallop))
+            rows["range_bin"].append(r)
+            rows["doppler_bin"].append(k)
+            rows["ambiguous"].append(ambiguous or fold != 0)
+    a = {k: np.asarray(v) for k, v in rows.items()}
+    if not len(a["range_m"]):
+        return PointCloud.empty()
+    rcs = rcs_estimate_dbsm(cfg, a["amp_adc"], a["range_m"], a["azimuth_deg"],
+                            params.tx_beamforming)
+    return PointCloud.from_polar(
+        a["range_m"], a["azimuth_deg"], a["radial_velocity_mps"], a["power_db"], a["snr_db"],
+        rcs, a["range_bin"].astype(int), a["doppler_bin"].astype(int),
+        a["ambiguous"].astype(bool), frame=frame)
+
+
+def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
+                  frame: int = 0) -> PointCloud:
+    """ADC frame, complex (n_chirps, num_rx, n_range) -> point cloud, through the float
+    reference of the FPGA chain (``model.reference.radar_cube``) and :func:`process_cube`."""
+    params = params or DetectionParams()
+    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window)
+    return process_cube(cube, cfg, params, frame)
