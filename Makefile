@@ -49,6 +49,7 @@ lint: $(STAMP)
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
+	$(RUN) python -m host.bench_host
 
 clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache

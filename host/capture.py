@@ -1,0 +1,97 @@
+"""Recorded DMA streams ("captures"): a file of packets exactly as the board sends them.
+
+File layout (little-endian)::
+
+    bytes 0..7   b"RDMACAP1"
+    u32          num_rx (lanes per word)
+    u32          packet_words (payload words per packet)
+    u32          num_tx, u32 n_range, u32 n_doppler   (frame geometry)
+    then per packet: u32 length in bytes, the packet's bytes (header word + payload)
+
+``radar replay`` sends a capture over UDP one packet per datagram; ``radar receive`` decodes
+datagrams with :class:`host.stream.StreamDecoder`.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from model.config import RadarConfig
+from model.packetizer import cube_to_payload, packetize, words_to_bytes
+from model.reference import cube_to_dma_order
+
+MAGIC = b"RDMACAP1"
+_HEAD = struct.Struct("<8s5I")
+
+
+@dataclass(frozen=True)
+class CaptureInfo:
+    """Geometry stored in a capture's file header."""
+
+    num_rx: int
+    packet_words: int
+    num_tx: int
+    n_range: int
+    n_doppler: int
+
+    def matches(self, cfg: RadarConfig) -> bool:
+        return (self.num_rx, self.num_tx, self.n_range, self.n_doppler) == (
+            cfg.num_rx, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+
+
+def frame_packets(cube: np.ndarray, cfg: RadarConfig, packet_words: int, frame_id: int
+                  ) -> list[bytes]:
+    """The DMA packets (bytes) of one frame.
+
+    cube: integer-valued complex (n_virtual, n_range, n_doppler) in int16 range.
+    """
+    words = cube_to_payload(cube_to_dma_order(cube, cfg))
+    return [words_to_bytes(p) for p in packetize(words, packet_words, frame_id)]
+
+
+def write_capture(path: Path, info: CaptureInfo, packets: Iterable[bytes]) -> int:
+    """Write packets to ``path``; returns the number written."""
+    n = 0
+    with open(path, "wb") as f:
+        f.write(_HEAD.pack(MAGIC, info.num_rx, info.packet_words, info.num_tx, info.n_range,
+                           info.n_doppler))
+        for p in packets:
+            f.write(struct.pack("<I", len(p)))
+            f.write(p)
+            n += 1
+    return n
+
+
+def read_capture(path: Path) -> tuple[CaptureInfo, Iterator[bytes]]:
+    """Header and an iterator over the packets of a capture; ValueError if it is not one
+    (bad magic, truncated header) -- a truncated last record is reported by the iterator
+    raising ValueError."""
+    f = open(path, "rb")  # noqa: SIM115 - closed by the generator
+    head = f.read(_HEAD.size)
+    if len(head) < _HEAD.size or head[:8] != MAGIC:
+        f.close()
+        raise ValueError(f"{path}: not a DMA capture (missing {MAGIC!r} header)")
+    _, num_rx, packet_words, num_tx, n_range, n_doppler = _HEAD.unpack(head)
+    info = CaptureInfo(num_rx, packet_words, num_tx, n_range, n_doppler)
+
+    def packets() -> Iterator[bytes]:
+        with f:
+            while True:
+                n = f.read(4)
+                if not n:
+                    return
+                if len(n) < 4:
+                    raise ValueError(f"{path}: truncated record length")
+                (length,) = struct.unpack("<I", n)
+                data = f.read(length)
+                if len(data) < length:
+                    raise ValueError(f"{path}: truncated packet ({len(data)} of {length} "
+                                     f"bytes)")
+                yield data
+
+    return info, packets()
