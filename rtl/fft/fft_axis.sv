@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: Apache-2.0
+// Streaming FFT/IFFT with AXI4-Stream interfaces (open replacement of the Xilinx FFT IP):
+// radix-2^2 single-path delay-feedback pipeline, one complex sample per clock per lane,
+// continuous frames, natural-order output, full backpressure, self-draining.
+`default_nettype none
+
+module fft_axis #(
+  // Transform length in samples, power of two, 16..4096.
+  parameter int N = 64,
+  // Channels processed in parallel, one lane each, 1..16 (lane 0 in the LSBs).
+  parameter int NUM_CH = 1,
+  // Bits of I and of Q, input and output, 8..24.
+  parameter int DATA_W = 16,
+  // 0: forward DFT (e^-j); 1: inverse (e^+j), same scaling.
+  parameter bit INVERSE = 0,
+  // Input window applied before the first butterfly: 0 none, 1 periodic Hann.
+  parameter bit WINDOW = 0,
+  // Scaling schedule, bit s = 1 divides radix-2 stage s (s = 0 first) by 2 with convergent
+  // rounding; bits >= log2(N) are ignored. Default 'hFFF (all stages): round(DFT(x)/N).
+  parameter int unsigned SCALE_SCH = 32'hFFF,
+  // Extra fraction bits carried inside the pipeline, 0..16; DATA_W+1+GUARD_W <= 27 so each
+  // real multiplier fits one DSP48E2 (27 x 18).
+  parameter int GUARD_W = 4
+) (
+  // Clock and synchronous active-high reset.
+  input  logic clk, rst,
+  // AXI4-Stream sink: time-domain samples, {Q, I} per lane, tlast on sample N-1.
+  input  logic [NUM_CH*2*DATA_W-1:0] s_axis_tdata,
+  input  logic s_axis_tvalid,
+  output logic s_axis_tready,
+  input  logic s_axis_tlast,
+  // AXI4-Stream source: bins in natural order, tuser = bin index, tlast on bin N-1.
+  output logic [NUM_CH*2*DATA_W-1:0] m_axis_tdata,
+  output logic m_axis_tvalid,
+  input  logic m_axis_tready,
+  output logic m_axis_tlast,
+  output logic [$clog2(N)-1:0] m_axis_tuser,
+  // Events, one-cycle pulses, registered: tlast on a sample that is not N-1 / missing on
+  // sample N-1 (the frame count is not resynchronised, like the Xilinx core); an output beat
+  // whose computation saturated (any lane, any stage), the cycle after its handshake.
+  output logic event_tlast_unexpected, event_tlast_missing, event_overflow
+);
+  import fft_pkg::*;
+
+  localparam int LOG2N = $clog2(N);
+  localparam int W     = DATA_W + 1 + GUARD_W;   // internal bits per component
+  localparam int DW    = NUM_CH * 2 * W;
+  localparam int ODW   = NUM_CH * 2 * DATA_W;
+  localparam int CNT_W = LOG2N + 2;              // samples in flight < 4N
+
+  // ---------------------------------------------------------------- parameter checks
+  if (N < 16 || N > 4096 || (1 << LOG2N) != N) begin : g_bad_n
+    $fatal(1, "fft_axis: parameter N=%0d must be a power of two in 16..4096", N);
+  end
+  if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_ch
+    $fatal(1, "fft_axis: parameter NUM_CH=%0d must be in 1..16", NUM_CH);
+  end
+  if (DATA_W < 8 || DATA_W > 24) begin : g_bad_dw
+    $fatal(1, "fft_axis: parameter DATA_W=%0d must be in 8..24", DATA_W);
+  end
+  if (GUARD_W < 0 || GUARD_W > 16 || W > 27) begin : g_bad_gw
+    $fatal(1, "fft_axis: parameter GUARD_W=%0d needs 0..16 and DATA_W+1+GUARD_W <= 27",
+           GUARD_W);
+  end
+
+  // ---------------------------------------------------------------- input control
+  // The whole pipeline moves on `adv`: a real input sample, or a bubble when the input is
+  // idle at a frame boundary while valid samples are still inside (self-draining). Bubbles
+  // carry a phantom index counting from 0 so every stage keeps its frame alignment.
+  logic [LOG2N-1:0] in_cnt_q, ph_cnt_q;
+  logic [CNT_W-1:0] inflight_q;
+  logic can_adv, in_fire, bubble, adv;
+
+  // last pipeline register (output conversion) and the reorder buffer write side
+  logic [ODW:0]     cv_data_q;   // {overflow, data}
+  logic [LOG2N-1:0] cv_pos_q;
+  logic             cv_vld_q;
+  logic             wr_ok;
+
+  assign can_adv       = !cv_vld_q || wr_ok;
+  assign s_axis_tready = can_adv;
+  assign in_fire       = s_axis_tvalid && can_adv;
+  assign bubble        = !s_axis_tvalid && can_adv && in_cnt_q == '0 && inflight_q != '0;
+  assign adv           = in_fire || bubble;
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      in_cnt_q   <= '0;
+      ph_cnt_q   <= '0;
+      inflight_q <= '0;
+    end else begin
+      if (in_fire) begin
+        in_cnt_q <= in_cnt_q + 1'b1;
+        ph_cnt_q <= '0;
+      end else if (bubble) begin
+        ph_cnt_q <= ph_cnt_q + 1'b1;
+      end
+      inflight_q <= inflight_q + CNT_W'(in_fire) - CNT_W'(adv && cv_vld_q);
+    end
+  end
+
+  // ---------------------------------------------------------------- input / window stage
+  // Stage boundary arrays: index s is the input of butterfly stage s, LOG2N the output.
+  logic [DW-1:0]    st_data [LOG2N+1];
+  logic             st_vld  [LOG2N+1];
+  logic [LOG2N-1:0] st_pos  [LOG2N+1];
+  logic             st_ov   [LOG2N+1];
+
+  fft_window #(
+    .NUM_CH(NUM_CH), .DATA_W(DATA_W), .GUARD_W(GUARD_W), .W(W), .LOG2N(LOG2N),
+    .WINDOW(WINDOW)
+  ) u_window (
+    .clk, .rst, .en(adv),
+    .in_data(s_axis_tdata), .in_vld(in_fire), .in_pos(in_fire ? in_cnt_q : ph_cnt_q),
+    .out_data(st_data[0]), .out_vld(st_vld[0]), .out_pos(st_pos[0])
+  );
+  assign st_ov[0] = 1'b0;
+
+  // ---------------------------------------------------------------- SDF stages
+  for (genvar s = 0; s < LOG2N; s++) begin : g_stage
+    logic [DW-1:0]    bo_data;
+    logic             bo_vld, bo_ov;
+    logic [LOG2N-1:0] bo_pos;
+
+    fft_sdf_bf #(
+      .NUM_CH(NUM_CH), .W(W), .LOG2N(LOG2N), .D(N >> (s + 1)),
+      .ROTATE(s % 2 == 1), .INVERSE(INVERSE), .SCALE(SCALE_SCH[s])
+    ) u_bf (
+      .clk, .rst, .en(adv),
+      .in_data(st_data[s]), .in_vld(st_vld[s]), .in_pos(st_pos[s]), .in_ov(st_ov[s]),
+      .out_data(bo_data), .out_vld(bo_vld), .out_pos(bo_pos), .out_ov(bo_ov)
+    );
+
+    if (s % 2 == 1 && s + 1 < LOG2N) begin : g_tw
+      // twiddle after the radix-2^2 pair (s-1, s), sub-transform length N >> (s-1)
+      fft_twiddle #(
+        .NUM_CH(NUM_CH), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N - s + 1), .INVERSE(INVERSE)
+      ) u_tw (
+        .clk, .rst, .en(adv),
+        .in_data(bo_data), .in_vld(bo_vld), .in_pos(bo_pos), .in_ov(bo_ov),
+        .out_data(st_data[s+1]), .out_vld(st_vld[s+1]), .out_pos(st_pos[s+1]),
+        .out_ov(st_ov[s+1])
+      );
+    end else begin : g_notw
+      assign st_data[s+1] = bo_data;
+      assign st_vld[s+1]  = bo_vld;
+      assign st_pos[s+1]  = bo_pos;
+      assign st_ov[s+1]   = bo_ov;
+    end
+  end
+
+  // ---------------------------------------------------------------- output conversion
+  logic [ODW-1:0] cv_d;
+  logic           cv_ov;
+  always_comb begin
+    logic signed [63:0] v;
+    cv_d  = '0;
+    cv_ov = st_ov[LOG2N];
+    for (int c = 0; c < 2 * NUM_CH; c++) begin
+      v = round_conv(64'(signed'(st_data[LOG2N][c*W +: W])), GUARD_W);
+      cv_ov = cv_ov | sat_ov(v, DATA_W);
+      cv_d[c*DATA_W +: DATA_W] = DATA_W'(sat_val(v, DATA_W));
+    end
+  end
+
+  always_ff @(posedge clk) begin
+    if (adv) begin
+      cv_data_q <= {cv_ov, cv_d};
+      cv_pos_q  <= st_pos[LOG2N];
+    end
+  end
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      cv_vld_q <= 1'b0;
+    end else if (adv) begin
+      cv_vld_q <= st_vld[LOG2N];
+    end
+  end
+
+  // ---------------------------------------------------------------- reorder + output
+  logic [ODW:0] m_word;
+
+  fft_reorder #(.N(N), .WIDTH(ODW + 1)) u_reorder (
+    .clk, .rst,
+    .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
+    .m_data(m_word), .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),
+    .m_last(m_axis_tlast), .m_user(m_axis_tuser)
+  );
+  assign m_axis_tdata = m_word[ODW-1:0];
+
+  // ---------------------------------------------------------------- events
+  logic ev_unexp_q, ev_miss_q, ev_ov_q;
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      ev_unexp_q <= 1'b0;
+      ev_miss_q  <= 1'b0;
+      ev_ov_q    <= 1'b0;
+    end else begin
+      ev_unexp_q <= in_fire && s_axis_tlast && in_cnt_q != LOG2N'(N - 1);
+      ev_miss_q  <= in_fire && !s_axis_tlast && in_cnt_q == LOG2N'(N - 1);
+      ev_ov_q    <= m_axis_tvalid && m_axis_tready && m_word[ODW];
+    end
+  end
+  assign event_tlast_unexpected = ev_unexp_q;
+  assign event_tlast_missing    = ev_miss_q;
+  assign event_overflow         = ev_ov_q;
+
+  // ---------------------------------------------------------------- protocol assertions
+`ifndef SYNTHESIS
+  logic             chk_q, s_stall_q, m_stall_q;
+  logic [ODW-1:0]   s_data_q, m_data_q;
+  logic             s_last_q, m_last_q;
+  logic [LOG2N-1:0] m_user_q;
+  always_ff @(posedge clk) begin
+    chk_q     <= !rst;
+    s_stall_q <= s_axis_tvalid && !s_axis_tready;
+    m_stall_q <= m_axis_tvalid && !m_axis_tready;
+    s_data_q  <= s_axis_tdata;
+    s_last_q  <= s_axis_tlast;
+    m_data_q  <= m_axis_tdata;
+    m_last_q  <= m_axis_tlast;
+    m_user_q  <= m_axis_tuser;
+    if (chk_q && !rst) begin
+      if (s_stall_q) begin
+        assert (s_axis_tvalid && s_axis_tdata == s_data_q && s_axis_tlast == s_last_q)
+          else $error("fft_axis: s_axis TVALID dropped or TDATA/TLAST changed while stalled");
+      end
+      if (m_stall_q) begin
+        assert (m_axis_tvalid && m_axis_tdata == m_data_q && m_axis_tlast == m_last_q &&
+                m_axis_tuser == m_user_q)
+          else $error("fft_axis: m_axis TVALID dropped or payload changed while stalled");
+      end
+    end
+  end
+`endif
+endmodule
+
+`default_nettype wire

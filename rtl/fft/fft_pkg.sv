@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: Apache-2.0
+// Fixed-point helpers of the streaming FFT: convergent rounding and saturation.
+`default_nettype none
+
+package fft_pkg;
+  // Convergent rounding (round half to even) of v / 2^k, k >= 0. Operands are 64-bit so one
+  // function serves every width; synthesis trims the unused bits at each call site.
+  function automatic logic signed [63:0] round_conv(input logic signed [63:0] v,
+                                                    input int unsigned k);
+    logic signed [63:0] q;
+    logic [63:0] mask;
+    logic half, rest;
+    if (k == 0) return v;
+    q = v >>> k;
+    half = v[k-1];
+    mask = (64'd1 << (k - 1)) - 64'd1;
+    rest = |(v & mask);
+    return q + ((half && (rest || q[0])) ? 64'sd1 : 64'sd0);
+  endfunction
+
+  // True when v does not fit a w-bit two's complement number.
+  function automatic logic sat_ov(input logic signed [63:0] v, input int unsigned w);
+    logic signed [63:0] hi, lo;
+    hi = (64'sd1 <<< (w - 1)) - 64'sd1;
+    lo = -(64'sd1 <<< (w - 1));
+    return (v > hi) || (v < lo);
+  endfunction
+
+  // v clipped to the w-bit two's complement range (result in the low w bits).
+  function automatic logic signed [63:0] sat_val(input logic signed [63:0] v,
+                                                 input int unsigned w);
+    logic signed [63:0] hi, lo;
+    hi = (64'sd1 <<< (w - 1)) - 64'sd1;
+    lo = -(64'sd1 <<< (w - 1));
+    if (v > hi) return hi;
+    if (v < lo) return lo;
+    return v;
+  endfunction
+endpackage
+
+`default_nettype wire

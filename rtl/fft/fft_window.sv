@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: Apache-2.0
+// Input stage of the streaming FFT: widens each I/Q sample to the internal format
+// (GUARD_W fraction bits) and, with WINDOW = 1, multiplies it by the periodic Hann window
+// from the shared ROM (registered operands and product, convergent rounding).
+`default_nettype none
+
+module fft_window #(
+  // Lanes processed in parallel, 1..16.
+  parameter int NUM_CH = 1,
+  // Input bits of I and of Q, 8..24.
+  parameter int DATA_W = 16,
+  // Fraction bits added inside the pipeline, 0..16.
+  parameter int GUARD_W = 4,
+  // Internal bits of I and of Q (>= DATA_W + GUARD_W).
+  parameter int W = 21,
+  // log2 of the transform length, 4..12.
+  parameter int LOG2N = 6,
+  // 0: no window (1 advance of latency); 1: periodic Hann (2 advances).
+  parameter bit WINDOW = 0
+) (
+  input  logic clk,
+  input  logic rst,
+  // Pipeline advance.
+  input  logic en,
+  // Sample in (DATA_W per component).
+  input  logic [NUM_CH*2*DATA_W-1:0] in_data,
+  input  logic                       in_vld,
+  input  logic [LOG2N-1:0]           in_pos,
+  // Sample out (W per component).
+  output logic [NUM_CH*2*W-1:0]      out_data,
+  output logic                       out_vld,
+  output logic [LOG2N-1:0]           out_pos
+);
+  import fft_pkg::*;
+  import fft_rom_pkg::*;
+
+  localparam int DW = NUM_CH * 2 * W;
+
+  if (W < DATA_W + GUARD_W || GUARD_W > COEF_FRAC || LOG2N > ROM_LOG2) begin : g_bad
+    $fatal(1, "fft_window: need W >= DATA_W+GUARD_W, GUARD_W <= 16 (GUARD_W=%0d)", GUARD_W);
+  end
+
+  if (WINDOW) begin : g_win
+    logic [NUM_CH*2*DATA_W-1:0] d1_q;
+    logic [LOG2N-1:0]           pos1_q, pos2_q;
+    logic                       vld1_q, vld2_q;
+    logic signed [COEF_W-1:0]   w1_q;
+    logic [DW-1:0]              y_d, y2_q;
+    logic [ROM_LOG2-1:0]        rom_idx;
+
+    assign rom_idx = ROM_LOG2'(in_pos) << (ROM_LOG2 - LOG2N);
+
+    always_comb begin
+      logic signed [63:0] p;
+      y_d = '0;
+      for (int c = 0; c < 2 * NUM_CH; c++) begin
+        p = 64'(signed'(d1_q[c*DATA_W +: DATA_W])) * 64'(w1_q);
+        // |x * w| <= |x| so the result always fits: no saturation needed.
+        y_d[c*W +: W] = W'(round_conv(p, COEF_FRAC - GUARD_W));
+      end
+    end
+
+    always_ff @(posedge clk) begin
+      if (en) begin
+        d1_q   <= in_data;
+        w1_q   <= signed'(HANN[rom_idx]);
+        pos1_q <= in_pos;
+        y2_q   <= y_d;
+        pos2_q <= pos1_q;
+      end
+    end
+
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        vld1_q <= 1'b0;
+        vld2_q <= 1'b0;
+      end else if (en) begin
+        vld1_q <= in_vld;
+        vld2_q <= vld1_q;
+      end
+    end
+
+    assign out_data = y2_q;
+    assign out_vld  = vld2_q;
+    assign out_pos  = pos2_q;
+  end else begin : g_nowin
+    logic [DW-1:0]    y_d, y1_q;
+    logic [LOG2N-1:0] pos1_q;
+    logic             vld1_q;
+
+    always_comb begin
+      y_d = '0;
+      for (int c = 0; c < 2 * NUM_CH; c++) begin
+        y_d[c*W +: W] = W'(signed'(in_data[c*DATA_W +: DATA_W])) <<< GUARD_W;
+      end
+    end
+
+    always_ff @(posedge clk) begin
+      if (en) begin
+        y1_q   <= y_d;
+        pos1_q <= in_pos;
+      end
+    end
+
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        vld1_q <= 1'b0;
+      end else if (en) begin
+        vld1_q <= in_vld;
+      end
+    end
+
+    assign out_data = y1_q;
+    assign out_vld  = vld1_q;
+    assign out_pos  = pos1_q;
+  end
+endmodule
+
+`default_nettype wire
