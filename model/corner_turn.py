@@ -1,0 +1,103 @@
+"""Bit-exact model of ``rtl/buffers/corner_turn.sv`` (frame transpose between the range FFT and
+the Doppler FFT) and of its in-place address generator.
+
+Words are uint32 lane arrays: a stream of ``n`` words with ``num_rx`` lanes is an array of
+shape ``(n, num_rx)`` (any integer dtype; the model only moves words).
+
+Input order (range FFT output, chirps TX-interleaved): word ``i = (c * n_range + r)`` with
+chirp ``c = d * num_tx + t`` sent by TX ``t``, i.e. the input frame reshapes to
+``(n_doppler, num_tx, n_range, num_rx)``.
+Output order (Doppler vectors): word ``j = (t * n_range + r) * n_doppler + d``, i.e.
+``(num_tx, n_range, n_doppler, num_rx)``, TLAST after every ``n_doppler`` words.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _log2(n: int, name: str) -> int:
+    b = int(n).bit_length() - 1
+    if n < 1 or (1 << b) != n:
+        raise ValueError(f"{name}={n} must be a power of two")
+    return b
+
+
+def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+    """Reorder one frame from chirp order to Doppler-vector order.
+
+    frame: ``(num_tx * n_doppler * n_range, num_rx)`` words in input order.
+    Returns ``(num_tx * n_range * n_doppler, num_rx)`` words in output order.
+    """
+    frame = np.asarray(frame)
+    num_rx = frame.shape[-1]
+    cube = frame.reshape(n_doppler, num_tx, n_range, num_rx)
+    return np.ascontiguousarray(cube.transpose(1, 2, 0, 3)).reshape(-1, num_rx)
+
+
+def output_tlast(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+    """bool ``(frame_words,)``: TLAST of each output word (last word of each Doppler vector)."""
+    j = np.arange(num_tx * n_range * n_doppler)
+    return (j % n_doppler) == n_doppler - 1
+
+
+def address_bits(num_tx: int, n_range: int, n_doppler: int) -> tuple[int, int]:
+    """(B, ROT): address bits of one frame and the per-frame rotation of the in-place scheme."""
+    bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
+                  _log2(n_doppler, "n_doppler"))
+    return bt + br + bd, bt + br
+
+
+def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
+    """Rotate ``bits``-bit integers left by ``s`` (0 <= s < bits)."""
+    x = np.asarray(x, dtype=np.int64)
+    mask = (1 << bits) - 1
+    return ((x << s) | (x >> (bits - s))) & mask if s else x & mask
+
+
+def write_addresses(k: int, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+    """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i) = p^k(i)."""
+    b, rot = address_bits(num_tx, n_range, n_doppler)
+    return rotl(np.arange(1 << b), (k * rot) % b, b)
+
+
+def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+    """int64 ``(frame_words,)``: slot read for output word j of frame k, R_k = W_{k+1}."""
+    return write_addresses(k + 1, num_tx, n_range, n_doppler)
+
+
+def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
+                    n_doppler: int) -> list[np.ndarray]:
+    """Run the in-place address scheme on a one-frame memory (checks the method itself).
+
+    frames: list of input frames ``(frame_words, num_rx)``. Returns the output frames. Raises
+    AssertionError if a slot would be overwritten before being read.
+    """
+    if not frames:
+        return []
+    b, _ = address_bits(num_tx, n_range, n_doppler)
+    mem = np.zeros((1 << b,) + frames[0].shape[1:], dtype=frames[0].dtype)
+    read = np.ones(1 << b, dtype=bool)
+    out = []
+    for k, f in enumerate(frames):
+        wa = write_addresses(k, num_tx, n_range, n_doppler)
+        assert read[wa].all(), "in-place scheme overwrote an unread slot"
+        mem[wa] = f
+        read[:] = False
+        ra = read_addresses(k, num_tx, n_range, n_doppler)
+        out.append(mem[ra].copy())
+        read[ra] = True
+    return out
+
+
+def frame_period(num_tx: int, n_range: int, n_doppler: int) -> int:
+    """Frames after which the in-place address pattern repeats: B / gcd(B, ROT)."""
+    b, rot = address_bits(num_tx, n_range, n_doppler)
+    return b // np.gcd(b, rot)
+
+
+def memory_bits(num_tx: int, num_rx: int, n_range: int, n_doppler: int, data_w: int = 16,
+                in_place: bool = True) -> int:
+    """Frame-buffer bits: one frame in place, two for the paper's double buffer."""
+    words = num_tx * n_range * n_doppler
+    return words * num_rx * 2 * data_w * (1 if in_place else 2)

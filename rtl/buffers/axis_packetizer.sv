@@ -1,0 +1,331 @@
+// SPDX-License-Identifier: Apache-2.0
+// DMA packetizer: a ring of packet banks (double buffer by default) that decouples the
+// Doppler FFT from a stalling DMA sink, cuts each frame into TLAST-closed packets and
+// prepends a header word to each packet.
+//
+// Packet and header format: docs/buffers.md and model/packetizer.py (the host shares it).
+// Frame boundaries come from counting FRAME_WORDS input words after reset; s_axis_tlast is
+// only checked (every TLAST_PERIOD words) and a mismatch raises the framing error flag.
+// Store and forward: a packet is sent only once it is complete in its bank, so its header
+// can state its exact length and whether words were dropped from it.
+`default_nettype none
+
+module axis_packetizer #(
+  // Receive lanes per word (one 32-bit {Q,I} sample each), 1..64.
+  parameter int NUM_RX = 4,
+  // Bits of I and of Q; the DMA format is 32-bit {Q,I} lanes, so only 16 is legal.
+  parameter int DATA_W = 16,
+  // Payload words per packet (the last packet of a frame may be shorter), 2..65535.
+  parameter int PACKET_WORDS = 256,
+  // Payload words per frame, 1..2^30; at most 4096 packets per frame (12-bit sequence).
+  parameter int FRAME_WORDS = 16384,
+  // Packet banks in the output buffer ring, power of two, 2..16. 2 is the paper's double
+  // buffer; more banks absorb longer DMA stalls and short frame-final packets when the
+  // input cannot be stalled.
+  parameter int NUM_BANKS = 2,
+  // 1: one header word before every packet's payload; 0: payload only.
+  parameter bit HEADER = 1'b1,
+  // 1: s_axis_tready deasserts while the bank to write is full (no loss; a stalled DMA
+  //    then stalls the pipeline back to the ADC ping-pong, which flags the loss there);
+  // 0: s_axis_tready is always 1 and a word that finds all banks full is dropped,
+  //    counted and flagged (for producers that cannot be stalled).
+  parameter bit INPUT_BACKPRESSURE = 1'b1,
+  // Expected s_axis_tlast period in words (e.g. N_DOPPLER), must divide FRAME_WORDS;
+  // 0 ignores s_axis_tlast.
+  parameter int TLAST_PERIOD = 0
+) (
+  input  wire logic                     clk,
+  input  wire logic                     rst,
+  // Input stream (Doppler FFT output, payload order)
+  input  wire logic [NUM_RX*32-1:0]     s_axis_tdata,
+  input  wire logic                     s_axis_tvalid,
+  output logic                          s_axis_tready,
+  input  wire logic                     s_axis_tlast,
+  // 1 on words of a frame damaged upstream (zero-filled chirps): sets DAMAGED in the
+  // header of every packet holding such a word (tie to 0 when unused)
+  input  wire logic [0:0]               s_axis_tuser,
+  // DMA stream: [header] payload, TLAST on the last word of every packet
+  output logic      [NUM_RX*32-1:0]     m_axis_tdata,
+  output logic                          m_axis_tvalid,
+  input  wire logic                     m_axis_tready,
+  output logic                          m_axis_tlast,
+  // Status (cleared only by rst)
+  output logic                          status_overflow,       // sticky: a word was dropped
+  output logic                          status_framing_error,  // sticky: s_axis_tlast misplaced
+  output logic      [31:0]              drop_count,            // words dropped (saturating)
+  output logic      [31:0]              framing_error_count,   // misplaced/missing tlasts
+  output logic      [31:0]              frame_count,           // input frames completed
+  output logic      [31:0]              packet_count           // packets sent (incl. header)
+);
+
+  // ---------------------------------------------------------------------------------------
+  // Derived sizes
+  localparam int WORD_W    = NUM_RX * 32;
+  localparam int NPKT      = (FRAME_WORDS + PACKET_WORDS - 1) / PACKET_WORDS;
+  localparam int LAST_LEN  = FRAME_WORDS - (NPKT - 1) * PACKET_WORDS;  // words, last packet
+  localparam int POS_W     = $clog2(PACKET_WORDS);
+  localparam int BANK_W    = $clog2(NUM_BANKS);
+  localparam int LEN_W     = $clog2(PACKET_WORDS + 1);
+  localparam int SEQ_W     = 12;
+  localparam int TLP       = (TLAST_PERIOD > 0) ? TLAST_PERIOD : 1;
+  localparam int TLP_W     = $clog2(TLP + 1);
+  localparam logic [7:0] MAGIC = 8'hA5;
+
+  // Parameter checks: stop elaboration on illegal values.
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_0
+    $fatal(1, "axis_packetizer: NUM_RX=%0d not in 1..64", NUM_RX);
+  end
+  if (DATA_W != 16) begin : g_bad_param_1
+    $fatal(1, "axis_packetizer: DATA_W=%0d, only 16 is legal", DATA_W);
+  end
+  if (PACKET_WORDS < 2 || PACKET_WORDS > 65535) begin : g_bad_param_2
+    $fatal(1, "axis_packetizer: PACKET_WORDS=%0d not in 2..65535", PACKET_WORDS);
+  end
+  if (FRAME_WORDS < 1 || FRAME_WORDS > (1 << 30)) begin : g_bad_param_3
+    $fatal(1, "axis_packetizer: FRAME_WORDS=%0d not in 1..2^30", FRAME_WORDS);
+  end
+  if (NPKT > 4096) begin : g_bad_param_4
+    $fatal(1, "axis_packetizer: FRAME_WORDS/PACKET_WORDS gives %0d > 4096 packets per frame",
+           NPKT);
+  end
+  if (NUM_BANKS < 2 || NUM_BANKS > 16 || (1 << BANK_W) != NUM_BANKS) begin : g_bad_param_5
+    $fatal(1, "axis_packetizer: NUM_BANKS=%0d must be a power of two in 2..16", NUM_BANKS);
+  end
+  if (TLAST_PERIOD < 0 || (TLAST_PERIOD > 0 && (FRAME_WORDS % TLAST_PERIOD) != 0))
+  begin : g_bad_param_6
+    $fatal(1, "axis_packetizer: TLAST_PERIOD=%0d must be 0 or divide FRAME_WORDS", TLAST_PERIOD);
+  end
+
+  // ---------------------------------------------------------------------------------------
+  // Packet memory: NUM_BANKS banks of 2^POS_W >= PACKET_WORDS words, address {bank, offset}
+  logic              ram_wr_en, ram_rd_en;
+  logic [BANK_W+POS_W-1:0] ram_wr_addr, ram_rd_addr;
+  logic [WORD_W-1:0] ram_rd_data;
+
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(NUM_BANKS << POS_W)) u_ram (
+    .clk     (clk),
+    .wr_en   (ram_wr_en),
+    .wr_addr (ram_wr_addr),
+    .wr_data (s_axis_tdata),
+    .rd_en   (ram_rd_en),
+    .rd_addr (ram_rd_addr),
+    .rd_data (ram_rd_data)
+  );
+
+  // Per-bank packet descriptor, written by the input side when the packet is complete.
+  typedef struct packed {
+    logic [LEN_W-1:0] len;       // payload words stored
+    logic [LEN_W-1:0] drops;     // payload words dropped
+    logic [SEQ_W-1:0] seq;       // packet number within the frame
+    logic [31:0]      frame;     // frame id (frames since reset)
+    logic             last;      // packet ends its frame
+    logic             ovf;       // status_overflow when the packet closed
+    logic             framing;   // status_framing_error when the packet closed
+    logic             damaged;   // a word of the packet was marked damaged upstream
+  } desc_t;
+
+  desc_t desc_q [NUM_BANKS];
+  logic [NUM_BANKS-1:0] full_q;            // bank holds a complete packet not yet fully read
+
+  // ---------------------------------------------------------------------------------------
+  // Input side
+  logic [BANK_W-1:0] wr_bank_q;
+  logic [POS_W-1:0] pos_q;       // input word position within the packet (dropped words count)
+  logic [LEN_W-1:0] wr_cnt_q;    // words stored in the open packet
+  logic [LEN_W-1:0] wr_drop_q;   // words dropped from the open packet
+  logic             wr_dmg_q;    // a word of the open packet was marked damaged
+  logic [SEQ_W-1:0] seq_q;
+  logic [31:0]      frame_q;
+  logic [TLP_W-1:0] tl_pos_q;
+  logic             ovf_q, framing_q;
+  logic [31:0]      drop_cnt_q, framing_cnt_q, frame_cnt_q, packet_cnt_q;
+
+  logic             beat, space, store, frame_end, pkt_end, tlast_err;
+  logic [LEN_W-1:0] cnt_next, drop_next;
+
+  assign space         = !full_q[wr_bank_q];
+  assign s_axis_tready = INPUT_BACKPRESSURE ? space : 1'b1;
+  assign beat          = s_axis_tvalid && s_axis_tready;
+  assign store         = beat && space;
+  assign frame_end     = (seq_q == SEQ_W'(NPKT - 1)) && (pos_q == POS_W'(LAST_LEN - 1));
+  assign pkt_end       = (pos_q == POS_W'(PACKET_WORDS - 1)) || frame_end;
+  assign cnt_next      = wr_cnt_q + LEN_W'(store);
+  assign drop_next     = wr_drop_q + LEN_W'(beat && !space);
+  assign tlast_err     = (TLAST_PERIOD > 0) && beat &&
+                         (s_axis_tlast != (tl_pos_q == TLP_W'(TLP - 1)));
+
+  assign ram_wr_en   = store;
+  assign ram_wr_addr = {wr_bank_q, wr_cnt_q[POS_W-1:0]};
+
+  // ---------------------------------------------------------------------------------------
+  // Output side: header (if any) then the payload of bank rd_bank_q
+  logic [BANK_W-1:0] rd_bank_q;
+  logic [POS_W-1:0] rd_idx_q;
+  logic             hdr_sent_q;
+  logic             can_issue, issue, issue_hdr, issue_data, rd_last;
+  logic             p_hdr_q, p_last_q;   // sideband of the read issued last clock
+  logic [WORD_W-1:0] hdr_word, p_hdr_word_q;
+  desc_t            rd_desc;
+
+  assign rd_desc    = desc_q[rd_bank_q];
+  assign issue      = full_q[rd_bank_q] && can_issue;
+  assign issue_hdr  = issue && HEADER && !hdr_sent_q;
+  assign issue_data = issue && !issue_hdr;
+  assign rd_last    = (LEN_W'(rd_idx_q) == rd_desc.len - 1'b1);
+  assign ram_rd_en   = issue_data;
+  assign ram_rd_addr = {rd_bank_q, rd_idx_q};
+
+  // Header word (docs/buffers.md): lane 0 = {MAGIC, frame[7:0], seq[11:0], flags[3:0]},
+  // flags = {framing, overflow, drop, last}; lane 1 = {dropped[15:0], length[15:0]};
+  // lane 2 = frame[31:0]; lane 3 = {damaged, packets per frame[14:0], seq[15:0]}; others 0.
+  localparam int HDR_W = (WORD_W > 128) ? WORD_W : 128;
+  // Extension lanes beyond NUM_RX are cut off (unused when NUM_RX < 4).
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [HDR_W-1:0] hdr_full;
+  /* verilator lint_on UNUSEDSIGNAL */
+  always_comb begin
+    hdr_full = '0;
+    hdr_full[31:0]  = {MAGIC, rd_desc.frame[7:0], rd_desc.seq,
+                       rd_desc.framing, rd_desc.ovf, (rd_desc.drops != '0), rd_desc.last};
+    hdr_full[63:32] = {16'(rd_desc.drops), 16'(rd_desc.len)};
+    hdr_full[95:64] = rd_desc.frame;
+    hdr_full[127:96] = {rd_desc.damaged, 15'(NPKT), 16'(rd_desc.seq)};
+  end
+  assign hdr_word = hdr_full[WORD_W-1:0];
+
+  logic [WORD_W:0] fifo_tdata;
+
+  buf_out_fifo #(.WIDTH(WORD_W + 1), .DEPTH(4)) u_out (
+    .clk           (clk),
+    .rst           (rst),
+    .can_issue     (can_issue),
+    .issue         (issue),
+    .in_data       ({p_last_q, p_hdr_q ? p_hdr_word_q : ram_rd_data}),
+    .m_axis_tdata  (fifo_tdata),
+    .m_axis_tvalid (m_axis_tvalid),
+    .m_axis_tready (m_axis_tready)
+  );
+  assign m_axis_tdata = fifo_tdata[WORD_W-1:0];
+  assign m_axis_tlast = fifo_tdata[WORD_W];
+
+  // Descriptor of the packet that closes with this input word
+  desc_t new_desc;
+  always_comb begin
+    new_desc         = '0;
+    new_desc.len     = cnt_next;
+    new_desc.drops   = drop_next;
+    new_desc.seq     = seq_q;
+    new_desc.frame   = frame_q;
+    new_desc.last    = frame_end;
+    new_desc.ovf     = ovf_q || (beat && !space);
+    new_desc.framing = framing_q || tlast_err;
+    new_desc.damaged = wr_dmg_q || (beat && s_axis_tuser[0]);
+  end
+
+  // ---------------------------------------------------------------------------------------
+  // Registers
+  always_ff @(posedge clk) begin
+    p_hdr_q      <= issue_hdr;
+    p_last_q     <= issue_data && rd_last;
+    p_hdr_word_q <= hdr_word;
+    if (beat && pkt_end && cnt_next != '0) desc_q[wr_bank_q] <= new_desc;
+  end
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      full_q        <= '0;
+      wr_bank_q     <= '0;
+      pos_q         <= '0;
+      wr_cnt_q      <= '0;
+      wr_drop_q     <= '0;
+      wr_dmg_q      <= 1'b0;
+      seq_q         <= '0;
+      frame_q       <= '0;
+      tl_pos_q      <= '0;
+      ovf_q         <= 1'b0;
+      framing_q     <= 1'b0;
+      drop_cnt_q    <= '0;
+      framing_cnt_q <= '0;
+      frame_cnt_q   <= '0;
+      packet_cnt_q  <= '0;
+      rd_bank_q     <= '0;
+      rd_idx_q      <= '0;
+      hdr_sent_q    <= 1'b0;
+    end else begin
+      // input side
+      if (beat) begin
+        tl_pos_q <= (tl_pos_q == TLP_W'(TLP - 1) || frame_end) ? '0 : tl_pos_q + 1'b1;
+        if (!space) begin
+          ovf_q <= 1'b1;
+          if (drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 1'b1;
+        end
+        if (tlast_err) begin
+          framing_q <= 1'b1;
+          if (framing_cnt_q != '1) framing_cnt_q <= framing_cnt_q + 1'b1;
+        end
+        if (pkt_end) begin
+          pos_q     <= '0;
+          wr_cnt_q  <= '0;
+          wr_drop_q <= '0;
+          wr_dmg_q  <= 1'b0;
+          seq_q     <= frame_end ? '0 : seq_q + 1'b1;
+          if (frame_end) begin
+            frame_q     <= frame_q + 1'b1;
+            frame_cnt_q <= frame_cnt_q + 1'b1;
+          end
+          if (cnt_next != '0) begin
+            full_q[wr_bank_q] <= 1'b1;
+            wr_bank_q         <= wr_bank_q + 1'b1;
+          end
+        end else begin
+          pos_q     <= pos_q + 1'b1;
+          wr_cnt_q  <= cnt_next;
+          wr_drop_q <= drop_next;
+          wr_dmg_q  <= wr_dmg_q || s_axis_tuser[0];
+        end
+      end
+      // output side (never clears the bank the input side sets: that one is not full)
+      if (issue_hdr) hdr_sent_q <= 1'b1;
+      if (issue_data) begin
+        if (rd_last) begin
+          rd_idx_q          <= '0;
+          hdr_sent_q        <= 1'b0;
+          full_q[rd_bank_q] <= 1'b0;
+          rd_bank_q         <= rd_bank_q + 1'b1;
+          packet_cnt_q      <= packet_cnt_q + 1'b1;
+        end else begin
+          rd_idx_q <= rd_idx_q + 1'b1;
+        end
+      end
+    end
+  end
+
+  assign status_overflow      = ovf_q;
+  assign status_framing_error = framing_q;
+  assign drop_count           = drop_cnt_q;
+  assign framing_error_count  = framing_cnt_q;
+  assign frame_count          = frame_cnt_q;
+  assign packet_count         = packet_cnt_q;
+
+`ifndef SYNTHESIS
+  // AXI4-Stream source rules: TVALID/TDATA/TLAST held while stalled.
+  logic             m_stall_q;
+  logic [WORD_W:0]  m_held_q;
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      m_stall_q <= 1'b0;
+    end else begin
+      m_stall_q <= m_axis_tvalid && !m_axis_tready;
+      if (m_stall_q) begin
+        assert (m_axis_tvalid) else $error("axis_packetizer: TVALID dropped while stalled");
+        assert ({m_axis_tlast, m_axis_tdata} == m_held_q)
+          else $error("axis_packetizer: TDATA/TLAST changed while stalled");
+      end
+    end
+    m_held_q <= {m_axis_tlast, m_axis_tdata};
+  end
+`endif
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+// Small register FIFO that turns a one-clock-latency memory read pipeline into an AXI4-Stream
+// source: issue a read only when can_issue, the data arrives on in_data one clock later.
+`default_nettype none
+
+module buf_out_fifo #(
+  // Width of one entry in bits (data plus sideband), 1..8192.
+  parameter int WIDTH = 32,
+  // Entries, power of two, 4..64. Four sustain one word per clock with can_issue taken
+  // from registers only (no combinational path from m_axis_tready to the read enable).
+  parameter int DEPTH = 4
+) (
+  input  wire logic             clk,
+  input  wire logic             rst,
+  // Read pipeline side
+  output logic                  can_issue,  // room for one more read in flight
+  input  wire logic             issue,      // a read was issued this clock (only if can_issue)
+  input  wire logic [WIDTH-1:0] in_data,    // data of the read issued the previous clock
+  // AXI4-Stream source (tdata carries the whole entry, the parent splits it)
+  output logic      [WIDTH-1:0] m_axis_tdata,
+  output logic                  m_axis_tvalid,
+  input  wire logic             m_axis_tready
+);
+
+  localparam int PTR_W = $clog2(DEPTH);
+
+  // Parameter checks: stop elaboration on illegal values.
+  if (DEPTH < 4 || DEPTH > 64 || (1 << PTR_W) != DEPTH) begin : g_bad_param_0
+    $fatal(1, "buf_out_fifo: DEPTH=%0d must be a power of two in 4..64", DEPTH);
+  end
+  if (WIDTH < 1 || WIDTH > 8192) begin : g_bad_param_1
+    $fatal(1, "buf_out_fifo: WIDTH=%0d out of range", WIDTH);
+  end
+
+  logic [WIDTH-1:0] mem_q [DEPTH];
+  logic [PTR_W-1:0] wr_ptr_q, rd_ptr_q;
+  logic [PTR_W:0]   count_q;        // entries stored
+  logic [PTR_W:0]   credit_q;       // entries stored + reads in flight
+  logic             inflight_q;     // a read was issued last clock
+  logic             push, pop;
+
+  assign push          = inflight_q;
+  assign pop           = m_axis_tvalid && m_axis_tready;
+  assign m_axis_tvalid = (count_q != '0);
+  assign m_axis_tdata  = mem_q[rd_ptr_q];
+  assign can_issue     = (credit_q < (PTR_W+1)'(DEPTH));
+
+  always_ff @(posedge clk) begin
+    if (push) mem_q[wr_ptr_q] <= in_data;
+  end
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      wr_ptr_q   <= '0;
+      rd_ptr_q   <= '0;
+      count_q    <= '0;
+      credit_q   <= '0;
+      inflight_q <= 1'b0;
+    end else begin
+      inflight_q <= issue;
+      if (push) wr_ptr_q <= wr_ptr_q + 1'b1;
+      if (pop)  rd_ptr_q <= rd_ptr_q + 1'b1;
+      count_q  <= count_q + (PTR_W+1)'(push) - (PTR_W+1)'(pop);
+      credit_q <= credit_q + (PTR_W+1)'(issue) - (PTR_W+1)'(pop);
+    end
+  end
+
+`ifndef SYNTHESIS
+  always_ff @(posedge clk) begin
+    if (!rst) begin
+      assert (!(issue && !can_issue)) else $error("buf_out_fifo: read issued without credit");
+      assert (!(push && count_q == (PTR_W+1)'(DEPTH))) else $error("buf_out_fifo: overflow");
+    end
+  end
+`endif
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+// In-place corner turn (frame transpose) between the range FFT and the Doppler FFT: one frame
+// of memory, written chirp by chirp, read as per-TX Doppler vectors while the next frame is
+// written into the slots just read.
+//
+// Input word i of a frame (i = (d*NUM_TX + t)*N_RANGE + r, chirp c = d*NUM_TX + t sent by
+// TX t, range bin r) and output word j (j = (t*N_RANGE + r)*N_DOPPLER + d) are B-bit numbers,
+// B = log2(NUM_TX*N_RANGE*N_DOPPLER); the reorder maps output j to input p(j) = rotl(j, ROT),
+// ROT = log2(NUM_TX) + log2(N_RANGE). In-place scheme: frame k is written at addresses
+// W_k(i) = p^k(i) = rotl(i, k*ROT mod B) and read at R_k(j) = W_k(p(j)) = rotl(j, (k+1)*ROT
+// mod B) = W_{k+1}(j), so frame k+1's word i goes to the slot that frame k's read number i
+// has just freed. The writer only ever trails the reader (write count < read count), which
+// is when s_axis_tready is low. Details and memory figures: docs/buffers.md.
+`default_nettype none
+
+module corner_turn #(
+  // TX slots (TDM chirps interleaved), power of two, 1..16.
+  parameter int NUM_TX = 1,
+  // Receive lanes per word, 1..64.
+  parameter int NUM_RX = 4,
+  // Range bins per chirp (words per input chirp), power of two, 2..4096.
+  parameter int N_RANGE = 64,
+  // Chirps per TX per frame (output Doppler vector length), power of two, 2..4096.
+  parameter int N_DOPPLER = 256,
+  // Bits of I and of Q per lane, 8..32.
+  parameter int DATA_W = 16
+) (
+  input  wire logic                          clk,
+  input  wire logic                          rst,
+  // Range FFT output: chirp by chirp, TLAST on range bin N_RANGE-1 of every chirp
+  input  wire logic [NUM_RX*2*DATA_W-1:0]    s_axis_tdata,
+  input  wire logic                          s_axis_tvalid,
+  output logic                               s_axis_tready,
+  input  wire logic                          s_axis_tlast,
+  // Doppler vectors: for TX t, for range bin r, N_DOPPLER words (chirps of TX t in order),
+  // TLAST on the last word of every vector, TUSER[0] on the first word of every frame
+  output logic      [NUM_RX*2*DATA_W-1:0]    m_axis_tdata,
+  output logic                               m_axis_tvalid,
+  input  wire logic                          m_axis_tready,
+  output logic                               m_axis_tlast,
+  output logic      [0:0]                    m_axis_tuser,
+  // Status (cleared only by rst)
+  output logic                               status_framing_error, // sticky: misplaced TLAST
+  output logic      [31:0]                   framing_error_count,  // misplaced/missing TLASTs
+  output logic      [31:0]                   frames_in,            // frames completely written
+  output logic      [31:0]                   frames_out            // frames completely read
+);
+
+  localparam int WORD_W = NUM_RX * 2 * DATA_W;
+  localparam int BT     = $clog2(NUM_TX);
+  localparam int BR     = $clog2(N_RANGE);
+  localparam int BD     = $clog2(N_DOPPLER);
+  localparam int B      = BT + BR + BD;           // address bits, one frame = 2^B words
+  localparam int ROT    = BT + BR;                // rotation per frame
+  localparam int SH_W   = $clog2(B);
+
+  // Parameter checks: stop elaboration on illegal values.
+  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_param_0
+    $fatal(1, "corner_turn: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  end
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_1
+    $fatal(1, "corner_turn: NUM_RX=%0d not in 1..64", NUM_RX);
+  end
+  if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_param_2
+    $fatal(1, "corner_turn: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
+  end
+  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_param_3
+    $fatal(1, "corner_turn: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
+  end
+  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_param_4
+    $fatal(1, "corner_turn: DATA_W=%0d not in 8..32", DATA_W);
+  end
+  if (B > 24) begin : g_bad_param_5
+    $fatal(1, "corner_turn: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
+  end
+
+  // rotl(x, s) on B bits, 0 <= s < B
+  // (function results assigned to the function name: Yosys does not parse `return`)
+  function automatic logic [B-1:0] rotl(input logic [B-1:0] x, input logic [SH_W-1:0] s);
+    rotl = B'({x, x} >> (B - 32'(s)));
+  endfunction
+
+  // (a + ROT) mod B for a shift amount a < B
+  function automatic logic [SH_W-1:0] next_shift(input logic [SH_W-1:0] a);
+    logic [SH_W:0] t;
+    t = {1'b0, a} + (SH_W+1)'(ROT);
+    if (t >= (SH_W+1)'(B)) t = t - (SH_W+1)'(B);
+    next_shift = t[SH_W-1:0];
+  endfunction
+
+  // ---------------------------------------------------------------------------------------
+  // Frame memory (one frame, simple dual port, registered read)
+  logic              ram_wr_en, ram_rd_en;
+  logic [B-1:0]      ram_wr_addr, ram_rd_addr;
+  logic [WORD_W-1:0] ram_rd_data;
+
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(1 << B)) u_ram (
+    .clk     (clk),
+    .wr_en   (ram_wr_en),
+    .wr_addr (ram_wr_addr),
+    .wr_data (s_axis_tdata),
+    .rd_en   (ram_rd_en),
+    .rd_addr (ram_rd_addr),
+    .rd_data (ram_rd_data)
+  );
+
+  // ---------------------------------------------------------------------------------------
+  // Write side
+  logic [B-1:0]    wr_cnt_q;     // input word index within the frame
+  logic [SH_W-1:0] wr_shift_q;   // k*ROT mod B for the frame being written
+  logic            pending_q;    // a completely written frame waits for the reader
+  logic            framing_q;
+  logic [31:0]     framing_cnt_q, frames_in_q, frames_out_q;
+  logic            wr_beat, wr_frame_end, chirp_end;
+
+  // Read side
+  logic [B-1:0]    rd_cnt_q;     // output word index (reads issued) within the frame
+  logic [SH_W-1:0] rd_shift_q;   // (k+1)*ROT mod B for the frame being read
+  logic            rd_active_q;
+  logic            can_issue, rd_issue, rd_start;
+  logic            p_last_q, p_sof_q;
+
+  // The writer may use slot W_{k+1}(i) = R_k(i) only once read i was issued (earlier clock).
+  assign s_axis_tready = !rst && !pending_q && (!rd_active_q || (wr_cnt_q < rd_cnt_q));
+  assign wr_beat       = s_axis_tvalid && s_axis_tready;
+  assign wr_frame_end  = (wr_cnt_q == '1);
+  assign chirp_end     = (wr_cnt_q[BR-1:0] == '1);
+  assign ram_wr_en     = wr_beat;
+  assign ram_wr_addr   = rotl(wr_cnt_q, wr_shift_q);
+
+  assign rd_start    = pending_q && !rd_active_q;
+  assign rd_issue    = rd_active_q && can_issue;
+  assign ram_rd_en   = rd_issue;
+  assign ram_rd_addr = rotl(rd_cnt_q, rd_shift_q);
+
+  always_ff @(posedge clk) begin
+    p_last_q <= (rd_cnt_q[BD-1:0] == '1);
+    p_sof_q  <= (rd_cnt_q == '0);
+  end
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      wr_cnt_q      <= '0;
+      wr_shift_q    <= '0;
+      pending_q     <= 1'b0;
+      framing_q     <= 1'b0;
+      framing_cnt_q <= '0;
+      frames_in_q   <= '0;
+      frames_out_q  <= '0;
+      rd_cnt_q      <= '0;
+      rd_shift_q    <= '0;
+      rd_active_q   <= 1'b0;
+    end else begin
+      if (wr_beat) begin
+        wr_cnt_q <= wr_cnt_q + 1'b1;
+        if (s_axis_tlast != chirp_end) begin
+          framing_q <= 1'b1;
+          if (framing_cnt_q != '1) framing_cnt_q <= framing_cnt_q + 1'b1;
+        end
+        if (wr_frame_end) begin
+          pending_q   <= 1'b1;
+          wr_shift_q  <= next_shift(wr_shift_q);
+          frames_in_q <= frames_in_q + 1'b1;
+        end
+      end
+      if (rd_start) begin
+        // the writer already advanced wr_shift_q to (k+1)*ROT: exactly the read shift
+        rd_active_q <= 1'b1;
+        pending_q   <= 1'b0;
+        rd_shift_q  <= wr_shift_q;
+      end
+      if (rd_issue) begin
+        rd_cnt_q <= rd_cnt_q + 1'b1;
+        if (rd_cnt_q == '1) begin
+          rd_active_q  <= 1'b0;
+          frames_out_q <= frames_out_q + 1'b1;
+        end
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------------------------------
+  // Output
+  logic [WORD_W+1:0] fifo_tdata;
+
+  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4)) u_out (
+    .clk           (clk),
+    .rst           (rst),
+    .can_issue     (can_issue),
+    .issue         (rd_issue),
+    .in_data       ({p_sof_q, p_last_q, ram_rd_data}),
+    .m_axis_tdata  (fifo_tdata),
+    .m_axis_tvalid (m_axis_tvalid),
+    .m_axis_tready (m_axis_tready)
+  );
+  assign m_axis_tdata    = fifo_tdata[WORD_W-1:0];
+  assign m_axis_tlast    = fifo_tdata[WORD_W];
+  assign m_axis_tuser[0] = fifo_tdata[WORD_W+1];
+
+  assign status_framing_error = framing_q;
+  assign framing_error_count  = framing_cnt_q;
+  assign frames_in            = frames_in_q;
+  assign frames_out           = frames_out_q;
+
+`ifndef SYNTHESIS
+  logic              m_stall_q;
+  logic [WORD_W+1:0] m_held_q;
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      m_stall_q <= 1'b0;
+    end else begin
+      m_stall_q <= m_axis_tvalid && !m_axis_tready;
+      if (m_stall_q) begin
+        assert (m_axis_tvalid) else $error("corner_turn: TVALID dropped while stalled");
+        assert ({m_axis_tuser, m_axis_tlast, m_axis_tdata} == m_held_q)
+          else $error("corner_turn: TDATA/TLAST/TUSER changed while stalled");
+      end
+      // the in-place invariant: never write a slot of the frame being read before reading it
+      if (wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)
+        else $error("corner_turn: writer overtook reader");
+    end
+    m_held_q <= {m_axis_tuser, m_axis_tlast, m_axis_tdata};
+  end
+`endif
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,224 @@
+"""cocotb testbench of ``rtl/buffers/corner_turn.sv`` against ``model/corner_turn.py``."""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
+from cocotb.triggers import RisingEdge
+from cocotbext.axi import AxiStreamFrame
+from sim import param, rtl_sources, run_cocotb
+
+from model import corner_turn as ct
+
+
+def to_bytes(words: np.ndarray) -> bytes:
+    return np.ascontiguousarray(words, dtype="<u4").tobytes()
+
+
+class TB(AxisTB):
+    def __init__(self, dut) -> None:
+        super().__init__(dut)
+        for comp in (self.source, self.sink):
+            comp.log.setLevel(logging.WARNING)
+        self.num_tx = param("NUM_TX")
+        self.num_rx = param("NUM_RX")
+        self.n_range = param("N_RANGE")
+        self.n_doppler = param("N_DOPPLER")
+        assert param("DATA_W") == 16
+        self.frame_words = self.num_tx * self.n_range * self.n_doppler
+        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+        self.cycle = 0
+        self.in_beats = self.out_beats = 0
+        self.in_first = self.out_first = self.out_last = None
+
+    def start_meter(self) -> None:
+        """Count handshakes per clock (only in the throughput test: it costs sim time)."""
+        cocotb.start_soon(self._meter())
+
+    async def _meter(self) -> None:
+        d = self.dut
+        while True:
+            await RisingEdge(d.clk)
+            self.cycle += 1
+            if d.s_axis_tvalid.value == 1 and d.s_axis_tready.value == 1:
+                self.in_beats += 1
+                if self.in_first is None:
+                    self.in_first = self.cycle
+            if d.m_axis_tvalid.value == 1 and d.m_axis_tready.value == 1:
+                self.out_beats += 1
+                if self.out_first is None:
+                    self.out_first = self.cycle
+                self.out_last = self.cycle
+
+    def random_frame(self) -> np.ndarray:
+        return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
+
+    async def send_frame(self, words: np.ndarray) -> None:
+        """One frame as chirps (TLAST on the last range bin of each chirp)."""
+        nr = self.n_range
+        for c in range(len(words) // nr):
+            await self.source.send(AxiStreamFrame(to_bytes(words[c * nr:(c + 1) * nr])))
+
+    async def recv_frames(self, n: int) -> list[np.ndarray]:
+        """Receive n frames of Doppler vectors, checking TLAST and TUSER (frame start)."""
+        frames = []
+        for _ in range(n):
+            vecs = []
+            for v in range(self.num_tx * self.n_range):
+                f = await self.sink.recv(compact=False)
+                w = np.frombuffer(bytes(f.tdata), dtype="<u4").reshape(-1, self.num_rx)
+                assert len(w) == self.n_doppler, f"vector of {len(w)} words"
+                lanes = self.num_rx * 4
+                sof = [f.tuser[i * lanes] for i in range(len(w))]
+                assert sof == [int(v == 0 and i == 0) for i in range(len(w))], sof[:4]
+                vecs.append(w)
+            frames.append(np.vstack(vecs))
+        return frames
+
+    def status(self) -> dict[str, int]:
+        d = self.dut
+        return {k: int(getattr(d, k).value) for k in (
+            "status_framing_error", "framing_error_count", "frames_in", "frames_out")}
+
+    def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
+        for k, (g, f) in enumerate(zip(got, sent, strict=True)):
+            exp = ct.corner_turn(f, self.num_tx, self.n_range, self.n_doppler)
+            if not np.array_equal(g, exp):
+                bad = np.nonzero((g != exp).any(axis=1))[0]
+                raise AssertionError(f"frame {k}: {len(bad)} words differ, first at {bad[0]}")
+
+
+@cocotb.test()
+async def test_throughput(dut):
+    """Back-to-back frames without stalls: one word per clock in and out."""
+    tb = TB(dut)
+    tb.start_meter()
+    await tb.reset()
+    nfr = 2 if tb.frame_words > 4096 else 3
+    frames = [tb.random_frame() for _ in range(nfr)]
+    rx = cocotb.start_soon(tb.recv_frames(nfr))
+    for f in frames:
+        await tb.send_frame(f)
+    got = await rx
+    tb.check(got, frames)
+    fw = tb.frame_words
+    out_span = tb.out_last - tb.out_first + 1
+    total = tb.out_last - tb.in_first + 1
+    tb.log.info("throughput: %d words out in %d clocks (%.4f words/clock); %d frames in+out "
+                "in %d clocks (ideal %d); latency first in -> first out %d clocks",
+                tb.out_beats, out_span, tb.out_beats / out_span, nfr, total, (nfr + 1) * fw,
+                tb.out_first - tb.in_first)
+    # per frame at most a few clocks of hand-over between writer and reader
+    assert out_span <= nfr * fw + 4 * nfr, out_span
+    assert total <= (nfr + 1) * fw + 4 * (nfr + 1), total
+    st = tb.status()
+    assert st == {"status_framing_error": 0, "framing_error_count": 0, "frames_in": nfr,
+                  "frames_out": nfr}, st
+
+
+@cocotb.test()
+async def test_random_stalls(dut):
+    """Random and long TVALID gaps / TREADY stalls over a full cycle of the address pattern."""
+    tb = TB(dut)
+    await tb.reset()
+    period = ct.frame_period(tb.num_tx, tb.n_range, tb.n_doppler)
+    nfr = 2 if tb.frame_words > 4096 else period + 2
+    tb.set_idle_generator(random_pause(0.3, 1))
+    tb.set_backpressure_generator(bursty_pause(2, max_run=3 * tb.n_doppler, busy_fraction=0.4))
+    frames = [tb.random_frame() for _ in range(nfr)]
+    rx = cocotb.start_soon(tb.recv_frames(nfr))
+    for k, f in enumerate(frames):
+        if k == nfr // 2:
+            tb.set_idle_generator(bursty_pause(3, max_run=2 * tb.n_range))
+            tb.set_backpressure_generator(random_pause(0.5, 4))
+        await tb.send_frame(f)
+    got = await rx
+    tb.check(got, frames)
+    st = tb.status()
+    assert st["framing_error_count"] == 0 and st["frames_out"] == nfr, st
+
+
+@cocotb.test()
+async def test_framing_error(dut):
+    """A short chirp (early TLAST) is flagged and counted; data still reorders by count."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.2, 5))
+    tb.set_backpressure_generator(random_pause(0.2, 6))
+    f = tb.random_frame()
+    nr = tb.n_range
+    rx = cocotb.start_soon(tb.recv_frames(1))
+    # chirp 0 split as (nr-1) + 1 words: early TLAST at word nr-2 -> exactly one error
+    await tb.source.send(AxiStreamFrame(to_bytes(f[:nr - 1])))
+    await tb.source.send(AxiStreamFrame(to_bytes(f[nr - 1:nr])))
+    for c in range(1, len(f) // nr):
+        await tb.source.send(AxiStreamFrame(to_bytes(f[c * nr:(c + 1) * nr])))
+    got = await rx
+    tb.check(got, [f])
+    st = tb.status()
+    assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
+
+
+@cocotb.test()
+async def test_reset_recovery(dut):
+    """Reset while a frame is read and the next written, then clean frames."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.1, 7))
+    tb.set_backpressure_generator(random_pause(0.3, 8))
+    for _ in range(1 if tb.frame_words > 4096 else 2):
+        await tb.send_frame(tb.random_frame())
+    await tb.cycles(tb.frame_words + tb.frame_words // 2)
+    tb.source.clear()
+    await tb.reset()
+    tb.sink.clear()
+    st = tb.status()
+    assert all(v == 0 for v in st.values()), st
+    tb.set_idle_generator(no_pause())
+    tb.set_backpressure_generator(random_pause(0.2, 9))
+    frames = [tb.random_frame() for _ in range(2)]
+    rx = cocotb.start_soon(tb.recv_frames(2))
+    for f in frames:
+        await tb.send_frame(f)
+    got = await rx
+    tb.check(got, frames)
+    assert tb.status()["frames_out"] == 2
+
+
+# ------------------------------------------------------------------------------------------
+# pytest: one Verilator build per HDL parameter set
+PARAMS = [
+    # smallest non-square reorder (B=5, ROT=2: address pattern period 5 frames)
+    dict(NUM_TX=1, NUM_RX=1, N_RANGE=4, N_DOPPLER=8),
+    # TDM-MIMO interleave, 4 TX, 512-bit words (B=9, ROT=5: period 9 frames)
+    dict(NUM_TX=4, NUM_RX=16, N_RANGE=8, N_DOPPLER=16),
+    # paper-fpga preset: 1 TX x 4 RX, 64 range bins, 256 chirps (16384 x 128-bit words)
+    dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
+]
+
+
+@pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: "_".join(
+    f"{k}{v}" for k, v in p.items()))
+def test_corner_turn(parameters: dict) -> None:
+    here = Path(__file__).resolve().parent
+    run_cocotb("corner_turn", rtl_sources("buffers/*.sv"), "test_corner_turn", here,
+               parameters={"DATA_W": 16, **parameters})
+
+
+@pytest.mark.parametrize("shape", [(1, 4, 8), (4, 8, 16), (2, 4, 4), (4, 2, 2), (1, 64, 256)])
+def test_in_place_model(shape: tuple[int, int, int]) -> None:
+    """The in-place address scheme (one frame of memory) reproduces the transpose over more
+    than a full period of its address pattern, never overwriting an unread slot."""
+    nt, nr, nd = shape
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 1 << 32, (nt * nr * nd, 2), dtype=np.uint32)
+              for _ in range(ct.frame_period(nt, nr, nd) + 2)]
+    out = ct.in_place_stream(frames, nt, nr, nd)
+    for f, o in zip(frames, out, strict=True):
+        assert np.array_equal(o, ct.corner_turn(f, nt, nr, nd))
