@@ -10,7 +10,7 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint bench clean help
+.PHONY: all setup demo test test-python sim lint bench bench-rtl clean help
 all: test
 
 help:
@@ -19,7 +19,8 @@ help:
 	@echo "make test            whole regression (pytest -n $(JOBS))"
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
-	@echo "make bench           benchmark scripts (print tables)"
+	@echo "make bench           model and host benchmarks (print tables)"
+	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
@@ -46,10 +47,15 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
+	$(RUN) ruff check model host gnn tb tests tools synth
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
 	$(RUN) python -m host.bench_host
+
+bench-rtl: $(STAMP)
+	$(RUN) python tb/fft_axis/bench_fft_axis.py
+	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
 
 clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache

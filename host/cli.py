@@ -23,14 +23,16 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from host.capture import CaptureInfo, frame_packets, read_capture, write_capture
+from host.backends import BACKENDS, cube_from_adc
+from host.capture import CaptureInfo, read_capture, write_capture
 from host.cfar import CfarParams, paper_threshold
 from host.evaluate import match_targets, table3
 from host.pipeline import DETECTORS, DetectionParams, process_cube
 from host.pointcloud import PointCloud
 from model.config import PRESETS, RadarConfig, get_preset
-from model.packetizer import check_geometry
-from model.reference import radar_cube, range_doppler_power
+from model.packetizer import words_to_bytes
+from model.pipeline import PipelineParams, chain_gain, dma_packets
+from model.reference import range_doppler_power
 from model.scene import Scene, load_scene, table1_scene
 from model.simulate import simulate_scene
 
@@ -87,12 +89,40 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 # ---- detect -------------------------------------------------------------------------------
-def _model_frames(scene: Scene, frames: int, params: DetectionParams):
-    """(frame index, cube, cloud, saturated) for each frame through the model backend."""
+def _model_frames(scene: Scene, frames: int, params: DetectionParams, backend: str):
+    """(frame index, cube, cloud, saturated) for each frame through a model backend."""
     cfg = scene.config
     for k in _progress(range(frames), "frames"):
         adc = simulate_scene(scene, frame_index=k)
-        cube = radar_cube(adc.samples, cfg, params.range_window, params.doppler_window)
+        cube = cube_from_adc(adc.samples, cfg, backend)
+        yield k, cube, process_cube(cube, cfg, params, frame=k), adc.saturated
+
+
+def _rtl_frames(scene: Scene, frames: int, params: DetectionParams):
+    """The same through the Verilated radar_pipeline: simulated ADC frames stream through
+    the RTL back to back; its DMA packets are decoded like the board's."""
+    from host.rtlsim.pipeline_rtl import run_pipeline_rtl
+    from host.stream import StreamDecoder
+
+    cfg = scene.config
+    chain = PipelineParams()
+    adcs = [simulate_scene(scene, frame_index=k) for k in range(frames)]
+    print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters); the first "
+          f"build takes a minute or two", file=sys.stderr)
+    try:
+        packets, status = run_pipeline_rtl([a.samples for a in adcs], cfg, chain)
+    except (RuntimeError, FileNotFoundError, ImportError) as exc:
+        raise CliError(f"--backend rtl: {exc}") from None
+    dec = StreamDecoder(cfg, chain.packet_words)
+    decoded = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
+    if len(decoded) != frames or not all(f.complete for f in decoded):
+        problems = [p for f in decoded for p in f.problems] + dec.stream_problems
+        raise CliError(f"--backend rtl: {len(decoded)} frame(s) back, problems: "
+                       f"{problems[:3]}, status {status}")
+    gain = chain_gain(cfg, chain)
+    for k, (f, adc) in enumerate(zip(sorted(decoded, key=lambda f: f.frame_id), adcs,
+                                     strict=True)):
+        cube = f.cube / gain
         yield k, cube, process_cube(cube, cfg, params, frame=k), adc.saturated
 
 
@@ -101,15 +131,14 @@ def cmd_detect(args: argparse.Namespace) -> int:
     out = _out_file(args.json, ".json", "--json")
     if args.frames < 1:
         raise CliError("--frames: must be >= 1")
-    if args.backend == "rtl":
-        raise CliError("--backend rtl needs the radar_pipeline RTL top level, which is not "
-                       "in this build yet; use --backend model")
     cfg = scene.config
     params = _params(args, scene.tx_beamforming)
     clouds, per_frame = [], []
     last_cube = None
     t0 = time.perf_counter()
-    for k, cube, cloud, saturated in _model_frames(scene, args.frames, params):
+    source = (_rtl_frames(scene, args.frames, params) if args.backend == "rtl"
+              else _model_frames(scene, args.frames, params, args.backend))
+    for k, cube, cloud, saturated in source:
         clouds.append(cloud)
         per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": saturated})
         last_cube = cube
@@ -161,13 +190,13 @@ def cmd_demo(args: argparse.Namespace) -> int:
     params = DetectionParams()
     t0 = time.perf_counter()
     adc = simulate_scene(scene)
-    cube = radar_cube(adc.samples, cfg)
+    cube = cube_from_adc(adc.samples, cfg, args.backend)
     t_host = time.perf_counter()
     cloud = process_cube(cube, cfg, params)
     t_host = time.perf_counter() - t_host
     matches, used = match_targets(cloud, scene.targets, cfg)
     print(f"Table I scene, preset {cfg.name} ({cfg.num_tx} TX x {cfg.num_rx} RX, "
-          f"{cfg.n_range} x {cfg.n_doppler} FFTs), model backend, CA-CFAR Pfa "
+          f"{cfg.n_range} x {cfg.n_doppler} FFTs), {args.backend} backend, CA-CFAR Pfa "
           f"{params.cfar.pfa:g}: {len(cloud)} points, {int((~used).sum())} unmatched, host "
           f"processing {t_host * 1e3:.0f} ms")
     print("errors are |estimate - actual|; 'paper' = the paper's hardware error (Table III)")
@@ -187,7 +216,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
                                f"non-coherent", markers, zoom)]
     no_bf = Scene(preset=scene.preset, seed=scene.seed, tx_beamforming=False,
                   targets=scene.targets, name="table1-no-bf")
-    cube_nobf = radar_cube(simulate_scene(no_bf).samples, cfg)
+    cube_nobf = cube_from_adc(simulate_scene(no_bf).samples, cfg, args.backend)
     ra_bf, az = range_azimuth_power(cube, cfg.num_tx, cfg.num_rx)
     ra_nobf, _ = range_azimuth_power(cube_nobf, cfg.num_tx, cfg.num_rx)
     figs.append(plot_range_azimuth_pair(
@@ -203,39 +232,25 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 # ---- capture / replay / receive -----------------------------------------------------------
-def _dma_cube(cube: np.ndarray, gain: float) -> tuple[np.ndarray, int]:
-    """Float cube x gain rounded to int16 with saturation: (integer complex cube, clipped)."""
-    x = cube * gain
-    re, im = np.rint(x.real), np.rint(x.imag)
-    clipped = int(np.count_nonzero((re < -32768) | (re > 32767))
-                  + np.count_nonzero((im < -32768) | (im > 32767)))
-    return np.clip(re, -32768, 32767) + 1j * np.clip(im, -32768, 32767), clipped
-
-
-def _default_gain(cfg: RadarConfig) -> float:
-    return float(np.sqrt(cfg.n_doppler))
-
-
 def cmd_capture(args: argparse.Namespace) -> int:
     scene = _scene(args)
     cfg = scene.config
     out = _out_file(args.out, ".dmacap", "--out")
-    gain = args.gain if args.gain is not None else _default_gain(cfg)
+    chain = PipelineParams(packet_words=args.packet_words)
     try:
-        check_geometry(cfg.num_tx * cfg.n_range * cfg.n_doppler, args.packet_words)
+        chain.check(cfg)
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
+    if args.frames < 1:
+        raise CliError("--frames: must be >= 1")
     packets: list[bytes] = []
-    clipped = 0
     for k in _progress(range(args.frames), "frames"):
-        cube = radar_cube(simulate_scene(scene, frame_index=k).samples, cfg)
-        ints, c = _dma_cube(cube, gain)
-        clipped += c
-        packets.extend(frame_packets(ints, cfg, args.packet_words, k))
+        adc = simulate_scene(scene, frame_index=k).samples
+        packets.extend(words_to_bytes(p) for p in dma_packets([adc], cfg, chain, k))
     info = CaptureInfo(cfg.num_rx, args.packet_words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
     n = write_capture(out, info, packets)
-    print(f"wrote {out}: {args.frames} frame(s), {n} packets, gain {gain:g}, "
-          f"{clipped} clipped values")
+    print(f"wrote {out}: {args.frames} frame(s), {n} packets (bit-accurate model of the FPGA "
+          f"chain, cube gain {chain_gain(cfg, chain):g} over 1/N per FFT)")
     return 0
 
 
@@ -262,7 +277,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
 
     cfg = get_preset(args.preset)
     out = _out_file(args.json, ".json", "--json")
-    gain = args.gain if args.gain is not None else _default_gain(cfg)
+    gain = chain_gain(cfg, PipelineParams(packet_words=args.packet_words))
     params = _params(args)
     try:
         decoder = StreamDecoder(cfg, args.packet_words)
@@ -311,7 +326,7 @@ def _add_detection_options(p: argparse.ArgumentParser) -> None:
                    help="paper detector: threshold over the channel-0 median, dB (default 15)")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(with_gnn: bool = False) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="radar",
         description="Open 77 GHz FMCW TDM-MIMO radar array processor: scene simulator, "
@@ -335,14 +350,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser(
         "detect", help="scene -> point cloud JSON",
-        description="Simulate frames of a scene, run the FPGA chain (model backend: the "
-                    "float reference) and the host processing, and write the point cloud "
+        description="Simulate frames of a scene, run them through the FPGA chain (a model "
+                    "of it or the RTL) and the host processing, and write the point cloud "
                     "JSON of DESIGN.md section 4.")
     d.add_argument("--scene", required=True, help="scene JSON file or built-in name (table1)")
     d.add_argument("--json", required=True, help="output point cloud .json")
-    d.add_argument("--backend", choices=("model", "rtl"), default="model",
-                   help="model: numpy reference of the FPGA chain (default); rtl: the "
-                        "Verilated radar_pipeline")
+    d.add_argument("--backend", choices=BACKENDS, default="model",
+                   help="model: bit-accurate model of the FPGA chain (default); float: its "
+                        "float64 reference (faster); rtl: the Verilated radar_pipeline")
     d.add_argument("--plots", default=None, help="folder for a range-Doppler map and the "
                                                  "x-y point cloud of the last frame")
     d.add_argument("--frames", type=int, default=1, help="frames to process (default 1)")
@@ -353,7 +368,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     m = sub.add_parser(
         "demo", help="the paper's Table I scene end to end, with figures",
-        description="Simulate the paper's Table I scene, run the FPGA chain (model backend) "
+        description="Simulate the paper's Table I scene, run the FPGA chain (bit-accurate "
+                    "model) "
                     "and host processing, print a Table III style comparison (with the "
                     "paper's hardware errors beside ours) and write the figures: channel-0 "
                     "range-Doppler map and its threshold (paper Fig. 6), range-azimuth "
@@ -362,23 +378,22 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--out", default="out", help="folder for figures and JSON (default out/)")
     m.add_argument("--preset", choices=presets, default="full",
                    help="radar preset (default full)")
+    m.add_argument("--backend", choices=BACKENDS[:2], default="model",
+                   help="model: bit-accurate FPGA chain (default, ~20 s on full); float: "
+                        "its float64 reference (~3 s)")
     m.set_defaults(func=cmd_demo)
 
     c = sub.add_parser(
         "capture", help="write the DMA packets of simulated frames to a capture file",
-        description="Simulate frames, run the model of the FPGA chain, quantise the cube to "
-                    "int16 DMA words (output gain --gain over the 1/N-per-FFT scaling) and "
-                    "write the packets (header word + payload, as the packetizer sends them) "
-                    "to a .dmacap file for `radar replay`.")
+        description="Simulate frames, run them through the bit-accurate model of the FPGA "
+                    "chain and write its DMA packets (header word + payload, exactly as the "
+                    "packetizer sends them) to a .dmacap file for `radar replay`.")
     c.add_argument("--scene", required=True, help="scene JSON file or built-in name")
     c.add_argument("--out", required=True, help="output .dmacap file")
     c.add_argument("--frames", type=int, default=3, help="frames (default 3)")
     c.add_argument("--packet-words", type=int, default=1023,
                    help="payload words per packet, PACKET_WORDS (default 1023: one packet "
                         "fits a UDP datagram for 16 lanes)")
-    c.add_argument("--gain", type=float, default=None,
-                   help="output gain over 1/N per FFT before int16 rounding (default "
-                        "sqrt(N_DOPPLER), keeping thermal noise above 1 LSB)")
     c.add_argument("--preset", choices=presets, default=None, help="override the preset")
     c.set_defaults(func=cmd_capture)
 
@@ -414,27 +429,25 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--idle-timeout", type=float, default=2.0,
                    help="stop when no datagram arrived for this long, s (default 2)")
     v.add_argument("--timeout", type=float, default=300.0, help="stop after this long, s")
-    v.add_argument("--gain", type=float, default=None, help="output gain of the stream "
-                                                            "(see capture)")
     v.add_argument("--use-damaged", action="store_true",
                    help="also process frames with missing packets (zeros where missing)")
     v.add_argument("--json", required=True, help="output point cloud .json")
     _add_detection_options(v)
     v.set_defaults(func=cmd_receive)
 
-    try:  # the GNN detector mounts its own subcommands when installed
+    g = sub.add_parser("gnn", help="GNN object detector: dataset, train, eval, detect "
+                                   "(radar gnn --help)")
+    if with_gnn:  # imported only for `radar gnn ...`: torch is slow to import
         from gnn.cli import add_subcommands
-    except ImportError:
-        pass
-    else:
-        g = sub.add_parser("gnn", help="GNN object detector: dataset, train, eval, detect")
+
         add_subcommands(g.add_subparsers(dest="gnn_command", required=True,
                                          metavar="GNN_COMMAND"))
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser(with_gnn=bool(argv) and argv[0] == "gnn")
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))

@@ -14,6 +14,24 @@ from model.config import RadarConfig  # noqa: E402
 from model.reference import signed_bins  # noqa: E402
 
 
+def _save(fig: plt.Figure, path: Path, tight: bool = True) -> Path:
+    """Write ``fig`` to ``path`` (creating folders) and release it."""
+    if tight:
+        fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def _rd_grid(cfg: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Doppler column order for a signed axis, velocity (m/s) per column, range (m) per
+    row) of a natural-order (n_range, n_doppler) map."""
+    order = np.argsort(signed_bins(cfg.n_doppler))
+    vel = signed_bins(cfg.n_doppler)[order] * cfg.velocity_bin_mps
+    return order, vel, np.arange(cfg.n_range) * cfg.range_bin_m
+
+
 def plot_range_doppler(power: np.ndarray, cfg: RadarConfig, path: Path, title: str,
                        markers: list[tuple[float, float, str]] | None = None,
                        max_range_m: float | None = None) -> Path:
@@ -22,10 +40,8 @@ def plot_range_doppler(power: np.ndarray, cfg: RadarConfig, path: Path, title: s
     ``markers``: (range_m, radial_velocity_mps, label) drawn as circles (the scene truth);
     velocities outside +-vmax are drawn where they alias to. ``max_range_m`` crops the plot.
     """
-    order = np.argsort(signed_bins(cfg.n_doppler))
+    order, vel, rng = _rd_grid(cfg)
     pdb = 10.0 * np.log10(np.maximum(power[:, order], 1e-12))
-    vel = signed_bins(cfg.n_doppler)[order] * cfg.velocity_bin_mps
-    rng = np.arange(cfg.n_range) * cfg.range_bin_m
     fig, ax = plt.subplots(figsize=(7, 5), dpi=110)
     floor = np.median(pdb)
     im = ax.pcolormesh(vel, rng, pdb, shading="nearest", vmin=floor - 3, vmax=pdb.max(),
@@ -43,19 +59,13 @@ def plot_range_doppler(power: np.ndarray, cfg: RadarConfig, path: Path, title: s
     if max_range_m is not None:
         ax.set_ylim(0, min(max_range_m, cfg.max_range_m))
     ax.set_title(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_detection_mask(power: np.ndarray, mask: np.ndarray, cfg: RadarConfig, path: Path,
                         title: str, max_range_m: float | None = None) -> Path:
     """The paper's Fig. 6: channel-0 range-Doppler map (left) and its thresholded image."""
-    order = np.argsort(signed_bins(cfg.n_doppler))
-    vel = signed_bins(cfg.n_doppler)[order] * cfg.velocity_bin_mps
-    rng = np.arange(cfg.n_range) * cfg.range_bin_m
+    order, vel, rng = _rd_grid(cfg)
     pdb = 10.0 * np.log10(np.maximum(power[:, order], 1e-12))
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), dpi=110, sharey=True)
     im = axes[0].pcolormesh(vel, rng, pdb, shading="nearest", cmap="viridis",
@@ -71,11 +81,7 @@ def plot_detection_mask(power: np.ndarray, mask: np.ndarray, cfg: RadarConfig, p
             ax.set_ylim(0, min(max_range_m, cfg.max_range_m))
     axes[0].set_ylabel("range (m)")
     fig.suptitle(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
@@ -99,10 +105,7 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
             ax.set_ylim(0, min(max_range_m, cfg.max_range_m))
     axes[0][0].set_ylabel("range (m)")
     fig.colorbar(im, ax=axes[0].tolist(), label="power (dB, LSB^2)")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(fig, path, tight=False)
 
 
 def plot_point_cloud(x: np.ndarray, y: np.ndarray, snr_db: np.ndarray, path: Path, title: str,
@@ -133,8 +136,4 @@ def plot_point_cloud(x: np.ndarray, y: np.ndarray, snr_db: np.ndarray, path: Pat
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
     ax.set_title(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(fig, path)

@@ -236,7 +236,7 @@ class StreamDecoder:
         seq = (w0 >> 4) & 0xFFF if lanes.size < 4 else int(lanes[3]) & 0xFFFF
         if seq >= self.n_packets:
             return None
-        if lanes.size > 3 and int(lanes[3]) >> 16 != self.n_packets:
+        if lanes.size > 3 and (int(lanes[3]) >> 16) & 0x7FFF != self.n_packets:
             return None
         nominal = self._nominal_words(seq)
         if lanes.size > 1:

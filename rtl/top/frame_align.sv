@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: Apache-2.0
+// Keeps the chirp stream frame-aligned after the ADC ping-pong lost chirps: the rest of a
+// damaged frame is zero-filled (so the corner turn always receives whole frames) and input
+// is discarded until the next frame start; every frame is reported as clean or damaged.
+//
+// Input: whole chirps from chirp_pingpong (TLAST on sample N_RANGE-1; on a chirp's first
+// sample TUSER[0] = frame start, TUSER[1] = chirps were discarded before this one).
+// A frame is FRAME_CHIRPS chirps. Rules, checked on the first sample of every input chirp:
+//   - frame start while the current frame is incomplete: zero-fill the current frame, then
+//     take this chirp as chirp 0 of the next (framing error);
+//   - discontinuity (TUSER[1]): zero-fill the current frame if it has begun, then discard
+//     chirps until a frame start (the lost chirps' frame cannot be trusted);
+//   - a chirp without frame start where a frame must begin: discard it (after reset the
+//     ADC may be mid-frame).
+// Zero-filled frames are flagged on frame_done_damaged; nothing is lost silently.
+`default_nettype none
+
+module frame_align #(
+  // Receive lanes per word, 1..64.
+  parameter int NUM_RX = 4,
+  // Bits of I and of Q, 8..32.
+  parameter int DATA_W = 16,
+  // Samples per chirp, 2..65536.
+  parameter int N_RANGE = 64,
+  // Chirps per frame (NUM_TX * N_DOPPLER), 1..2^24.
+  parameter int FRAME_CHIRPS = 256
+) (
+  input  wire logic                       clk,
+  input  wire logic                       rst,
+  // Chirps from the ping-pong
+  input  wire logic [NUM_RX*2*DATA_W-1:0] s_axis_tdata,
+  input  wire logic                       s_axis_tvalid,
+  output logic                            s_axis_tready,
+  input  wire logic                       s_axis_tlast,
+  input  wire logic [1:0]                 s_axis_tuser,
+  // Whole frames of whole chirps to the range FFT (TLAST on every chirp's last sample)
+  output logic      [NUM_RX*2*DATA_W-1:0] m_axis_tdata,
+  output logic                            m_axis_tvalid,
+  input  wire logic                       m_axis_tready,
+  output logic                            m_axis_tlast,
+  // One pulse per output frame, with whether any of its chirps were zero-filled
+  output logic                            frame_done,
+  output logic                            frame_done_damaged,
+  // Status (cleared only by rst)
+  output logic      [31:0]                frames_damaged,    // frames with zero-filled chirps
+  output logic      [31:0]                chirps_filled,     // zero chirps inserted
+  output logic      [31:0]                chirps_discarded   // input chirps thrown away
+);
+
+  localparam int WORD_W = NUM_RX * 2 * DATA_W;
+  localparam int SMP_W  = (N_RANGE > 1) ? $clog2(N_RANGE) : 1;
+  localparam int CHP_W  = (FRAME_CHIRPS > 1) ? $clog2(FRAME_CHIRPS) : 1;
+
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
+    $fatal(1, "frame_align: NUM_RX=%0d not in 1..64", NUM_RX);
+  end
+  if (N_RANGE < 2 || N_RANGE > 65536) begin : g_bad_n_range
+    $fatal(1, "frame_align: N_RANGE=%0d not in 2..65536", N_RANGE);
+  end
+  if (FRAME_CHIRPS < 1 || FRAME_CHIRPS > (1 << 24)) begin : g_bad_frame_chirps
+    $fatal(1, "frame_align: FRAME_CHIRPS=%0d not in 1..2^24", FRAME_CHIRPS);
+  end
+
+  typedef enum logic [1:0] {PASS, FILL, DISCARD} state_t;
+  state_t           state_q;
+  logic [SMP_W-1:0] smp_q;        // sample index within the chirp being emitted
+  logic [CHP_W-1:0] chirp_q;      // chirps emitted in the current frame
+  logic             in_first_q;   // next input beat is the first sample of a chirp
+  logic             discard_q;    // after the fill, discard input up to a frame start
+  logic [31:0]      dmg_cnt_q, fill_cnt_q, disc_cnt_q;
+
+  // Decisions on the first sample of an input chirp
+  logic sof, gap, frame_begun, at_first, need_fill, need_discard, disc_stop;
+  assign sof          = s_axis_tuser[0];
+  assign gap          = s_axis_tuser[1];
+  assign frame_begun  = chirp_q != '0;
+  assign at_first     = s_axis_tvalid && in_first_q;
+  // chirps of the current frame were lost (gap) or its end never came (early frame start),
+  // or the frame's start chirp itself was lost: fill up with zeros so nothing goes missing
+  assign need_fill    = at_first && ((frame_begun && (sof || gap)) || (!frame_begun && gap &&
+                                                                          !sof));
+  // a chirp that cannot start a frame (e.g. the ADC was mid-frame at reset)
+  assign need_discard = at_first && !frame_begun && !sof && !gap;
+  assign disc_stop    = at_first && sof;
+
+  logic chirp_end, frame_end;
+  assign chirp_end = smp_q == SMP_W'(N_RANGE - 1);
+  assign frame_end = chirp_end && (chirp_q == CHP_W'(FRAME_CHIRPS - 1));
+
+  always_comb begin
+    s_axis_tready = 1'b0;
+    m_axis_tvalid = 1'b0;
+    m_axis_tdata  = s_axis_tdata;
+    m_axis_tlast  = chirp_end;
+    unique case (state_q)
+      PASS: begin
+        s_axis_tready = !(need_fill || need_discard) && m_axis_tready;
+        m_axis_tvalid = !(need_fill || need_discard) && s_axis_tvalid;
+      end
+      FILL: begin
+        m_axis_tvalid = 1'b1;
+        m_axis_tdata  = '0;
+      end
+      DISCARD: s_axis_tready = !disc_stop;  // the frame-start chirp itself is kept
+      default: ;
+    endcase
+  end
+
+  logic out_beat, in_beat;
+  assign out_beat = m_axis_tvalid && m_axis_tready;
+  assign in_beat  = s_axis_tvalid && s_axis_tready;
+
+  assign frame_done         = out_beat && frame_end;
+  assign frame_done_damaged = state_q == FILL;  // a fill always runs to the frame's end
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      state_q    <= PASS;
+      smp_q      <= '0;
+      chirp_q    <= '0;
+      in_first_q <= 1'b1;
+      discard_q  <= 1'b0;
+      dmg_cnt_q  <= '0;
+      fill_cnt_q <= '0;
+      disc_cnt_q <= '0;
+    end else begin
+      if (in_beat) in_first_q <= s_axis_tlast;
+      unique case (state_q)
+        PASS: begin
+          if (need_fill) begin
+            state_q   <= FILL;             // the held chirp is looked at again afterwards
+            discard_q <= gap && !sof;
+          end else if (need_discard) begin
+            state_q <= DISCARD;
+          end
+        end
+        FILL: begin
+          if (out_beat && chirp_end && fill_cnt_q != '1) fill_cnt_q <= fill_cnt_q + 32'd1;
+          if (out_beat && frame_end) begin
+            state_q <= discard_q ? DISCARD : PASS;
+            if (dmg_cnt_q != '1) dmg_cnt_q <= dmg_cnt_q + 32'd1;
+          end
+        end
+        DISCARD: begin
+          if (disc_stop) state_q <= PASS;
+          else if (in_beat && s_axis_tlast && disc_cnt_q != '1) disc_cnt_q <= disc_cnt_q + 32'd1;
+        end
+        default: state_q <= PASS;
+      endcase
+      if (out_beat) begin
+        smp_q <= chirp_end ? '0 : smp_q + 1'b1;
+        if (chirp_end) chirp_q <= frame_end ? '0 : chirp_q + 1'b1;
+      end
+    end
+  end
+
+  assign frames_damaged   = dmg_cnt_q;
+  assign chirps_filled    = fill_cnt_q;
+  assign chirps_discarded = disc_cnt_q;
+
+`ifndef SYNTHESIS
+  // AXI4-Stream: TVALID held and data stable while stalled (output side)
+  logic             v_q;
+  logic [WORD_W:0]  d_q;
+  always_ff @(posedge clk) begin
+    v_q <= m_axis_tvalid && !m_axis_tready && !rst;
+    d_q <= {m_axis_tlast, m_axis_tdata};
+    if (v_q) begin
+      assert (m_axis_tvalid) else $error("frame_align: TVALID dropped while stalled");
+      assert ({m_axis_tlast, m_axis_tdata} == d_q)
+        else $error("frame_align: data changed while stalled");
+    end
+  end
+`endif
+
+endmodule
+
+`default_nettype wire

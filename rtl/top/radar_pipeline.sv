@@ -1,0 +1,313 @@
+// SPDX-License-Identifier: Apache-2.0
+// FMCW TDM-MIMO radar FPGA chain: ADC chirp ping-pong -> frame alignment -> range FFT ->
+// corner turn -> Doppler FFT -> DMA packetizer, NUM_RX lanes in parallel, one sample per
+// clock per lane.
+//
+// Rate decoupling: a stalled DMA back-pressures the packetizer, the Doppler FFT and the
+// corner turn's read side; the corner turn's frame store absorbs it (the Doppler side reads
+// a held frame at up to one word per clock while the ADC fills the next). Only a DMA slower
+// on average than the ADC overflows, at the ADC ping-pong, which drops whole chirps (a real
+// ADC cannot wait). frame_align then zero-fills the rest of that frame and resynchronises
+// on the next frame start, so the corner turn never loses alignment; the frame's packets
+// carry the DAMAGED header flag, the counters say how many chirps were lost and filled, and
+// the next frame is clean.
+`default_nettype none
+
+module radar_pipeline #(
+  // Receive lanes (RX channels) processed in parallel, 1..16.
+  parameter int NUM_RX = 4,
+  // TDM transmit slots per frame: chirp c of a frame is sent by TX c mod NUM_TX, 1..16.
+  parameter int NUM_TX = 1,
+  // Samples per chirp = range FFT length, power of two, 16..4096.
+  parameter int N_RANGE = 64,
+  // Chirps per TX per frame = Doppler FFT length, power of two, 16..4096.
+  parameter int N_DOPPLER = 256,
+  // Bits of I and of Q; the DMA format is 32-bit {Q,I} lanes, so only 16 is legal.
+  parameter int DATA_W = 16,
+  // Payload words per DMA packet (TLAST period; the last packet of a frame may be shorter).
+  parameter int PACKET_WORDS = 1024,
+  // 1: periodic Hann window before both FFTs; 0: none.
+  parameter bit WINDOW = 1'b1,
+  // Range FFT scaling schedule (fft_axis SCALE_SCH): default 1/N.
+  parameter int unsigned RANGE_SCALE_SCH = 32'hFFF,
+  // Doppler FFT scaling schedule: default halves every other stage (1/sqrt(N) for even
+  // log2 N) so thermal noise stays above 1 LSB in the 16-bit output (see model/pipeline.py).
+  parameter int unsigned DOPPLER_SCALE_SCH = 32'h555,
+  // 1: a header word before each packet's payload (frame id, sequence, flags); 0: none.
+  parameter bit HEADER = 1'b1,
+  // Packet banks of the output buffer, power of two, 2..16 (2 = the paper's double buffer).
+  parameter int OUT_BANKS = 4
+) (
+  input  wire logic                       clk,
+  input  wire logic                       rst,
+  // ADC samples: lane r = RX r, {Q,I}; TLAST on the last sample of each chirp, TUSER[0] on
+  // the first sample of a frame. A real ADC does not wait: s_axis_adc_tready stays high.
+  input  wire logic [NUM_RX*2*DATA_W-1:0] s_axis_adc_tdata,
+  input  wire logic                       s_axis_adc_tvalid,
+  output logic                            s_axis_adc_tready,
+  input  wire logic                       s_axis_adc_tlast,
+  input  wire logic [0:0]                 s_axis_adc_tuser,
+  // DMA stream: per packet [header] + payload (for tx, range bin, Doppler bin: one word of
+  // NUM_RX lanes), TLAST on the last word of every packet.
+  output logic      [NUM_RX*32-1:0]       m_axis_dma_tdata,
+  output logic                            m_axis_dma_tvalid,
+  input  wire logic                       m_axis_dma_tready,
+  output logic                            m_axis_dma_tlast,
+  // Status, cleared only by rst. Sticky flags:
+  output logic                            status_adc_overflow,   // ADC chirps were dropped
+  output logic                            status_dma_overflow,   // DMA words dropped (never:
+                                                                 // the DMA back-pressures)
+  output logic                            status_fft_overflow,   // an FFT saturated
+  output logic                            status_framing_error,  // a TLAST was misplaced
+  // Counters (saturating at 2^32-1 where the blocks saturate):
+  output logic      [31:0]                adc_chirps_dropped,
+  output logic      [31:0]                dma_words_dropped,
+  output logic      [31:0]                fft_overflow_count,    // output beats saturated
+  output logic      [31:0]                framing_error_count,
+  output logic      [31:0]                chirps_in,             // chirps out of the ping-pong
+  output logic      [31:0]                frames_damaged,        // frames with zero-filled chirps
+  output logic      [31:0]                chirps_filled,         // zero chirps inserted
+  output logic      [31:0]                chirps_discarded,      // chirps thrown away to realign
+  output logic      [31:0]                frames_turned,         // frames through the corner turn
+  output logic      [31:0]                frames_out,            // frames packetized
+  output logic      [31:0]                packets_out
+);
+
+  localparam int LANE_W      = 2 * DATA_W;
+  localparam int WORD_W      = NUM_RX * LANE_W;
+  localparam int FRAME_WORDS = NUM_TX * N_RANGE * N_DOPPLER;
+
+  // ---- parameter checks -----------------------------------------------------------------
+  if (DATA_W != 16) begin : g_bad_data_w
+    $fatal(1, "radar_pipeline: DATA_W=%0d, the DMA format needs 16", DATA_W);
+  end
+  if (NUM_RX < 1 || NUM_RX > 16) begin : g_bad_num_rx
+    $fatal(1, "radar_pipeline: NUM_RX=%0d not in 1..16", NUM_RX);
+  end
+  if (NUM_TX < 1 || NUM_TX > 16 || (NUM_TX & (NUM_TX - 1)) != 0) begin : g_bad_num_tx
+    $fatal(1, "radar_pipeline: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  end
+  if (N_RANGE < 16 || N_RANGE > 4096 || (N_RANGE & (N_RANGE - 1)) != 0)
+  begin : g_bad_n_range
+    $fatal(1, "radar_pipeline: N_RANGE=%0d must be a power of two in 16..4096", N_RANGE);
+  end
+  if (N_DOPPLER < 16 || N_DOPPLER > 4096 || (N_DOPPLER & (N_DOPPLER - 1)) != 0)
+  begin : g_bad_n_doppler
+    $fatal(1, "radar_pipeline: N_DOPPLER=%0d must be a power of two in 16..4096", N_DOPPLER);
+  end
+
+  // ---- ADC chirp ping-pong ----------------------------------------------------------------
+  logic [WORD_W-1:0] pp_tdata;
+  logic              pp_tvalid, pp_tready, pp_tlast;
+  logic [1:0]        pp_tuser;
+  logic              pp_framing;
+  logic [31:0]       pp_drop_samples, pp_framing_count, pp_chirps_out;
+
+  chirp_pingpong #(
+    .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .DATA_W(DATA_W), .ADC_BACKPRESSURE(1'b0)
+  ) u_pingpong (
+    .clk, .rst,
+    .s_axis_tdata(s_axis_adc_tdata), .s_axis_tvalid(s_axis_adc_tvalid),
+    .s_axis_tready(s_axis_adc_tready), .s_axis_tlast(s_axis_adc_tlast),
+    .s_axis_tuser(s_axis_adc_tuser),
+    .m_axis_tdata(pp_tdata), .m_axis_tvalid(pp_tvalid), .m_axis_tready(pp_tready),
+    .m_axis_tlast(pp_tlast), .m_axis_tuser(pp_tuser),
+    .status_overflow(status_adc_overflow), .status_framing_error(pp_framing),
+    .drop_count(pp_drop_samples), .chirps_dropped(adc_chirps_dropped),
+    .framing_error_count(pp_framing_count), .chirps_out(pp_chirps_out)
+  );
+  assign chirps_in = pp_chirps_out;
+
+  // ---- frame alignment (zero-fills frames that lost chirps) --------------------------------
+  localparam int FRAME_CHIRPS = NUM_TX * N_DOPPLER;
+  logic [WORD_W-1:0] fa_tdata;
+  logic              fa_tvalid, fa_tready, fa_tlast;
+  logic              fa_frame_done, fa_frame_damaged;
+
+  frame_align #(
+    .NUM_RX(NUM_RX), .DATA_W(DATA_W), .N_RANGE(N_RANGE), .FRAME_CHIRPS(FRAME_CHIRPS)
+  ) u_frame_align (
+    .clk, .rst,
+    .s_axis_tdata(pp_tdata), .s_axis_tvalid(pp_tvalid), .s_axis_tready(pp_tready),
+    .s_axis_tlast(pp_tlast), .s_axis_tuser(pp_tuser),
+    .m_axis_tdata(fa_tdata), .m_axis_tvalid(fa_tvalid), .m_axis_tready(fa_tready),
+    .m_axis_tlast(fa_tlast),
+    .frame_done(fa_frame_done), .frame_done_damaged(fa_frame_damaged),
+    .frames_damaged(frames_damaged), .chirps_filled(chirps_filled),
+    .chirps_discarded(chirps_discarded)
+  );
+
+  // ---- range FFT ----------------------------------------------------------------------------
+  logic [WORD_W-1:0]          rf_tdata;
+  logic                       rf_tvalid, rf_tready, rf_tlast;
+  logic [$clog2(N_RANGE)-1:0] rf_tuser;
+  logic                       rf_ev_unexp, rf_ev_miss, rf_ev_ovf;
+
+  fft_axis #(
+    .N(N_RANGE), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0), .WINDOW(WINDOW),
+    .SCALE_SCH(RANGE_SCALE_SCH)
+  ) u_range_fft (
+    .clk, .rst,
+    .s_axis_tdata(fa_tdata), .s_axis_tvalid(fa_tvalid), .s_axis_tready(fa_tready),
+    .s_axis_tlast(fa_tlast),
+    .m_axis_tdata(rf_tdata), .m_axis_tvalid(rf_tvalid), .m_axis_tready(rf_tready),
+    .m_axis_tlast(rf_tlast), .m_axis_tuser(rf_tuser),
+    .event_tlast_unexpected(rf_ev_unexp), .event_tlast_missing(rf_ev_miss),
+    .event_overflow(rf_ev_ovf)
+  );
+
+  // ---- corner turn (frame buffer) -------------------------------------------------------
+  logic [WORD_W-1:0] ct_tdata;
+  logic              ct_tvalid, ct_tready, ct_tlast;
+  logic [0:0]        ct_tuser;
+  logic              ct_framing;
+  logic [31:0]       ct_framing_count, ct_frames_out;
+
+  corner_turn #(
+    .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+    .DATA_W(DATA_W)
+  ) u_corner_turn (
+    .clk, .rst,
+    .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
+    .s_axis_tlast(rf_tlast),
+    .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
+    .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
+    .status_framing_error(ct_framing), .framing_error_count(ct_framing_count),
+    .frames_in(frames_turned), .frames_out(ct_frames_out)
+  );
+
+  // ---- Doppler FFT --------------------------------------------------------------------------
+  logic [WORD_W-1:0]            df_tdata;
+  logic                         df_tvalid, df_tready, df_tlast;
+  logic [$clog2(N_DOPPLER)-1:0] df_tuser;
+  logic                         df_ev_unexp, df_ev_miss, df_ev_ovf;
+
+  fft_axis #(
+    .N(N_DOPPLER), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0), .WINDOW(WINDOW),
+    .SCALE_SCH(DOPPLER_SCALE_SCH)
+  ) u_doppler_fft (
+    .clk, .rst,
+    .s_axis_tdata(ct_tdata), .s_axis_tvalid(ct_tvalid), .s_axis_tready(ct_tready),
+    .s_axis_tlast(ct_tlast),
+    .m_axis_tdata(df_tdata), .m_axis_tvalid(df_tvalid), .m_axis_tready(df_tready),
+    .m_axis_tlast(df_tlast), .m_axis_tuser(df_tuser),
+    .event_tlast_unexpected(df_ev_unexp), .event_tlast_missing(df_ev_miss),
+    .event_overflow(df_ev_ovf)
+  );
+
+  // ---- per-frame damage marks, frame_align -> packetizer input ---------------------------
+  // Frames leave in order; between the two points the corner turn holds one frame and
+  // fills the next, so at most DMG_DEPTH-1 marks wait here.
+  localparam int DMG_DEPTH = 4;
+  localparam int FWORD_W   = $clog2(FRAME_WORDS + 1);
+  logic [DMG_DEPTH-1:0]       dmg_q;        // marks, oldest in bit 0
+  logic [$clog2(DMG_DEPTH):0] dmg_cnt_q;
+  logic [FWORD_W-1:0]         df_word_q;    // Doppler output word within its frame
+  logic                       df_beat, df_frame_end, dmg_push, dmg_pop, df_damaged;
+  assign df_beat      = df_tvalid && df_tready;
+  assign df_frame_end = df_beat && (df_word_q == FWORD_W'(FRAME_WORDS - 1));
+  assign dmg_push     = fa_frame_done;
+  assign dmg_pop      = df_frame_end && (dmg_cnt_q != '0);
+  assign df_damaged   = (dmg_cnt_q != '0) && dmg_q[0];
+
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      dmg_q     <= '0;
+      dmg_cnt_q <= '0;
+      df_word_q <= '0;
+    end else begin
+      if (df_beat) df_word_q <= df_frame_end ? '0 : df_word_q + 1'b1;
+      unique case ({dmg_push, dmg_pop})
+        2'b10: begin
+          dmg_q[dmg_cnt_q[$clog2(DMG_DEPTH)-1:0]] <= fa_frame_damaged;
+          dmg_cnt_q <= dmg_cnt_q + 1'b1;
+        end
+        2'b01: begin
+          dmg_q     <= dmg_q >> 1;
+          dmg_cnt_q <= dmg_cnt_q - 1'b1;
+        end
+        2'b11: begin
+          dmg_q                                          <= dmg_q >> 1;
+          dmg_q[dmg_cnt_q[$clog2(DMG_DEPTH)-1:0] - 1'b1] <= fa_frame_damaged;
+        end
+        default: ;
+      endcase
+    end
+  end
+
+`ifndef SYNTHESIS
+  always_ff @(posedge clk) begin
+    if (!rst) begin
+      assert (!(dmg_push && !dmg_pop && dmg_cnt_q == ($clog2(DMG_DEPTH) + 1)'(DMG_DEPTH)))
+        else $error("radar_pipeline: damage-mark FIFO overflow");
+      assert (!(df_beat && dmg_cnt_q == '0))
+        else $error("radar_pipeline: Doppler output of a frame frame_align never sent");
+    end
+  end
+`endif
+
+  // ---- output double buffer + TLAST packetizer ------------------------------------------
+  logic        pk_framing;
+  logic [31:0] pk_framing_count;
+
+  axis_packetizer #(
+    .NUM_RX(NUM_RX), .DATA_W(DATA_W), .PACKET_WORDS(PACKET_WORDS), .FRAME_WORDS(FRAME_WORDS),
+    .NUM_BANKS(OUT_BANKS), .HEADER(HEADER), .INPUT_BACKPRESSURE(1'b1),
+    .TLAST_PERIOD(N_DOPPLER)
+  ) u_packetizer (
+    .clk, .rst,
+    .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
+    .s_axis_tlast(df_tlast), .s_axis_tuser(df_damaged),
+    .m_axis_tdata(m_axis_dma_tdata), .m_axis_tvalid(m_axis_dma_tvalid),
+    .m_axis_tready(m_axis_dma_tready), .m_axis_tlast(m_axis_dma_tlast),
+    .status_overflow(status_dma_overflow), .status_framing_error(pk_framing),
+    .drop_count(dma_words_dropped), .framing_error_count(pk_framing_count),
+    .frame_count(frames_out), .packet_count(packets_out)
+  );
+
+  // ---- pipeline status --------------------------------------------------------------------
+  // Events of the two FFTs: saturation and misplaced/missing TLAST (1-cycle pulses).
+  logic fft_tlast_event;
+  assign fft_tlast_event = rf_ev_unexp | rf_ev_miss | df_ev_unexp | df_ev_miss;
+
+  logic        fft_ovf_q, fft_framing_q;
+  logic [31:0] fft_ovf_count_q, fft_framing_count_q;
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      fft_ovf_q           <= 1'b0;
+      fft_framing_q       <= 1'b0;
+      fft_ovf_count_q     <= '0;
+      fft_framing_count_q <= '0;
+    end else begin
+      if (rf_ev_ovf || df_ev_ovf) begin
+        fft_ovf_q <= 1'b1;
+        if (fft_ovf_count_q != '1) fft_ovf_count_q <= fft_ovf_count_q + 32'd1;
+      end
+      if (fft_tlast_event) begin
+        fft_framing_q <= 1'b1;
+        if (fft_framing_count_q != '1) fft_framing_count_q <= fft_framing_count_q + 32'd1;
+      end
+    end
+  end
+  assign status_fft_overflow = fft_ovf_q;
+  assign fft_overflow_count  = fft_ovf_count_q;
+  assign status_framing_error = pp_framing | ct_framing | pk_framing | fft_framing_q;
+
+  // Sum of the blocks' framing counters (each saturates; the sum is clamped).
+  logic [33:0] framing_sum;
+  assign framing_sum = {2'b00, pp_framing_count} + {2'b00, ct_framing_count}
+                     + {2'b00, pk_framing_count} + {2'b00, fft_framing_count_q};
+  assign framing_error_count = (framing_sum[33:32] != 2'b00) ? '1 : framing_sum[31:0];
+
+  // Signals the chain does not need: bin indices (the order is implied), the ping-pong's
+  // frame-start / discontinuity marks (its counters report drops), the corner turn's
+  // frame-start mark and output frame count, and the ping-pong's dropped-sample count
+  // (chirps dropped are reported instead). Waiver: reduced into a deliberately unused bit.
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic unused_ok;
+  assign unused_ok = ^{rf_tuser, df_tuser, pp_tuser, ct_tuser, ct_frames_out, pp_drop_samples};
+  /* verilator lint_on UNUSEDSIGNAL */
+
+endmodule
+
+`default_nettype wire
