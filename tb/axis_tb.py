@@ -53,6 +53,36 @@ class AxisTB:
         self.source = AxiStreamSource(AxiStreamBus.from_prefix(dut, source_prefix), dut.clk,
                                       dut.rst)
         self.sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, sink_prefix), dut.clk, dut.rst)
+        self._in_prefix, self._out_prefix = source_prefix, sink_prefix
+        self.cycle = 0
+        self.reset_meter()
+
+    # ---- throughput meter (costs simulation time: start it only where it is measured) -----
+    def start_meter(self) -> None:
+        """Count handshakes on both interfaces every clock: ``in_beats``, ``out_beats``,
+        ``in_first`` (clock of the first input handshake), ``out_first``/``out_last``."""
+        cocotb.start_soon(self._meter())
+
+    def reset_meter(self) -> None:
+        self.in_beats = self.out_beats = 0
+        self.in_first = self.out_first = self.out_last = None
+
+    async def _meter(self) -> None:
+        d = self.dut
+        s_valid, s_ready = (getattr(d, f"{self._in_prefix}_{n}") for n in ("tvalid", "tready"))
+        m_valid, m_ready = (getattr(d, f"{self._out_prefix}_{n}") for n in ("tvalid", "tready"))
+        while True:
+            await RisingEdge(d.clk)
+            self.cycle += 1
+            if s_valid.value == 1 and s_ready.value == 1:
+                self.in_beats += 1
+                if self.in_first is None:
+                    self.in_first = self.cycle
+            if m_valid.value == 1 and m_ready.value == 1:
+                self.out_beats += 1
+                if self.out_first is None:
+                    self.out_first = self.cycle
+                self.out_last = self.cycle
 
     def set_idle_generator(self, generator: Iterator[bool] | None) -> None:
         """TVALID gaps on the source (None = back to back)."""

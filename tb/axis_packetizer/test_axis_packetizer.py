@@ -39,31 +39,6 @@ class TB(AxisTB):
         self.tlast_period = param("TLAST_PERIOD")
         self.n_packets = pk.packets_per_frame(self.frame_words, self.packet_words)
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
-        self.out_beats = 0
-        self.in_first = self.out_first = self.out_last = None
-        self.cycle = 0
-
-    def start_meter(self) -> None:
-        """Count handshakes per clock (only in the throughput test: it costs sim time)."""
-        cocotb.start_soon(self._meter())
-
-    async def _meter(self) -> None:
-        """Count output handshakes and the clock of the first/last one."""
-        dut = self.dut
-        while True:
-            await RisingEdge(dut.clk)
-            self.cycle += 1
-            if self.in_first is None and dut.s_axis_tvalid.value == 1 and \
-                    dut.s_axis_tready.value == 1:
-                self.in_first = self.cycle
-            if dut.m_axis_tvalid.value == 1 and dut.m_axis_tready.value == 1:
-                self.out_beats += 1
-                if self.out_first is None:
-                    self.out_first = self.cycle
-                self.out_last = self.cycle
-
-    def reset_meter(self) -> None:
-        self.out_beats, self.in_first, self.out_first, self.out_last = 0, None, None, None
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)

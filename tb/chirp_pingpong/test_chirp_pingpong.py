@@ -16,10 +16,7 @@ from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
 from model import chirp_pingpong as cp
-
-
-def to_bytes(words: np.ndarray) -> bytes:
-    return np.ascontiguousarray(words, dtype="<u4").tobytes()
+from model.packetizer import words_to_bytes
 
 
 class TB(AxisTB):
@@ -33,27 +30,6 @@ class TB(AxisTB):
         assert param("DATA_W") == 16
         self.bpw = self.num_rx * 4  # bytes per word
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
-        self.cycle = 0
-        self.out_beats = 0
-        self.in_first = self.out_first = self.out_last = None
-
-    def start_meter(self) -> None:
-        """Count handshakes per clock (only in the throughput test: it costs sim time)."""
-        cocotb.start_soon(self._meter())
-
-    async def _meter(self) -> None:
-        d = self.dut
-        while True:
-            await RisingEdge(d.clk)
-            self.cycle += 1
-            if self.in_first is None and d.s_axis_tvalid.value == 1 and \
-                    d.s_axis_tready.value == 1:
-                self.in_first = self.cycle
-            if d.m_axis_tvalid.value == 1 and d.m_axis_tready.value == 1:
-                self.out_beats += 1
-                if self.out_first is None:
-                    self.out_first = self.cycle
-                self.out_last = self.cycle
 
     def stream(self, n_chirps: int, chirps_per_frame: int = 16):
         """Random ADC stream of n_chirps good chirps: (words, tlast, sof)."""
@@ -72,7 +48,7 @@ class TB(AxisTB):
         start = 0
         for end in ends:
             user = [int(u) for u in sof[start:end] for _ in range(self.bpw)]
-            fr = AxiStreamFrame(to_bytes(words[start:end]), tuser=user)
+            fr = AxiStreamFrame(words_to_bytes(words[start:end]), tuser=user)
             await self.source.send(fr)
             start = end
 

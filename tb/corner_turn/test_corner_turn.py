@@ -10,15 +10,11 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotb.triggers import RisingEdge
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
 from model import corner_turn as ct
-
-
-def to_bytes(words: np.ndarray) -> bytes:
-    return np.ascontiguousarray(words, dtype="<u4").tobytes()
+from model.packetizer import words_to_bytes
 
 
 class TB(AxisTB):
@@ -33,28 +29,6 @@ class TB(AxisTB):
         assert param("DATA_W") == 16
         self.frame_words = self.num_tx * self.n_range * self.n_doppler
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
-        self.cycle = 0
-        self.in_beats = self.out_beats = 0
-        self.in_first = self.out_first = self.out_last = None
-
-    def start_meter(self) -> None:
-        """Count handshakes per clock (only in the throughput test: it costs sim time)."""
-        cocotb.start_soon(self._meter())
-
-    async def _meter(self) -> None:
-        d = self.dut
-        while True:
-            await RisingEdge(d.clk)
-            self.cycle += 1
-            if d.s_axis_tvalid.value == 1 and d.s_axis_tready.value == 1:
-                self.in_beats += 1
-                if self.in_first is None:
-                    self.in_first = self.cycle
-            if d.m_axis_tvalid.value == 1 and d.m_axis_tready.value == 1:
-                self.out_beats += 1
-                if self.out_first is None:
-                    self.out_first = self.cycle
-                self.out_last = self.cycle
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
@@ -63,7 +37,7 @@ class TB(AxisTB):
         """One frame as chirps (TLAST on the last range bin of each chirp)."""
         nr = self.n_range
         for c in range(len(words) // nr):
-            await self.source.send(AxiStreamFrame(to_bytes(words[c * nr:(c + 1) * nr])))
+            await self.source.send(AxiStreamFrame(words_to_bytes(words[c * nr:(c + 1) * nr])))
 
     async def recv_frames(self, n: int) -> list[np.ndarray]:
         """Receive n frames of Doppler vectors, checking TLAST and TUSER (frame start)."""
@@ -155,10 +129,10 @@ async def test_framing_error(dut):
     nr = tb.n_range
     rx = cocotb.start_soon(tb.recv_frames(1))
     # chirp 0 split as (nr-1) + 1 words: early TLAST at word nr-2 -> exactly one error
-    await tb.source.send(AxiStreamFrame(to_bytes(f[:nr - 1])))
-    await tb.source.send(AxiStreamFrame(to_bytes(f[nr - 1:nr])))
+    await tb.source.send(AxiStreamFrame(words_to_bytes(f[:nr - 1])))
+    await tb.source.send(AxiStreamFrame(words_to_bytes(f[nr - 1:nr])))
     for c in range(1, len(f) // nr):
-        await tb.source.send(AxiStreamFrame(to_bytes(f[c * nr:(c + 1) * nr])))
+        await tb.source.send(AxiStreamFrame(words_to_bytes(f[c * nr:(c + 1) * nr])))
     got = await rx
     tb.check(got, [f])
     st = tb.status()
