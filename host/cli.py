@@ -36,6 +36,9 @@ from model.reference import range_doppler_power
 from model.scene import Scene, load_scene, table1_scene
 from model.simulate import simulate_scene
 
+RTL_SIM_MAX_FRAME_BITS = 16 * 2**20
+"""Largest corner-turn frame the RTL backend simulates (paper-fpga: 2 Mib; full: 128 Mib)."""
+
 
 class CliError(Exception):
     """Bad input: reported as one line, exit status 2."""
@@ -105,6 +108,11 @@ def _rtl_frames(scene: Scene, frames: int, params: DetectionParams):
     from host.stream import StreamDecoder
 
     cfg = scene.config
+    frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
+    if frame_bits > RTL_SIM_MAX_FRAME_BITS:
+        raise CliError(f"--backend rtl: preset {cfg.name!r} needs a "
+                       f"{frame_bits / 2**20:.0f} Mib corner turn (external DDR4 on the "
+                       f"ZCU106), too large to simulate here; use --preset paper-fpga")
     chain = PipelineParams()
     adcs = [simulate_scene(scene, frame_index=k) for k in range(frames)]
     print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters); the first "
