@@ -10,7 +10,8 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint bench bench-rtl clean help
+.PHONY: all setup demo test test-python sim lint bench bench-rtl gnn-dataset gnn-train gnn-eval \
+        clean help
 all: test
 
 help:
@@ -21,6 +22,9 @@ help:
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
+	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
+	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
@@ -56,6 +60,20 @@ bench: $(STAMP)
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
+
+GNN_CACHE ?= $(HOME)/.cache/radar-gnn
+
+gnn-dataset: $(STAMP)
+	$(RUN) python -m gnn.cli dataset --train 700 --val 500 --test 200 --workers 2
+
+gnn-train: $(STAMP)
+	$(RUN) python -m gnn.cli train --epochs 50 --hidden 64 --layers 3 \
+	  --data $(GNN_CACHE)/train.npz $(GNN_CACHE)/val.npz
+
+gnn-eval: $(STAMP)
+	mkdir -p $(OUT)
+	$(RUN) python -m gnn.cli eval --json $(OUT)/gnn_eval.json
+	$(RUN) python -m gnn.bench_infer
 
 clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache

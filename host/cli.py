@@ -33,7 +33,7 @@ from model.config import PRESETS, RadarConfig, get_preset
 from model.packetizer import words_to_bytes
 from model.pipeline import PipelineParams, chain_gain, dma_packets
 from model.reference import range_doppler_power
-from model.scene import Scene, load_scene, table1_scene
+from model.scene import EGO_SPEED_KMH, Scene, load_scene, table1_scene
 from model.simulate import simulate_scene
 
 RTL_SIM_MAX_FRAME_BITS = 16 * 2**20
@@ -141,25 +141,55 @@ def cmd_detect(args: argparse.Namespace) -> int:
         raise CliError("--frames: must be >= 1")
     cfg = scene.config
     params = _params(args, scene.tx_beamforming)
-    clouds, per_frame = [], []
+    clouds, per_frame, objects = [], [], []
     last_cube = None
+    ego = _ego_speed(args, scene)
     t0 = time.perf_counter()
     source = (_rtl_frames(scene, args.frames, params) if args.backend == "rtl"
               else _model_frames(scene, args.frames, params, args.backend))
     for k, cube, cloud, saturated in source:
         clouds.append(cloud)
         per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": saturated})
+        if args.gnn:
+            objects.extend({"frame": k, **o} for o in _gnn_objects(cloud, ego))
         last_cube = cube
     cloud = PointCloud.concat(clouds)
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
     doc.update({"backend": args.backend, "detector": args.detector, "scene": scene.name,
                 "frame_info": per_frame})
+    if args.gnn:
+        doc["objects"] = objects
     out.write_text(json.dumps(doc, indent=1))
     print(f"{len(cloud)} points in {args.frames} frame(s) ({time.perf_counter() - t0:.2f} s) "
           f"-> {out}")
+    if args.gnn:
+        print(f"GNN: {len(objects)} object(s): " + ", ".join(
+            f"{o['class']} ({o['score']:.2f}) at x {o['x_m']:.1f} y {o['y_m']:.1f}"
+            for o in objects[:8]))
     if args.plots and last_cube is not None:
-        _detect_plots(Path(args.plots), cfg, scene, last_cube, clouds[-1])
+        last = [o for o in objects if o["frame"] == args.frames - 1]
+        _detect_plots(Path(args.plots), cfg, scene, last_cube, clouds[-1], _boxes(last))
     return 0
+
+
+def _gnn_objects(cloud: PointCloud, ego_speed_mps: float) -> list[dict[str, Any]]:
+    """Classified boxes from the shipped GNN checkpoint (imports torch: only when asked)."""
+    from gnn.infer import detect_objects
+
+    return detect_objects(cloud, ego_speed_mps=ego_speed_mps)
+
+
+def _boxes(objects: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """GNN objects -> boxes for host.plots.plot_point_cloud."""
+    return [{"x": o["x_m"], "y": o["y_m"], "length": o["length_m"], "width": o["width_m"],
+             "heading_deg": o["heading_deg"], "label": f"{o['class']} {o['score']:.2f}"}
+            for o in objects]
+
+
+def _ego_speed(args: argparse.Namespace, scene: Scene) -> float:
+    if args.ego_speed is not None:
+        return float(args.ego_speed)
+    return EGO_SPEED_KMH / 3.6 if scene.name == "table1" else 0.0
 
 
 def _truth(scene: Scene) -> list[tuple[float, float, str]]:
@@ -167,7 +197,7 @@ def _truth(scene: Scene) -> list[tuple[float, float, str]]:
 
 
 def _detect_plots(folder: Path, cfg: RadarConfig, scene: Scene, cube: np.ndarray,
-                  cloud: PointCloud) -> None:
+                  cloud: PointCloud, boxes: list[dict[str, Any]] | None = None) -> None:
     from host.plots import plot_point_cloud, plot_range_doppler
 
     markers = [(t.range_m, t.radial_velocity_mps, f"T{i + 1}")
@@ -177,7 +207,7 @@ def _detect_plots(folder: Path, cfg: RadarConfig, scene: Scene, cube: np.ndarray
                                 f"{cfg.name}: range-Doppler (all channels)", markers, zoom),
              plot_point_cloud(cloud.x_m, cloud.y_m, cloud.snr_db, folder / "point_cloud.png",
                               f"{cfg.name}: point cloud ({len(cloud)} points)",
-                              _truth(scene))]
+                              _truth(scene), boxes)]
     print("figures: " + ", ".join(str(p) for p in paths))
 
 
@@ -230,10 +260,19 @@ def cmd_demo(args: argparse.Namespace) -> int:
     figs.append(plot_range_azimuth_pair(
         [(ra_bf, "TX subarray beamforming (3 elements)"), (ra_nobf, "single TX element")],
         az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom))
+    objects = _gnn_objects(cloud, EGO_SPEED_KMH / 3.6) if not args.no_gnn else []
+    if not args.no_gnn:
+        print(f"GNN (synthetic-trained checkpoint; ego {EGO_SPEED_KMH:.0f} km/h is beyond its "
+              f"training range): " + (", ".join(
+                  f"{o['class']} {o['score']:.2f} at ({o['x_m']:.1f}, {o['y_m']:.1f}) m"
+                  for o in objects) or "no objects"))
     figs.append(plot_point_cloud(cloud.x_m, cloud.y_m, cloud.snr_db, out / "point_cloud.png",
-                                 f"{cfg.name}: Table I point cloud", _truth(scene)))
-    (out / "table1_points.json").write_text(json.dumps(cloud.to_json_dict(cfg.name, 1),
-                                                       indent=1))
+                                 f"{cfg.name}: Table I point cloud" + (
+                                     " and GNN objects" if objects else ""),
+                                 _truth(scene), _boxes(objects)))
+    doc = cloud.to_json_dict(cfg.name, 1)
+    doc["objects"] = objects
+    (out / "table1_points.json").write_text(json.dumps(doc, indent=1))
     print(f"figures in {out}/: " + ", ".join(p.name for p in figs)
           + f" ({time.perf_counter() - t0:.1f} s)")
     return 0
@@ -371,6 +410,12 @@ def build_parser(with_gnn: bool = False) -> argparse.ArgumentParser:
     d.add_argument("--frames", type=int, default=1, help="frames to process (default 1)")
     d.add_argument("--preset", choices=presets, default=None,
                    help="override the scene's radar preset")
+    d.add_argument("--gnn", action="store_true",
+                   help="also classify objects with the GNN (shipped checkpoint): adds "
+                        "\"objects\" (class, score, rotated box, point indices) to the JSON")
+    d.add_argument("--ego-speed", type=float, default=None,
+                   help="ego speed along +x for the GNN's velocity compensation, m/s "
+                        "(default: 27.78 for table1, else 0)")
     _add_detection_options(d)
     d.set_defaults(func=cmd_detect)
 
@@ -389,6 +434,8 @@ def build_parser(with_gnn: bool = False) -> argparse.ArgumentParser:
     m.add_argument("--backend", choices=BACKENDS[:2], default="model",
                    help="model: bit-accurate FPGA chain (default, ~20 s on full); float: "
                         "its float64 reference (~3 s)")
+    m.add_argument("--no-gnn", action="store_true",
+                   help="skip the GNN object classification (saves loading torch)")
     m.set_defaults(func=cmd_demo)
 
     c = sub.add_parser(

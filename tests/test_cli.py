@@ -117,3 +117,15 @@ def test_capture_replay_receive_over_loopback(tmp_path, capsys):
     assert [f["complete"] for f in doc["frame_info"]] == [True, True]
     # the same vehicles as the model backend: 3 of 4 on paper-fpga (vehicle 1 too weak)
     assert sum(p["frame"] == 0 for p in doc["points"]) >= 3
+
+
+def test_detect_with_gnn_objects(tmp_path):
+    out = tmp_path / "pc.json"
+    assert main(["detect", "--scene", "table1", "--backend", "float", "--gnn", "--json",
+                 str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["objects"], "the GNN finds the Table I vehicles"
+    for o in doc["objects"]:
+        assert {"class", "score", "x_m", "y_m", "length_m", "width_m", "heading_deg",
+                "points", "frame"} <= set(o)
+        assert all(0 <= i < len(doc["points"]) for i in o["points"])
