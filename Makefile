@@ -22,6 +22,8 @@ help:
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
+	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
 	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
@@ -60,6 +62,8 @@ bench: $(STAMP)
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
+
+include synth/synth.mk
 
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 
