@@ -92,6 +92,17 @@ class AxisTB:
         """TREADY stalls on the sink (None = always ready)."""
         self.sink.set_pause_generator(generator)
 
+    async def wait_quiet(self, quiet: int = 64) -> None:
+        """Wait until the source has sent everything and neither interface has had TVALID
+        high for ``quiet`` consecutive clocks."""
+        await self.source.wait()
+        s_valid = getattr(self.dut, f"{self._in_prefix}_tvalid")
+        m_valid = getattr(self.dut, f"{self._out_prefix}_tvalid")
+        idle = 0
+        while idle < quiet:
+            await RisingEdge(self.dut.clk)
+            idle = 0 if (m_valid.value == 1 or s_valid.value == 1) else idle + 1
+
     async def cycles(self, n: int) -> None:
         for _ in range(n):
             await RisingEdge(self.dut.clk)

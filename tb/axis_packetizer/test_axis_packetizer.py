@@ -11,7 +11,6 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotb.triggers import RisingEdge
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
@@ -51,12 +50,7 @@ class TB(AxisTB):
 
     async def drain(self, quiet: int = 64) -> list[np.ndarray]:
         """Wait for the source to finish and the output to go quiet; return received packets."""
-        await self.source.wait()
-        idle = 0
-        while idle < quiet:
-            await RisingEdge(self.dut.clk)
-            busy = self.dut.m_axis_tvalid.value == 1 or self.dut.s_axis_tvalid.value == 1
-            idle = 0 if busy else idle + 1
+        await self.wait_quiet(quiet)
         out = []
         while not self.sink.empty():
             out.append(frame_to_words(self.sink.recv_nowait(), self.num_rx))

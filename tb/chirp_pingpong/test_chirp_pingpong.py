@@ -11,7 +11,6 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotb.triggers import RisingEdge
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
@@ -53,12 +52,7 @@ class TB(AxisTB):
             start = end
 
     async def drain(self, quiet: int = 64) -> list[cp.OutChirp]:
-        await self.source.wait()
-        idle = 0
-        while idle < quiet:
-            await RisingEdge(self.dut.clk)
-            busy = self.dut.m_axis_tvalid.value == 1 or self.dut.s_axis_tvalid.value == 1
-            idle = 0 if busy else idle + 1
+        await self.wait_quiet(quiet)
         out = []
         while not self.sink.empty():
             f = self.sink.recv_nowait(compact=False)
