@@ -50,14 +50,15 @@ class FftFixedResult:
 
 
 def rnd(v: np.ndarray, k: int) -> np.ndarray:
-    """Convergent rounding (half to even) of ``v / 2**k``; ``v`` int64 array, ``k >= 0``."""
+    """Convergent rounding (half to even) of ``v / 2**k``; ``v`` int64 array, ``k >= 0``.
+
+    ``(v + 2**(k-1) - 1 + lsb) >> k`` with ``lsb`` the bit that becomes the result's LSB:
+    a remainder above one half carries, below does not, exactly one half carries only when
+    the truncated result is odd (one add and one shift instead of compare-and-select).
+    """
     if k == 0:
         return v
-    q = v >> k
-    rem = v & ((1 << k) - 1)
-    half = 1 << (k - 1)
-    inc = (rem > half) | ((rem == half) & ((q & 1) == 1))
-    return q + inc.astype(np.int64)
+    return (v + ((1 << (k - 1)) - 1) + ((v >> k) & 1)) >> k
 
 
 def sat(v: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
