@@ -165,7 +165,7 @@ module frame_align #(
   always_ff @(posedge clk) begin
     v_q <= m_axis_tvalid && !m_axis_tready && !rst;
     d_q <= {m_axis_tlast, m_axis_tdata};
-    if (v_q) begin
+    if (v_q && !rst) begin  // the AXI rules do not hold across a reset
       assert (m_axis_tvalid) else $error("frame_align: TVALID dropped while stalled");
       assert ({m_axis_tlast, m_axis_tdata} == d_q)
         else $error("frame_align: data changed while stalled");
