@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.reference import angle_spectrum
+from model.config import RadarConfig
+from model.reference import angle_spectrum, tdm_phase_compensation
 
 
 @dataclass(frozen=True)
@@ -123,7 +124,7 @@ def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
     return unique
 
 
-def range_azimuth_power(cube: np.ndarray, num_tx: int, num_rx: int, n_fft: int = 256
+def range_azimuth_power(cube: np.ndarray, cfg: RadarConfig, n_fft: int = 256
                         ) -> tuple[np.ndarray, np.ndarray]:
     """Range-azimuth map: TDM-compensated, Hann-tapered angle FFT of every cell, power
     summed over Doppler (for figures; detection uses :func:`estimate_angles`).
@@ -131,10 +132,7 @@ def range_azimuth_power(cube: np.ndarray, num_tx: int, num_rx: int, n_fft: int =
     cube: complex (n_virtual, n_range, n_doppler). Returns (float (n_range, n_fft) power,
     float (n_fft,) azimuth of each column in deg, NaN outside the visible region).
     """
-    n_v, _, n_d = cube.shape
-    k = np.where(np.arange(n_d) < n_d // 2, np.arange(n_d), np.arange(n_d) - n_d)
-    tx = np.arange(n_v) // num_rx
-    comp = np.exp(-2j * np.pi * np.outer(tx, k) / (n_d * num_tx))          # (n_v, n_d)
-    x = cube * comp[:, None, :]
-    spec, az = angle_spectrum(np.moveaxis(x, 0, -1), n_fft=n_fft, window=True)  # (r, d, n_fft)
+    comp = tdm_phase_compensation(cfg, np.arange(cfg.n_doppler))             # (n_d, n_v)
+    x = np.moveaxis(cube, 0, -1) * comp[None, :, :]                           # (r, d, n_v)
+    spec, az = angle_spectrum(x, n_fft=n_fft, window=True)                    # (r, d, n_fft)
     return np.sum(np.abs(spec) ** 2, axis=1), az

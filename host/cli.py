@@ -255,8 +255,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     no_bf = Scene(preset=scene.preset, seed=scene.seed, tx_beamforming=False,
                   targets=scene.targets, name="table1-no-bf")
     cube_nobf = cube_from_adc(simulate_scene(no_bf).samples, cfg, args.backend)
-    ra_bf, az = range_azimuth_power(cube, cfg.num_tx, cfg.num_rx)
-    ra_nobf, _ = range_azimuth_power(cube_nobf, cfg.num_tx, cfg.num_rx)
+    ra_bf, az = range_azimuth_power(cube, cfg)
+    ra_nobf, _ = range_azimuth_power(cube_nobf, cfg)
     figs.append(plot_range_azimuth_pair(
         [(ra_bf, "TX subarray beamforming (3 elements)"), (ra_nobf, "single TX element")],
         az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom))
