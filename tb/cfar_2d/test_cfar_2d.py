@@ -10,6 +10,7 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
+from cocotb.triggers import with_timeout
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
@@ -55,10 +56,12 @@ class TB(AxisTB):
         c = self.cfg
         bd = (c.n_doppler - 1).bit_length()
         frames = []
+        # a hang fails after 20x the stall-free row time
+        limit = 20 * 10 * (c.n_doppler + 2 * c.pd) * (c.pr + 2)
         for _ in range(n):
             cells = []
             for _r in range(c.n_range):
-                f = await self.sink.recv(compact=False)
+                f = await with_timeout(self.sink.recv(compact=False), limit, "ns")
                 raw = bytes(f.tdata)
                 assert len(raw) == c.n_doppler * c.out_bytes, f"row of {len(raw)} bytes"
                 for i in range(c.n_doppler):

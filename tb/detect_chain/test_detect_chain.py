@@ -11,6 +11,7 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
+from cocotb.triggers import with_timeout
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
@@ -77,16 +78,21 @@ class TB(AxisTB):
                     f"frame {k}: {len(bad)} words differ, first at {bad[0]}: got "
                     f"{[(x.range_bin, x.doppler_bin) for x in dg.records][:6]} "
                     f"trailer {dg.trailer}, expected "
-                    f"{[(x.range_bin, x.doppler_bin) for x in de.records][:6]} trailer {de.trailer}")
+                    f"{[(x.range_bin, x.doppler_bin) for x in de.records][:6]} "
+                    f"trailer {de.trailer}")
             decoded.append(dg)
         return decoded
 
 
 async def run_frames(tb: TB, frames: list[np.ndarray]) -> list[np.ndarray]:
+    """Send and receive; a hang (deadlock) fails after 20x the stall-free frame time."""
+    c = tb.cfg
+    clocks = (c.num_tx * c.n_range * c.n_doppler + c.n_range * (c.n_doppler + 2 * c.cfar.pd)
+              + (c.cfar.pr + 1) * c.n_doppler + c.frame_words)
     rx = cocotb.start_soon(tb.recv_frames(len(frames)))
     for f in frames:
         await tb.send_frame(f)
-    return await rx
+    return await with_timeout(rx, 20 * 10 * clocks * (len(frames) + 1), "ns")
 
 
 @cocotb.test()
@@ -149,12 +155,15 @@ PARAMS = [
     # 1 TX x 4 RX, CA, top range bins blanked, small MAX_DETECTIONS, high Pfa
     (dict(NUM_TX=1, NUM_RX=4, N_RANGE=16, N_DOPPLER=32, GUARD_R=1, GUARD_D=1, TRAIN_R=2,
           TRAIN_D=4, KIND=0, BLANK_TOP=2, MAX_DETECTIONS=8), 1e-2),
-    # small 4-TX configuration (16 virtual channels, 2-word snapshots... 4 words), GO
+    # small 4-TX configuration (16 virtual channels, 4-word snapshots), GO
     (dict(NUM_TX=4, NUM_RX=4, N_RANGE=8, N_DOPPLER=16, GUARD_R=0, GUARD_D=1, TRAIN_R=2,
           TRAIN_D=2, KIND=1, BLANK_TOP=0, MAX_DETECTIONS=6), 1e-2),
     # 2 TX x 16 RX (one-word record headers), SO
     (dict(NUM_TX=2, NUM_RX=16, N_RANGE=8, N_DOPPLER=8, GUARD_R=1, GUARD_D=0, TRAIN_R=1,
           TRAIN_D=2, KIND=2, BLANK_TOP=1, MAX_DETECTIONS=5), 1e-2),
+    # paper-fpga: 1 TX x 4 RX, 64 x 256, the host's default window and Pfa
+    (dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256, GUARD_R=2, GUARD_D=2, TRAIN_R=4,
+          TRAIN_D=8, KIND=0, BLANK_TOP=0, MAX_DETECTIONS=64), 1e-6),
 ]
 
 

@@ -10,6 +10,7 @@ import cocotb
 import numpy as np
 import pytest
 from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
+from cocotb.triggers import with_timeout
 from cocotbext.axi import AxiStreamFrame
 from sim import param, rtl_sources, run_cocotb
 
@@ -53,7 +54,9 @@ class TB(AxisTB):
         for _ in range(n):
             rows = []
             for r in range(self.n_range):
-                f = await self.sink.recv(compact=False)
+                # a hang fails after 40x the stall-free row time
+                f = await with_timeout(self.sink.recv(compact=False),
+                                       40 * 10 * self.num_tx * self.n_doppler, "ns")
                 raw = np.frombuffer(bytes(f.tdata), dtype=np.uint8).reshape(-1, self.out_bytes)
                 assert len(raw) == self.n_doppler, f"row of {len(raw)} cells"
                 vals = [int.from_bytes(bytes(c), "little") for c in raw]
