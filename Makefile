@@ -83,3 +83,8 @@ clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache
 	find . -name __pycache__ -not -path './$(VENV)/*' -prune -exec rm -rf {} +
 	find . -name '*.result.xml' -not -path './$(VENV)/*' -delete
+
+# On-chip detection blocks at every parameter set (make test runs a quick subset)
+.PHONY: test-detect-long
+test-detect-long: $(STAMP)
+	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain

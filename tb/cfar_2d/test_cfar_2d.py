@@ -176,12 +176,14 @@ async def test_reset_recovery(dut):
 # ------------------------------------------------------------------------------------------
 # pytest: one Verilator build per HDL parameter set
 PARAMS = [
-    # smallest: 4 x 4 map, no guard, one training cell per side, CA
-    dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
-         BLANK_TOP=1),
     # GO with top range bins blanked, asymmetric window
     dict(N_RANGE=16, N_DOPPLER=32, POW_W=34, GUARD_R=1, GUARD_D=2, TRAIN_R=2, TRAIN_D=3, KIND=1,
          BLANK_TOP=3),
+]
+LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
+    # smallest: 4 x 4 map, no guard, one training cell per side, CA
+    dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
+         BLANK_TOP=1),
     # SO, Doppler window nearly the whole row (wrap on both sides)
     dict(N_RANGE=16, N_DOPPLER=8, POW_W=38, GUARD_R=0, GUARD_D=1, TRAIN_R=3, TRAIN_D=2, KIND=2,
          BLANK_TOP=0),
@@ -189,6 +191,8 @@ PARAMS = [
     dict(N_RANGE=64, N_DOPPLER=256, POW_W=34, GUARD_R=2, GUARD_D=2, TRAIN_R=4, TRAIN_D=8,
          KIND=0, BLANK_TOP=0),
 ]
+if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
+    PARAMS += LONG_PARAMS
 
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: "_".join(

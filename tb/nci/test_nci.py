@@ -157,15 +157,19 @@ async def test_reset_recovery(dut):
 # ------------------------------------------------------------------------------------------
 # pytest: one Verilator build per HDL parameter set
 PARAMS = [
-    # smallest: one channel, 2 x 2 map
-    dict(NUM_TX=1, NUM_RX=1, N_RANGE=2, N_DOPPLER=2),
     # TX count not a power of two (accumulator RAM, t wrap at 3)
     dict(NUM_TX=3, NUM_RX=2, N_RANGE=4, N_DOPPLER=4),
+]
+LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
+    # smallest: one channel, 2 x 2 map
+    dict(NUM_TX=1, NUM_RX=1, N_RANGE=2, N_DOPPLER=2),
     # 4 TX x 16 RX (the full preset's virtual array, 38-bit power), small map
     dict(NUM_TX=4, NUM_RX=16, N_RANGE=4, N_DOPPLER=16),
     # paper-fpga: 1 TX x 4 RX, 64 x 256
     dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
 ]
+if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
+    PARAMS += LONG_PARAMS
 
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: "_".join(
