@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint bench bench-rtl gnn-dataset gnn-train gnn-eval \
-        clean help
+        clean help view bench-view
 all: test
 
 help:
@@ -27,14 +27,18 @@ help:
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
 	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
+	@echo "make view            live browser view of the Table I replay at http://127.0.0.1:8050/"
+	@echo "make bench-view      browser display updates/s and memory of radar view (table)"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
+	@tools/install-chromium.sh
 
 $(STAMP): pyproject.toml
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
+	tools/install-chromium.sh
 	touch $@
 
 demo: $(STAMP)
@@ -53,7 +57,7 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
-	$(RUN) ruff check model host gnn tb tests tools synth
+	$(RUN) ruff check model host gnn tb tests tools synth radar
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
@@ -83,3 +87,16 @@ clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache
 	find . -name __pycache__ -not -path './$(VENV)/*' -prune -exec rm -rf {} +
 	find . -name '*.result.xml' -not -path './$(VENV)/*' -delete
+
+# ---- radar view (live browser view) --------------------------------------------------------
+VIEW_CAPTURE ?= $(OUT)/table1_paper-fpga.dmacap
+
+$(VIEW_CAPTURE): | $(STAMP)
+	mkdir -p $(dir $@)
+	$(RUN) radar capture --scene table1 --preset paper-fpga --frames 8 --out $@
+
+view: $(STAMP) $(VIEW_CAPTURE)
+	$(RUN) python -m radar.view --replay $(VIEW_CAPTURE) --gnn
+
+bench-view: $(STAMP)
+	$(RUN) python -m radar.view.bench_view

@@ -1,0 +1,1 @@
+"""The application: the ``radar`` command line, frame sources, demo and live view."""
