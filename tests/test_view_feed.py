@@ -14,11 +14,12 @@ from host.capture import frame_packets
 from host.pointcloud import PointCloud
 from host.stream import StreamDecoder
 from model.config import get_preset
+from model.reference import range_doppler_power
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth, missing_packets
 from radar.view.render import MAX_AXIS, box_outline, frame_message, heatmap, pool_max
 from radar.view.server import STATIC_DIR, plotly_js_path
-from radar.view.sources import PacketIngest, Processor, replay_loop
+from radar.view.sources import PacketIngest, Processor, channel_power_sum, replay_loop
 
 CFG = get_preset("paper-fpga")
 PACKET_WORDS = 1023
@@ -44,7 +45,7 @@ class _Recorder(Processor):
         super().__init__(CFG, Feed(), health)
         self.got: list[int] = []
 
-    def submit(self, frame_id: int, cube: np.ndarray) -> None:
+    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0) -> None:
         self.got.append(frame_id)
 
 
@@ -164,6 +165,11 @@ def test_bad_cube_is_reported_not_raised():
     assert "frame 7" in health.snapshot()["problems"][-1]
 
 
+def test_channel_power_sum_is_the_reference():
+    cube = _cube(3)
+    np.testing.assert_allclose(channel_power_sum(cube), range_doppler_power(cube), rtol=1e-5)
+
+
 def test_pool_max_keeps_single_cell_peak():
     full = get_preset("full")
     p = np.ones((full.n_range, full.n_doppler))
@@ -180,7 +186,7 @@ def test_heatmap_quantisation_round_trip():
     q = np.frombuffer(base64.b64decode(m["q"]), np.uint8).reshape(m["rows"], m["cols"])
     assert (m["rows"], m["cols"]) == (CFG.n_range, MAX_AXIS)
     assert q.max() == 255 and q[10, MAX_AXIS // 2] == 255
-    assert m["hi"] == pytest.approx(70.0) and m["lo"] == pytest.approx(17.0)
+    assert m["hi"] == pytest.approx(70.0) and m["lo"] == pytest.approx(15.0)
     assert m["velocity_mps"][0] < 0 < m["velocity_mps"][-1]
 
 

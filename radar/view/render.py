@@ -3,7 +3,8 @@
 Heat maps are reduced before they leave the host: max-pooled (so a one-cell target never
 disappears) to at most :data:`MAX_AXIS` cells per axis (``full`` 256 x 256 -> 128 x 128),
 converted to dB, and quantised to 8 bits over [``lo``, ``hi``] dB (``lo``: a little under the
-median, i.e. the noise floor; ``hi``: the peak), sent as base64. The page maps a code q back
+median, i.e. the noise floor; ``hi``: the peak; both rounded out to a 5 dB grid so the
+colour scale is steady), sent as base64. The page maps a code q back
 to ``lo + q * (hi - lo) / 255`` dB. Doppler is shifted so velocity increases left to right.
 """
 
@@ -26,6 +27,9 @@ MAX_AXIS = 128
 
 FLOOR_BELOW_MEDIAN_DB = 3.0
 """The colour scale starts this far below the map's median (noise floor), dB."""
+
+SCALE_STEP_DB = 5.0
+"""Colour-scale limits are rounded out to multiples of this, dB."""
 
 
 def pool_max(a: np.ndarray, max_axis: int = MAX_AXIS) -> np.ndarray:
@@ -58,8 +62,11 @@ def heatmap(power: np.ndarray, cfg: RadarConfig) -> dict[str, Any]:
     shifted = np.fft.fftshift(power, axes=1)
     pooled = pool_max(shifted)
     db = 10 * np.log10(np.maximum(pooled, 1e-20))
-    hi = float(db.max())
-    lo = min(float(np.median(db)) - FLOOR_BELOW_MEDIAN_DB, hi - 1.0)
+    # on a SCALE_STEP_DB grid: the colour scale stays put from frame to frame, so the page
+    # redraws only the image, not the colour bar
+    hi = SCALE_STEP_DB * math.ceil(float(db.max()) / SCALE_STEP_DB)
+    lo = min(SCALE_STEP_DB * math.floor((float(np.median(db)) - FLOOR_BELOW_MEDIAN_DB)
+                                        / SCALE_STEP_DB), hi - SCALE_STEP_DB)
     q = np.clip(np.rint((db - lo) * (255.0 / (hi - lo))), 0, 255).astype(np.uint8)
     return {"q": base64.b64encode(q.tobytes()).decode("ascii"),
             "rows": int(q.shape[0]), "cols": int(q.shape[1]),

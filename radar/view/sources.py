@@ -28,12 +28,20 @@ from host.pipeline import DetectionParams, process_cube
 from host.stream import Frame, StreamDecoder
 from host.udp import UDP_MAX_PAYLOAD
 from model.config import RadarConfig
-from model.reference import range_doppler_power
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
 
 IDLE_RESTART_S = 1.0
 """No datagram for this long: open frames are closed and the next packet starts afresh."""
+
+
+def channel_power_sum(cube: np.ndarray) -> np.ndarray:
+    """sum_v |cube|^2, float (n_range, n_doppler): ``model.reference.range_doppler_power``
+    computed on the interleaved I/Q floats (no complex abs), about 3x faster."""
+    if cube.dtype != np.complex64 or not cube.flags.c_contiguous:
+        return np.sum(np.abs(cube) ** 2, axis=0)
+    iq = cube.view(np.float32)  # (n_virtual, n_range, 2 * n_doppler)
+    return np.einsum("vrd,vrd->rd", iq, iq).reshape(*cube.shape[1:], 2).sum(axis=-1)
 
 
 class Processor:
@@ -55,16 +63,18 @@ class Processor:
         self.ego_speed_mps = ego_speed_mps
         self.source = source
         self._cond = threading.Condition()
-        self._slot: tuple[int, np.ndarray] | None = None
+        self._slot: tuple[int, np.ndarray, float] | None = None
         self._skipped = 0
         self.errors = 0
 
-    def submit(self, frame_id: int, cube: np.ndarray) -> None:
-        """Hand over a cube complex (n_virtual, n_range, n_doppler) in reference units."""
+    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0) -> None:
+        """Hand over a cube complex (n_virtual, n_range, n_doppler); ``cube * scale`` is in
+        reference units. The processor owns the cube from now on (scaled in place on its
+        own thread, so the ingest thread stays free for the link)."""
         with self._cond:
             if self._slot is not None:
                 self._skipped += 1
-            self._slot = (frame_id, cube)
+            self._slot = (frame_id, cube, scale)
             self._cond.notify()
 
     def run(self, stop: threading.Event) -> None:
@@ -74,9 +84,11 @@ class Processor:
                     self._cond.wait(0.2)
                 if self._slot is None:
                     continue
-                (frame_id, cube), self._slot = self._slot, None
+                (frame_id, cube, scale), self._slot = self._slot, None
                 skipped, self._skipped = self._skipped, 0
             try:
+                if scale != 1.0:
+                    cube *= np.float32(scale) if cube.dtype == np.complex64 else scale
                 self._process(frame_id, cube, skipped)
             except Exception as exc:  # noqa: BLE001 - a bad frame must not stop the view
                 self.errors += 1
@@ -88,7 +100,7 @@ class Processor:
         objects = (self.detect_objects(cloud, ego_speed_mps=self.ego_speed_mps)
                    if self.detect_objects is not None and len(cloud) else [])
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=frame_id, cfg=self.cfg,
-                          cloud=cloud, cube=cube, nci=range_doppler_power(cube),
+                          cloud=cloud, cube=cube, nci=channel_power_sum(cube),
                           objects=objects, source=self.source)
         self.health.on_shown(len(cloud), len(objects), skipped)
         self.feed.publish(frame)
@@ -205,7 +217,7 @@ class PacketIngest:
         self.health.on_frame(f, self.packet_words, self.decoder.n_packets, self._id_gap(
             f.frame_id))
         if f.complete or self.use_damaged:
-            self.processor.submit(f.frame_id, f.cube / np.float32(self.gain))
+            self.processor.submit(f.frame_id, f.cube, scale=1.0 / self.gain)
 
 
 def udp_loop(sock: socket.socket, ingest: PacketIngest, stop: threading.Event,

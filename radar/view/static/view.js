@@ -5,7 +5,7 @@
 
 const state = window.radarView = {
   draws: 0, frames: 0, lastSeq: null, drawFps: 0, connected: false, reconnects: 0,
-  drawTimes: [], lastHealth: null,
+  drawTimes: [], lastHealth: null, drawMs: {},
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };
 const MARGIN = { l: 55, r: 10, t: 30, b: 40 };
@@ -47,7 +47,7 @@ function pointCloud(div, msg) {
   const p = msg.points;
   const vmax = msg.limits.max_velocity_mps;
   const traces = [{
-    type: "scattergl", mode: "markers", x: p.y, y: p.x, name: "points",
+    type: "scatter", mode: "markers", x: p.y, y: p.x, name: "points",
     marker: { size: 6, color: p.v, cmin: -vmax, cmax: vmax, colorscale: "RdBu",
               colorbar: { title: { text: "m/s" } } },
     text: p.snr.map((s, i) => `v ${p.v[i]} m/s, SNR ${s} dB`),
@@ -65,8 +65,7 @@ function pointCloud(div, msg) {
   }
   const r = msg.limits.max_range_m;
   return Plotly.react(div, traces, {
-    title: { text: `point cloud: ${p.x.length} points, ${msg.boxes.length} objects`,
-             font: { size: 13 } },
+    title: { text: "point cloud, coloured by radial velocity; GNN objects", font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "cloud",
     xaxis: { title: { text: "y (m, left +)" }, range: [r / 2, -r / 2] },
     yaxis: { title: { text: "x (m, forward)" }, range: [0, r] },
@@ -116,18 +115,26 @@ function countDraw() {
   document.getElementById("draw_fps").textContent = state.drawFps.toFixed(1);
 }
 
+async function timed(name, fn) {
+  // time spent per plot, ms (exponential average): read by the benchmark
+  const t0 = performance.now();
+  await fn();
+  const dt = performance.now() - t0;
+  state.drawMs[name] = state.drawMs[name] === undefined ? dt : 0.9 * state.drawMs[name] + 0.1 * dt;
+}
+
 async function draw(msg) {
   if (msg.type === "frame") {
     document.getElementById("source").textContent = `${msg.source} (${msg.preset})`;
     document.getElementById("frame_id").textContent = msg.frame_id;
     const input = document.getElementById("channel");
     input.max = msg.n_virtual - 1;
-    await Promise.all([
-      heatmap("plot-rd", msg.rd, `range-Doppler, virtual channel ${msg.channel}`),
-      heatmap("plot-nci", msg.nci, "range-Doppler, integrated over channels"),
-      pointCloud("plot-cloud", msg),
-      profile("plot-profile", msg),
-    ]);
+    await timed("rd", () => heatmap("plot-rd", msg.rd,
+                                      `range-Doppler, virtual channel ${msg.channel}`));
+    await timed("nci", () => heatmap("plot-nci", msg.nci,
+                                     "range-Doppler, integrated over channels"));
+    await timed("cloud", () => pointCloud("plot-cloud", msg));
+    await timed("profile", () => profile("plot-profile", msg));
     state.frames += 1;
     state.lastSeq = msg.seq;
     countDraw();

@@ -1,0 +1,132 @@
+"""Benchmark of ``radar view`` in a real browser (prints a table; not a test).
+
+For each preset a short Table I capture is made (float reference of the FPGA chain, scaled by
+the chain gain and rounded to int16 exactly like the DMA payload), replayed by ``radar view``
+faster than the goal, and watched by headless chromium for ``--duration`` seconds. Reported:
+frames/s decoded by the view, display updates/s drawn by the page (the goal: >= 20 for
+paper-fpga, >= 5 for full), frames the view skipped to stay current, and the view process's
+resident memory (start / end / max, MiB) and the page's JS heap: flat memory means nothing
+queues up. ``--duration 600`` is the 10-minute run of the issue.
+
+    python -m radar.view.bench_view [--duration 20] [--presets paper-fpga full]
+                                    [--screenshot docs/img/radar_view.png]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from host.capture import CaptureInfo, frame_packets, write_capture
+from model.pipeline import PipelineParams, chain_gain
+from model.reference import radar_cube
+from model.scene import table1_scene
+from model.simulate import simulate_scene
+from radar.view.browser import chromium_missing_reason, launch, start_view
+
+GOALS = {"paper-fpga": 20.0, "full": 5.0}
+"""Display updates per second the issue asks for."""
+
+FEED_FPS = {"paper-fpga": 40.0, "full": 15.0}
+"""Replay rate, frames/s: above the goal, so the display rate is what limits."""
+
+
+def make_capture(preset: str, path: Path, frames: int = 4, packet_words: int = 1023) -> Path:
+    """A Table I capture from the float reference chain (fast, also for ``full``)."""
+    scene = table1_scene(preset)
+    cfg = scene.config
+    chain = PipelineParams(packet_words=packet_words)
+    gain = chain_gain(cfg, chain)
+    packets: list[bytes] = []
+    for k in range(frames):
+        cube = radar_cube(simulate_scene(scene, frame_index=k).samples, cfg, chain.window,
+                          chain.window) * gain
+        cube = np.clip(np.rint(cube.real), -32768, 32767) + 1j * np.clip(
+            np.rint(cube.imag), -32768, 32767)
+        packets += frame_packets(cube, cfg, packet_words, k)
+    write_capture(path, CaptureInfo(cfg.num_rx, packet_words, cfg.num_tx, cfg.n_range,
+                                    cfg.n_doppler), packets)
+    return path
+
+
+def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
+        gnn: bool) -> dict[str, float]:
+    from playwright.sync_api import sync_playwright
+
+    cap = make_capture(preset, folder / f"{preset}.dmacap")
+    args = ["--replay", str(cap), "--fps", str(FEED_FPS[preset])] + (["--gnn"] if gnn else [])
+    view = start_view(args, timeout_s=120)
+    try:
+        with sync_playwright() as pw:
+            ctx = launch(pw, folder / f"profile-{preset}")
+            page = ctx.new_page()
+            page.goto(view.url)
+            page.wait_for_function("window.radarView.frames >= 3", timeout=120_000)
+            time.sleep(1.0)
+            state0 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
+                                   "h: window.radarView.lastHealth})")
+            rss = [view.rss_kib()]
+            heap0 = page.evaluate("performance.memory.usedJSHeapSize")
+            t_end = time.monotonic() + duration_s
+            while time.monotonic() < t_end:
+                time.sleep(min(1.0, max(0.0, t_end - time.monotonic())))
+                rss.append(view.rss_kib())
+            state1 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
+                                   "h: window.radarView.lastHealth})")
+            heap1 = page.evaluate("performance.memory.usedJSHeapSize")
+            if screenshot is not None:
+                screenshot.parent.mkdir(parents=True, exist_ok=True)
+                page.screenshot(path=str(screenshot))
+            ctx.close()
+    finally:
+        view.stop()
+    dt = (state1["t"] - state0["t"]) / 1e3
+    h0, h1 = state0["h"], state1["h"]
+    decoded = (h1["frames_complete"] + h1["frames_damaged"]
+               - h0["frames_complete"] - h0["frames_damaged"])
+    return {"decoded_fps": decoded / dt, "display_fps": (state1["f"] - state0["f"]) / dt,
+            "not_shown": h1["frames_not_shown"] - h0["frames_not_shown"],
+            "rss0": rss[0] / 1024, "rss1": rss[-1] / 1024, "rss_max": max(rss) / 1024,
+            "heap0": heap0 / 2**20, "heap1": heap1 / 2**20, "seconds": dt}
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--duration", type=float, default=20.0,
+                   help="seconds watched per preset (default 20; 600 = the 10-minute run)")
+    p.add_argument("--presets", nargs="+", default=["paper-fpga", "full"],
+                   choices=sorted(GOALS))
+    p.add_argument("--screenshot", type=Path, default=None,
+                   help="save a screenshot of the first preset's page here (.png)")
+    p.add_argument("--gnn", action="store_true", help="run the GNN too (boxes on the page)")
+    args = p.parse_args(argv)
+    reason = chromium_missing_reason()
+    if reason:
+        print(f"bench_view: {reason}", file=sys.stderr)
+        return 2
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, preset in enumerate(args.presets):
+            r = run(preset, args.duration, Path(tmp), args.screenshot if i == 0 else None,
+                    args.gnn)
+            rows.append((preset, r))
+    print(f"radar view in headless chromium, Table I replay, {args.duration:g} s per preset"
+          f"{' with GNN' if args.gnn else ''}")
+    print(f"{'preset':<11}{'feed fps':>9}{'decoded/s':>10}{'display/s':>10}{'goal':>6}"
+          f"{'skipped':>8}{'RSS start':>10}{'end':>7}{'max MiB':>8}{'JS heap':>13}")
+    for preset, r in rows:
+        ok = "ok" if r["display_fps"] >= GOALS[preset] else "MISS"
+        print(f"{preset:<11}{FEED_FPS[preset]:>9.0f}{r['decoded_fps']:>10.1f}"
+              f"{r['display_fps']:>10.1f}{GOALS[preset]:>4.0f} {ok:<3}{r['not_shown']:>6.0f}"
+              f"{r['rss0']:>10.0f}{r['rss1']:>7.0f}{r['rss_max']:>8.0f}"
+              f"{r['heap0']:>6.1f}->{r['heap1']:<5.1f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
