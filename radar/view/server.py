@@ -6,9 +6,10 @@ internet), ``/ws`` the live feed, ``/api/state`` counters as JSON (for scripts a
 
 Flow control per browser: at most one message in flight. The server sends the newest frame
 (or, when no new frame came, a health update every :data:`HEALTH_PERIOD_S`) and waits for the
-page's ``{"ack": ...}``, sent after the page has drawn it. A slow or stalled browser therefore
-only ever skips frames (newest wins); nothing queues up on the host, and other browsers are
-not held back. A browser that reconnects is simply a new client.
+page's ``{"ack": ...}``, which the page sends when it starts drawing that message (so the next
+one is prepared while it draws; a message that arrives while one is drawn replaces any other
+waiting one). A slow or stalled browser therefore only ever skips frames (newest wins);
+nothing queues up on the host or in the page, and other browsers are not held back. A browser that reconnects is simply a new client.
 """
 
 from __future__ import annotations

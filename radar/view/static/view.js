@@ -48,7 +48,8 @@ function pointCloud(div, msg) {
   const vmax = msg.limits.max_velocity_mps;
   const traces = [{
     type: "scatter", mode: "markers", x: p.y, y: p.x, name: "points",
-    marker: { size: 6, color: p.v, cmin: -vmax, cmax: vmax, colorscale: "RdBu",
+    marker: { size: 8, color: p.v, cmin: -vmax, cmax: vmax, colorscale: "Jet",
+              line: { width: 1, color: "#222" },
               colorbar: { title: { text: "m/s" } } },
     text: p.snr.map((s, i) => `v ${p.v[i]} m/s, SNR ${s} dB`),
     hovertemplate: "x %{y:.1f} m, y %{x:.1f} m<br>%{text}<extra></extra>",
@@ -142,24 +143,38 @@ async function draw(msg) {
   showHealth(msg.health);
 }
 
+// Double buffering: the page acknowledges a message when it starts drawing it, so the server
+// prepares and sends the next one meanwhile. At most one message is drawn and one waits.
+let pending = null;
+let drawing = false;
+
+async function drawLoop() {
+  drawing = true;
+  while (pending) {
+    const msg = pending;
+    pending = null;
+    if (ws && ws.readyState === WebSocket.OPEN) {
+      ws.send(JSON.stringify({ ack: msg.seq ?? null, draw_fps: state.drawFps }));
+    }
+    try {
+      await draw(msg);
+    } catch (err) {
+      console.error("radar view: draw failed", err);
+    }
+    await new Promise(resolve => requestAnimationFrame(resolve));  // let the browser paint
+  }
+  drawing = false;
+}
+
 function connect() {
   ws = new WebSocket(`ws://${location.host}/ws`);
   ws.onopen = () => {
     state.connected = true;
     if (channel) ws.send(JSON.stringify({ channel }));
   };
-  ws.onmessage = async (ev) => {
-    try {
-      await draw(JSON.parse(ev.data));
-    } catch (err) {
-      console.error("radar view: draw failed", err);
-    }
-    // acknowledge after the browser has painted: the server then sends the newest frame
-    requestAnimationFrame(() => {
-      if (ws.readyState === WebSocket.OPEN) {
-        ws.send(JSON.stringify({ ack: state.lastSeq, draw_fps: state.drawFps }));
-      }
-    });
+  ws.onmessage = (ev) => {
+    pending = JSON.parse(ev.data);  // a message not yet drawn is replaced: newest wins
+    if (!drawing) drawLoop();
   };
   ws.onclose = () => {
     state.connected = false;
