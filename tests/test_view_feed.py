@@ -181,11 +181,11 @@ def test_pool_max_keeps_single_cell_peak():
 
 def test_heatmap_quantisation_round_trip():
     p = np.full((CFG.n_range, CFG.n_doppler), 100.0)
-    p[10, 0] = 1e7  # Doppler bin 0 -> the centre column after the shift
+    p[10, 1] = 1e7  # Doppler bin 1 -> shifted column n/2 + 1 -> pooled column n/4
     m = heatmap(p, CFG)
     q = np.frombuffer(base64.b64decode(m["q"]), np.uint8).reshape(m["rows"], m["cols"])
     assert (m["rows"], m["cols"]) == (CFG.n_range, MAX_AXIS)
-    assert q.max() == 255 and q[10, MAX_AXIS // 2] == 255
+    assert q.max() == 255 and q[10, MAX_AXIS // 2] == 255, "a one-cell peak survives"
     assert m["hi"] == pytest.approx(70.0) and m["lo"] == pytest.approx(15.0)
     assert m["velocity_mps"][0] < 0 < m["velocity_mps"][-1]
 
