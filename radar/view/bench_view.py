@@ -11,7 +11,8 @@ rate an idle machine reaches is about 1000 / draw ms; the load average is printe
 machine is shared. ``--duration 600`` is the 10-minute run of the issue.
 
     python -m radar.view.bench_view [--duration 20] [--presets paper-fpga full]
-                                    [--screenshot docs/img/radar_view.png]
+                                    [--screenshot docs/img/radar_view.png] [--gnn]
+                                    [--capture out/table1_paper-fpga.dmacap]
 """
 
 from __future__ import annotations
@@ -58,10 +59,10 @@ def make_capture(preset: str, path: Path, frames: int = 4, packet_words: int = 1
 
 
 def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
-        gnn: bool) -> dict[str, float]:
+        gnn: bool, capture: Path | None = None) -> dict[str, float]:
     from playwright.sync_api import sync_playwright
 
-    cap = make_capture(preset, folder / f"{preset}.dmacap")
+    cap = capture or make_capture(preset, folder / f"{preset}.dmacap")
     args = ["--replay", str(cap), "--fps", str(FEED_FPS[preset])] + (["--gnn"] if gnn else [])
     view = start_view(args, timeout_s=120)
     try:
@@ -108,6 +109,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--screenshot", type=Path, default=None,
                    help="save a screenshot of the first preset's page here (.png)")
     p.add_argument("--gnn", action="store_true", help="run the GNN too (boxes on the page)")
+    p.add_argument("--capture", type=Path, default=None,
+                   help="replay this capture for the first preset instead of making one")
     args = p.parse_args(argv)
     reason = chromium_missing_reason()
     if reason:
@@ -117,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for i, preset in enumerate(args.presets):
             r = run(preset, args.duration, Path(tmp), args.screenshot if i == 0 else None,
-                    args.gnn)
+                    args.gnn, args.capture if i == 0 else None)
             rows.append((preset, r))
     load = os.getloadavg()[0]
     print(f"radar view in headless chromium, Table I replay, {args.duration:g} s per preset"

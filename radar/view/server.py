@@ -9,7 +9,8 @@ Flow control per browser: at most one message in flight. The server sends the ne
 page's ``{"ack": ...}``, which the page sends when it starts drawing that message (so the next
 one is prepared while it draws; a message that arrives while one is drawn replaces any other
 waiting one). A slow or stalled browser therefore only ever skips frames (newest wins);
-nothing queues up on the host or in the page, and other browsers are not held back. A browser that reconnects is simply a new client.
+nothing queues up on the host or in the page, and other browsers are not held back. A
+browser that reconnects is simply a new client.
 """
 
 from __future__ import annotations
