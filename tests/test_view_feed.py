@@ -151,6 +151,29 @@ def test_processor_drops_to_newest():
     assert health.snapshot()["frames_not_shown"] == 2
 
 
+def test_processing_follows_browser_demand():
+    """With a server (demand_driven), a cube is processed only once a browser asks."""
+    health, feed = LinkHealth(), Feed()
+    feed.demand_driven = True
+    proc = Processor(CFG, feed, health)
+    stop = threading.Event()
+    t = threading.Thread(target=proc.run, args=(stop,))
+    t.start()
+    try:
+        proc.submit(0, _cube(0) / 64)
+        threading.Event().wait(0.6)
+        assert feed.latest() is None
+        feed.want()
+        for _ in range(200):
+            if feed.latest() is not None:
+                break
+            threading.Event().wait(0.05)
+        assert feed.latest() is not None and feed.latest().frame_id == 0
+    finally:
+        stop.set()
+        t.join()
+
+
 def test_bad_cube_is_reported_not_raised():
     health, feed = LinkHealth(), Feed()
     proc = Processor(CFG, feed, health)

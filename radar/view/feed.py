@@ -53,6 +53,24 @@ class Feed:
         self._latest: ViewFrame | None = None
         self._seq = 0
         self.on_publish: Callable[[], None] | None = None
+        self.demand_driven = False
+        self._wanted = threading.Event()
+
+    def want(self) -> None:
+        """A browser is ready for a new frame (any thread)."""
+        self._wanted.set()
+
+    def wait_wanted(self, timeout_s: float) -> bool:
+        """Whether a new frame should be produced: always, unless ``demand_driven`` (set by
+        the server), then only once some browser asked for one since the producer last
+        started on a frame. The
+        host then processes frames no faster than the browsers draw them, and the CPU it
+        saves goes to the browser."""
+        return not self.demand_driven or self._wanted.wait(timeout_s)
+
+    def taken(self) -> None:
+        """The producer started on a frame: later requests ask for the one after it."""
+        self._wanted.clear()
 
     def next_seq(self) -> int:
         with self._lock:

@@ -137,6 +137,7 @@ class ViewServer:
         loop = asyncio.get_running_loop()
         while not ws.closed:
             await client.credit.wait()
+            self.feed.want()
             with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(client.wake.wait(), HEALTH_PERIOD_S)
             client.wake.clear()
@@ -163,6 +164,7 @@ class ViewServer:
     async def start(self) -> None:
         """Bind and serve on the running loop; :attr:`port` is the bound port."""
         self._loop = asyncio.get_running_loop()
+        self.feed.demand_driven = True
         self.feed.on_publish = lambda: self._loop.call_soon_threadsafe(  # type: ignore[union-attr]
             self._wake_all)
         self._runner = web.AppRunner(self._app(), access_log=None, handle_signals=False)
@@ -175,6 +177,7 @@ class ViewServer:
 
     async def close(self) -> None:
         self.feed.on_publish = None
+        self.feed.demand_driven = False
         if self._runner is not None:
             await self._runner.cleanup()
 

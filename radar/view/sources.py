@@ -79,6 +79,8 @@ class Processor:
 
     def run(self, stop: threading.Event) -> None:
         while not stop.is_set():
+            if not self.feed.wait_wanted(0.2):
+                continue
             with self._cond:
                 if self._slot is None:
                     self._cond.wait(0.2)
@@ -86,6 +88,7 @@ class Processor:
                     continue
                 (frame_id, cube, scale), self._slot = self._slot, None
                 skipped, self._skipped = self._skipped, 0
+            self.feed.taken()
             try:
                 if scale != 1.0:
                     cube *= np.float32(scale) if cube.dtype == np.complex64 else scale
