@@ -96,7 +96,7 @@ $(VIEW_CAPTURE): | $(STAMP)
 	$(RUN) radar capture --scene table1 --preset paper-fpga --frames 8 --out $@
 
 view: $(STAMP) $(VIEW_CAPTURE)
-	$(RUN) python -m radar.view --replay $(VIEW_CAPTURE) --gnn
+	$(RUN) python -m radar.view --replay $(VIEW_CAPTURE) --gnn --ego-speed 27.78
 
 bench-view: $(STAMP)
 	$(RUN) python -m radar.view.bench_view

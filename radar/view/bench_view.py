@@ -63,7 +63,8 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
     from playwright.sync_api import sync_playwright
 
     cap = capture or make_capture(preset, folder / f"{preset}.dmacap")
-    args = ["--replay", str(cap), "--fps", str(FEED_FPS[preset])] + (["--gnn"] if gnn else [])
+    args = ["--replay", str(cap), "--fps", str(FEED_FPS[preset])] + (
+        ["--gnn", "--ego-speed", "27.78"] if gnn else [])
     view = start_view(args, timeout_s=120)
     try:
         with sync_playwright() as pw:

@@ -101,8 +101,9 @@ def build(args: argparse.Namespace, stop: threading.Event
             desc = f"UDP {args.udp_host}:{args.udp_port}"
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
+    # the Table I scene's ego speed for its simulation; a capture or a link does not say
     ego = args.ego_speed if args.ego_speed is not None else (
-        EGO_SPEED_KMH / 3.6 if (args.scene == "table1" or "table1" in desc) else 0.0)
+        EGO_SPEED_KMH / 3.6 if args.scene and scene.name == "table1" else 0.0)
     processor = Processor(cfg, feed, health, _params(args), _gnn(args), ego, source=desc)
     threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
                                 daemon=True)]
@@ -218,7 +219,8 @@ def add_view_parser(sub: Any) -> argparse.ArgumentParser:
     v.add_argument("--gnn", action="store_true",
                    help="classify objects with the GNN (shipped checkpoint), draw boxes")
     v.add_argument("--ego-speed", type=float, default=None,
-                   help="ego speed for the GNN, m/s (default 27.78 for table1, else 0)")
+                   help="ego speed along +x for the GNN's velocity compensation, m/s "
+                        "(default: 27.78 for --scene table1, else 0)")
     v.add_argument("--duration", type=float, default=None,
                    help="stop after this many seconds (default: run until Ctrl-C)")
     _add_detection_options(v)
