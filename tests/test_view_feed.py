@@ -14,7 +14,8 @@ from host.capture import frame_packets
 from host.pointcloud import PointCloud
 from host.stream import StreamDecoder
 from model.config import get_preset
-from model.reference import range_doppler_power
+from model.packetizer import cube_to_payload, packetize, words_to_bytes
+from model.reference import cube_to_dma_order, range_doppler_power
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth, missing_packets
 from radar.view.render import MAX_AXIS, box_outline, frame_message, heatmap, pool_max
@@ -113,6 +114,22 @@ def test_reordered_frame_is_not_lost(frames):
             ingest.push(p)
     ingest.idle()
     assert health.snapshot()["frames_lost"] == 0
+
+
+def test_sticky_hardware_flags_stay_set(frames):
+    """The packetizer's OVERFLOW flag in one frame's headers stays shown afterwards, also
+    across a sender restart."""
+    ingest, health, _ = _ingest()
+    words = cube_to_payload(cube_to_dma_order(_cube(9), CFG))
+    flagged = [words_to_bytes(p) for p in packetize(words, PACKET_WORDS, 0, overflow=True)]
+    for p in flagged + frames[1]:
+        ingest.push(p)
+    ingest.restart()
+    for p in frames[0]:
+        ingest.push(p)
+    s = health.snapshot()
+    assert s["hw_overflow"] and not s["hw_framing"]
+    assert any("OVERFLOW" in p for p in s["problems"])
 
 
 def test_missing_packets_counts_per_packet(frames):
