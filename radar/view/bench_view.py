@@ -98,7 +98,8 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
             "not_shown": h1["frames_not_shown"] - h0["frames_not_shown"],
             "rss0": rss[0] / 1024, "rss1": rss[-1] / 1024, "rss_max": max(rss) / 1024,
             "heap0": heap0 / 2**20, "heap1": heap1 / 2**20, "seconds": dt,
-            "draw_ms": sum(state1["ms"].values())}
+            "draw_ms": sum(state1["ms"].values()),
+            "rss_trace": [rss[round(i * (len(rss) - 1) / 5)] / 1024 for i in range(6)]}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -137,6 +138,9 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['draw_ms']:>8.0f}"
               f"{r['rss0']:>10.0f}{r['rss1']:>7.0f}{r['rss_max']:>8.0f}"
               f"{r['heap0']:>6.1f}->{r['heap1']:<5.1f}")
+    for preset, r in rows:
+        trace = " ".join(f"{v:.0f}" for v in r["rss_trace"])
+        print(f"{preset}: view RSS MiB at 0, 20, ..., 100 % of the run: {trace}")
     return 0
 
 
