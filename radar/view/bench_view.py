@@ -23,6 +23,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +59,12 @@ def make_capture(preset: str, path: Path, frames: int = 4, packet_words: int = 1
     return path
 
 
+def _thread_time_s(cdp: Any) -> float:
+    """CPU time of the page's main thread so far, s (Chrome DevTools ``ThreadTime``)."""
+    metrics = cdp.send("Performance.getMetrics")["metrics"]
+    return float(next(m["value"] for m in metrics if m["name"] == "ThreadTime"))
+
+
 def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
         gnn: bool, capture: Path | None = None) -> dict[str, float]:
     from playwright.sync_api import sync_playwright
@@ -72,9 +79,12 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
             page = ctx.new_page()
             page.goto(view.url)
             page.wait_for_function("window.radarView.frames >= 3", timeout=120_000)
+            cdp = ctx.new_cdp_session(page)
+            cdp.send("Performance.enable")
             time.sleep(1.0)
             state0 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
                                    "h: window.radarView.lastHealth})")
+            thread0, cpu0 = _thread_time_s(cdp), view.cpu_s()
             rss = [view.rss_kib()]
             heap0 = page.evaluate("performance.memory.usedJSHeapSize")
             t_end = time.monotonic() + duration_s
@@ -84,6 +94,7 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
             state1 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
                                    "h: window.radarView.lastHealth, ms: window.radarView.drawMs})")
             heap1 = page.evaluate("performance.memory.usedJSHeapSize")
+            thread1, cpu1 = _thread_time_s(cdp), view.cpu_s()
             if screenshot is not None:
                 screenshot.parent.mkdir(parents=True, exist_ok=True)
                 page.screenshot(path=str(screenshot))
@@ -94,7 +105,10 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
     h0, h1 = state0["h"], state1["h"]
     decoded = (h1["frames_complete"] + h1["frames_damaged"]
                - h0["frames_complete"] - h0["frames_damaged"])
+    drawn = max(1, state1["f"] - state0["f"])
     return {"decoded_fps": decoded / dt, "display_fps": (state1["f"] - state0["f"]) / dt,
+            "page_cpu_ms": 1e3 * (thread1 - thread0) / drawn,
+            "host_cpu_ms": 1e3 * (cpu1 - cpu0) / max(1, decoded),
             "not_shown": h1["frames_not_shown"] - h0["frames_not_shown"],
             "rss0": rss[0] / 1024, "rss1": rss[-1] / 1024, "rss_max": max(rss) / 1024,
             "heap0": heap0 / 2**20, "heap1": heap1 / 2**20, "seconds": dt,
@@ -138,6 +152,13 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['draw_ms']:>8.0f}"
               f"{r['rss0']:>10.0f}{r['rss1']:>7.0f}{r['rss_max']:>8.0f}"
               f"{r['heap0']:>6.1f}->{r['heap1']:<5.1f}")
+    print("CPU time per update (what an unloaded machine could reach: 1000 / ms per s)")
+    print(f"{'preset':<11}{'page main thread ms/update':>28}{'view process ms/frame':>23}"
+          f"{'page-bound /s':>15}{'host-bound /s':>15}")
+    for preset, r in rows:
+        print(f"{preset:<11}{r['page_cpu_ms']:>28.1f}{r['host_cpu_ms']:>23.1f}"
+              f"{1e3 / max(r['page_cpu_ms'], 1e-3):>15.1f}"
+              f"{1e3 / max(r['host_cpu_ms'], 1e-3):>15.1f}")
     for preset, r in rows:
         trace = " ".join(f"{v:.0f}" for v in r["rss_trace"])
         print(f"{preset}: view RSS MiB at 0, 20, ..., 100 % of the run: {trace}")

@@ -66,6 +66,11 @@ class ViewProcess:
                 return int(line.split()[1])
         return 0
 
+    def cpu_s(self) -> float:
+        """User + system CPU time of the process so far, s (Linux /proc)."""
+        fields = Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
     def stop(self) -> None:
         self.proc.terminate()
         try:
