@@ -9,6 +9,10 @@ const state = window.radarView = {
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };
 const MARGIN = { l: 55, r: 10, t: 30, b: 40 };
+// Fixed tick layout: plotly then skips measuring tick labels for overflow and auto-angles,
+// a large share of each redraw's time.
+const AXIS = { ticklabeloverflow: "allow", tickangle: 0, automargin: false };
+function axis(title, extra) { return { ...AXIS, title: { text: title }, ...extra }; }
 const HEALTH_KEYS = ["frames_per_s", "frames_complete", "frames_damaged", "frames_lost",
   "frames_not_shown", "packets_lost", "malformed", "late_packets", "datagrams",
   "stream_restarts", "hw_overflow", "hw_framing", "detections", "objects"];
@@ -34,12 +38,11 @@ function heatmap(div, m, title) {
   if (!m) { Plotly.purge(div); return Promise.resolve(); }
   return Plotly.react(div, [{
     type: "heatmap", z: decodeMap(m), x: m.velocity_mps, y: m.range_m,
-    zmin: m.lo, zmax: m.hi, colorscale: "Viridis", colorbar: { title: { text: "dB" } },
+    zmin: m.lo, zmax: m.hi, colorscale: "Viridis", colorbar: { title: { text: "dB" }, ticklabeloverflow: "allow" },
     hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>%{z:.1f} dB<extra></extra>",
   }], {
     title: { text: title, font: { size: 13 } }, margin: MARGIN, uirevision: div,
-    xaxis: { title: { text: "radial velocity (m/s)" } },
-    yaxis: { title: { text: "range (m)" } },
+    xaxis: axis("radial velocity (m/s)"), yaxis: axis("range (m)"),
   }, CONFIG);
 }
 
@@ -50,7 +53,7 @@ function pointCloud(div, msg) {
     type: "scatter", mode: "markers", x: p.y, y: p.x, name: "points",
     marker: { size: 8, color: p.v, cmin: -vmax, cmax: vmax, colorscale: "Jet",
               line: { width: 1, color: "#222" },
-              colorbar: { title: { text: "m/s" } } },
+              colorbar: { title: { text: "m/s" }, ticklabeloverflow: "allow" } },
     text: p.snr.map((s, i) => `v ${p.v[i]} m/s, SNR ${s} dB`),
     hovertemplate: "x %{y:.1f} m, y %{x:.1f} m<br>%{text}<extra></extra>",
   }];
@@ -68,8 +71,8 @@ function pointCloud(div, msg) {
   return Plotly.react(div, traces, {
     title: { text: "point cloud, coloured by radial velocity; GNN objects", font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "cloud",
-    xaxis: { title: { text: "y (m, left +)" }, range: [r / 2, -r / 2] },
-    yaxis: { title: { text: "x (m, forward)" }, range: [0, r] },
+    xaxis: axis("y (m, left +)", { range: [r / 2, -r / 2] }),
+    yaxis: axis("x (m, forward)", { range: [0, r] }),
   }, CONFIG);
 }
 
@@ -83,7 +86,7 @@ function profile(div, msg) {
   ], {
     title: { text: "range profile (all channels, all Doppler bins)", font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "profile",
-    xaxis: { title: { text: "range (m)" } }, yaxis: { title: { text: "power (dB)" } },
+    xaxis: axis("range (m)"), yaxis: axis("power (dB)"),
   }, CONFIG);
 }
 
