@@ -1,5 +1,5 @@
 """Single source of the FFT coefficient ROMs shared by the RTL (``rtl/fft/fft_rom_pkg.sv``)
-and the bit-accurate model (:mod:`model.fft_fixed`).
+and the bit-accurate model (:mod:`model.fft_axis`).
 
 Two tables of ``ROM_SIZE = 4096`` entries cover every transform length N = 16..4096:
 

@@ -2,10 +2,10 @@
 the block models: ADC frame in, DMA packets out, identical to the RTL for loss-free input.
 
     chirp ping-pong (pass-through when nothing is dropped)
-    -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_fixed
+    -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_axis
     -> corner turn (chirp order -> Doppler vectors)                      model.corner_turn
-    -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_fixed
-    -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.packetizer
+    -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
+    -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.axis_packetizer
 
 Scaling: the range FFT keeps the IP's default 1/N (a full-scale ADC tone cannot overflow);
 the Doppler FFT divides only every other radix-2 stage (``0x555``: 1/sqrt(N) for even
@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from model.axis_packetizer import check_geometry, cube_to_payload, packetize
 from model.config import RadarConfig
 from model.corner_turn import corner_turn
-from model.fft_fixed import fft_fixed
-from model.packetizer import check_geometry, cube_to_payload, packetize
+from model.fft_axis import fft_fixed
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -103,6 +103,15 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
                     scale_sch=params.doppler_scale_sch)
     payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
     return ChainOutput(payload, int(rng.overflow.sum()), int(dop.overflow.sum()))
+
+
+def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
+                ) -> np.ndarray:
+    """The chain's cube as the host works with it: complex64 (n_virtual, n_range, n_doppler)
+    divided by :func:`chain_gain` (units of the float reference), identical to the cube
+    decoded from the DMA stream."""
+    params = params or PipelineParams()
+    return run_chain(adc, cfg, params).cube().astype(np.complex64) / chain_gain(cfg, params)
 
 
 def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,
