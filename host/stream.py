@@ -44,7 +44,7 @@ def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
     cube = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.complex64)
     cube.real = iq[..., 0]  # I: low half of the word (little-endian)
     cube.imag = iq[..., 1]  # Q: high half
-    return cube.reshape(cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    return cube.reshape(cfg.cube_shape)
 
 
 @dataclass

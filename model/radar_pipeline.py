@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.axis_packetizer import check_geometry, cube_to_payload, packetize
-from model.config import RadarConfig
+from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
 from model.fft_axis import fft_fixed
 
@@ -49,6 +49,14 @@ class PipelineParams:
     def frame_words(self, cfg: RadarConfig) -> int:
         """Payload words per frame, num_tx * n_range * n_doppler."""
         return cfg.num_tx * cfg.n_range * cfg.n_doppler
+
+    def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
+        """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
+        (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
+        schedules and HEADER)."""
+        return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
+                              RANGE_SCALE_SCH=self.range_scale_sch,
+                              DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header))
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a combination the RTL refuses at elaboration."""
@@ -90,10 +98,7 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
               ) -> ChainOutput:
     """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube."""
     params = params or PipelineParams()
-    expected = (cfg.n_chirps, cfg.num_rx, cfg.n_range)
-    if adc.shape != expected:
-        raise ValueError(f"adc: expected shape {expected} (chirps, rx, samples), got "
-                         f"{adc.shape}")
+    cfg.check_adc(adc)
     # range FFT, one transform per chirp, lanes = RX
     rng = fft_fixed(np.transpose(adc, (0, 2, 1)), window=params.window,
                     scale_sch=params.range_scale_sch)

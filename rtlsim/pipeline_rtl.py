@@ -22,14 +22,6 @@ from rtlsim.toolchain import build_and_test, rtl_sources
 PIPELINE_SOURCES = ("fft/*.sv", "buffers/*.sv", "top/*.sv")
 
 
-def hdl_parameters(cfg: RadarConfig, chain: PipelineParams) -> dict[str, int]:
-    """``radar_pipeline`` HDL parameters for a radar configuration and chain settings."""
-    return {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
-            "N_DOPPLER": cfg.n_doppler, "DATA_W": 16, "PACKET_WORDS": chain.packet_words,
-            "WINDOW": int(chain.window), "RANGE_SCALE_SCH": chain.range_scale_sch,
-            "DOPPLER_SCALE_SCH": chain.doppler_scale_sch, "HEADER": int(chain.header)}
-
-
 def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
                      chain: PipelineParams | None = None) -> tuple[list[bytes], dict[str, int]]:
     """Stream ``adc_frames`` (each complex (n_chirps, num_rx, n_range)) through the RTL.
@@ -41,7 +33,7 @@ def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
         d = Path(tmp)
         np.save(d / "adc.npy", np.stack(adc_frames).astype(np.complex64))
         build_and_test("radar_pipeline", rtl_sources(*PIPELINE_SOURCES),
-                       "rtlsim.pipeline_test", hdl_parameters(cfg, chain),
+                       "rtlsim.pipeline_test", chain.hdl_parameters(cfg),
                        extra_env={"RADAR_RTL_ADC": str(d / "adc.npy"),
                                   "RADAR_RTL_DMA": str(d / "dma.npz"),
                                   "RADAR_RTL_STATUS": str(d / "status.json")},

@@ -26,7 +26,7 @@ from test_radar_pipeline import CONFIGS  # noqa: E402
 from model.axis_packetizer import packets_per_frame  # noqa: E402
 from model.config import get_preset  # noqa: E402
 from model.radar_pipeline import PipelineParams  # noqa: E402
-from rtlsim.pipeline_rtl import PIPELINE_SOURCES, hdl_parameters  # noqa: E402
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES  # noqa: E402
 from rtlsim.toolchain import rtl_sources, run_cocotb  # noqa: E402
 
 CLOCK_HZ = 100e6
@@ -39,7 +39,7 @@ def measure(name: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.json"
         run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES), "test_radar_pipeline",
-                   HERE, hdl_parameters(cfg, chain),
+                   HERE, chain.hdl_parameters(cfg),
                    extra_env={"RP_BENCH_JSON": str(out)}, testcase="throughput_latency")
         return json.loads(out.read_text())
 

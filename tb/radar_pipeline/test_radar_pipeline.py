@@ -35,7 +35,7 @@ from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_frame, simulate_scene
 from rtlsim.axis import random_pause
 from rtlsim.pipeline import PipelineTB
-from rtlsim.pipeline_rtl import PIPELINE_SOURCES, hdl_parameters
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import rtl_sources, run_cocotb
 
 SMALL4 = RadarConfig(name="small4", num_tx=4, num_rx=4, n_range=32, n_doppler=32,
@@ -274,7 +274,7 @@ async def throughput_latency(dut) -> None:
 def test_radar_pipeline(name: str, tmp_path: Path) -> None:
     cfg, chain = CONFIGS[name]
     run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES), "test_radar_pipeline",
-               Path(__file__).parent, hdl_parameters(cfg, chain),
+               Path(__file__).parent, chain.hdl_parameters(cfg),
                extra_env={"SEED": os.environ.get("SEED", "1")})
     if name == "paper-fpga":
         # `radar detect --backend rtl` (same build folder, so run here, after the build)
