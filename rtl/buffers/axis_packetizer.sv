@@ -307,24 +307,13 @@ module axis_packetizer #(
   assign frame_count          = frame_cnt_q;
   assign packet_count         = packet_cnt_q;
 
-`ifndef SYNTHESIS
-  // AXI4-Stream source rules: TVALID/TDATA/TLAST held while stalled.
-  logic             m_stall_q;
-  logic [WORD_W:0]  m_held_q;
-  always_ff @(posedge clk) begin
-    if (rst) begin
-      m_stall_q <= 1'b0;
-    end else begin
-      m_stall_q <= m_axis_tvalid && !m_axis_tready;
-      if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("axis_packetizer: TVALID dropped while stalled");
-        assert ({m_axis_tlast, m_axis_tdata} == m_held_q)
-          else $error("axis_packetizer: TDATA/TLAST changed while stalled");
-      end
-    end
-    m_held_q <= {m_axis_tlast, m_axis_tdata};
-  end
-`endif
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(NUM_RX*32 + 2), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tuser, s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(NUM_RX*32 + 1)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tlast, m_axis_tdata}));
 
 endmodule
 

@@ -36,7 +36,6 @@ module fft_sdf_bf #(
   output logic [LOG2N-1:0]      out_pos,
   output logic                  out_ov
 );
-  import fft_pkg::*;
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int MW = DW + LOG2N + 1;         // delay line word: data, index, overflow
@@ -106,16 +105,16 @@ module fft_sdf_bf #(
           {xr, xi} = {xi, -xr};
         end
       end
-      sr = round_conv(ar + xr, SCALE ? 1 : 0);
-      si = round_conv(ai + xi, SCALE ? 1 : 0);
-      dr = round_conv(ar - xr, SCALE ? 1 : 0);
-      di = round_conv(ai - xi, SCALE ? 1 : 0);
-      sum_ov = sum_ov | sat_ov(sr, W) | sat_ov(si, W);
-      dif_ov = dif_ov | sat_ov(dr, W) | sat_ov(di, W);
-      sum_data[ch*2*W +: W]     = W'(sat_val(sr, W));
-      sum_data[ch*2*W + W +: W] = W'(sat_val(si, W));
-      dif_data[ch*2*W +: W]     = W'(sat_val(dr, W));
-      dif_data[ch*2*W + W +: W] = W'(sat_val(di, W));
+      sr = fft_pkg::round_conv(ar + xr, SCALE ? 1 : 0);
+      si = fft_pkg::round_conv(ai + xi, SCALE ? 1 : 0);
+      dr = fft_pkg::round_conv(ar - xr, SCALE ? 1 : 0);
+      di = fft_pkg::round_conv(ai - xi, SCALE ? 1 : 0);
+      sum_ov = sum_ov | fft_pkg::sat_ov(sr, W) | fft_pkg::sat_ov(si, W);
+      dif_ov = dif_ov | fft_pkg::sat_ov(dr, W) | fft_pkg::sat_ov(di, W);
+      sum_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(sr, W));
+      sum_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(si, W));
+      dif_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(dr, W));
+      dif_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(di, W));
     end
   end
 

@@ -158,20 +158,13 @@ module frame_align #(
   assign chirps_filled    = fill_cnt_q;
   assign chirps_discarded = disc_cnt_q;
 
-`ifndef SYNTHESIS
-  // AXI4-Stream: TVALID held and data stable while stalled (output side)
-  logic             v_q;
-  logic [WORD_W:0]  d_q;
-  always_ff @(posedge clk) begin
-    v_q <= m_axis_tvalid && !m_axis_tready && !rst;
-    d_q <= {m_axis_tlast, m_axis_tdata};
-    if (v_q && !rst) begin  // the AXI rules do not hold across a reset
-      assert (m_axis_tvalid) else $error("frame_align: TVALID dropped while stalled");
-      assert ({m_axis_tlast, m_axis_tdata} == d_q)
-        else $error("frame_align: data changed while stalled");
-    end
-  end
-`endif
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(WORD_W + 3), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tuser, s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(WORD_W + 1)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tlast, m_axis_tdata}));
 
 endmodule
 
