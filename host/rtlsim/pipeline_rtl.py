@@ -18,7 +18,7 @@ from host.rtlsim.toolchain import build_and_test, rtl_sources
 from model.config import RadarConfig
 from model.pipeline import PipelineParams
 
-PIPELINE_SOURCES = ("fft/*.sv", "buffers/*.sv", "top/*.sv")
+PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "top/*.sv")
 
 
 def hdl_parameters(cfg: RadarConfig, chain: PipelineParams) -> dict[str, int]:

@@ -49,14 +49,14 @@ module chirp_pingpong #(
   localparam int POS_W  = $clog2(N_RANGE);
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_0
-    $fatal(1, "chirp_pingpong: NUM_RX=%0d not in 1..64", NUM_RX);
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
-  if (N_RANGE < 2 || N_RANGE > 65536) begin : g_bad_param_1
-    $fatal(1, "chirp_pingpong: N_RANGE=%0d not in 2..65536", N_RANGE);
+  if (N_RANGE < 2 || N_RANGE > 65536) begin : g_bad_n_range
+    $fatal(1, "%m: N_RANGE=%0d not in 2..65536", N_RANGE);
   end
-  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_param_2
-    $fatal(1, "chirp_pingpong: DATA_W=%0d not in 8..32", DATA_W);
+  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
   end
 
   // ---------------------------------------------------------------------------------------

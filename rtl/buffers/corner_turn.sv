@@ -55,23 +55,23 @@ module corner_turn #(
   localparam int SH_W   = $clog2(B);
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_param_0
-    $fatal(1, "corner_turn: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_num_tx
+    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
   end
-  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_1
-    $fatal(1, "corner_turn: NUM_RX=%0d not in 1..64", NUM_RX);
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
-  if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_param_2
-    $fatal(1, "corner_turn: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
+  if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
   end
-  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_param_3
-    $fatal(1, "corner_turn: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
+  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
   end
-  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_param_4
-    $fatal(1, "corner_turn: DATA_W=%0d not in 8..32", DATA_W);
+  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
   end
-  if (B > 24) begin : g_bad_param_5
-    $fatal(1, "corner_turn: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
+  if (B > 24) begin : g_bad_frame_words
+    $fatal(1, "%m: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
   end
 
   // rotl(x, s) on B bits, 0 <= s < B

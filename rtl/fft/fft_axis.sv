@@ -49,16 +49,16 @@ module fft_axis #(
 
   // ---------------------------------------------------------------- parameter checks
   if (N < 16 || N > 4096 || (1 << LOG2N) != N) begin : g_bad_n
-    $fatal(1, "fft_axis: parameter N=%0d must be a power of two in 16..4096", N);
+    $fatal(1, "%m: N=%0d must be a power of two in 16..4096", N);
   end
-  if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_ch
-    $fatal(1, "fft_axis: parameter NUM_CH=%0d must be in 1..16", NUM_CH);
+  if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_num_ch
+    $fatal(1, "%m: NUM_CH=%0d must be in 1..16", NUM_CH);
   end
-  if (DATA_W < 8 || DATA_W > 24) begin : g_bad_dw
-    $fatal(1, "fft_axis: parameter DATA_W=%0d must be in 8..24", DATA_W);
+  if (DATA_W < 8 || DATA_W > 24) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d must be in 8..24", DATA_W);
   end
-  if (GUARD_W < 0 || GUARD_W > 16 || W > 27) begin : g_bad_gw
-    $fatal(1, "fft_axis: parameter GUARD_W=%0d needs 0..16 and DATA_W+1+GUARD_W <= 27",
+  if (GUARD_W < 0 || GUARD_W > 16 || W > 27) begin : g_bad_guard_w
+    $fatal(1, "%m: GUARD_W=%0d needs 0..16 and DATA_W+1+GUARD_W <= 27",
            GUARD_W);
   end
 
@@ -183,8 +183,8 @@ module fft_axis #(
   fft_reorder #(.N(N), .WIDTH(ODW + 1)) u_reorder (
     .clk, .rst,
     .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
-    .m_data(m_word), .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),
-    .m_last(m_axis_tlast), .m_user(m_axis_tuser)
+    .m_axis_tdata(m_word), .m_axis_tvalid(m_axis_tvalid), .m_axis_tready(m_axis_tready),
+    .m_axis_tlast(m_axis_tlast), .m_axis_tuser(m_axis_tuser)
   );
   assign m_axis_tdata = m_word[ODW-1:0];
 

@@ -43,10 +43,10 @@ module fft_sdf_bf #(
   localparam int PW = (D > 1) ? $clog2(D) : 1;
 
   if (D < 1 || (1 << DB) != D || DB >= LOG2N) begin : g_bad_d
-    $fatal(1, "fft_sdf_bf: D=%0d must be a power of two below 2^LOG2N", D);
+    $fatal(1, "%m: D=%0d must be a power of two below 2^LOG2N", D);
   end
-  if (ROTATE && DB + 1 >= LOG2N) begin : g_bad_rot
-    $fatal(1, "fft_sdf_bf: ROTATE needs D <= 2^(LOG2N-2) (D=%0d)", D);
+  if (ROTATE && DB + 1 >= LOG2N) begin : g_bad_rotate
+    $fatal(1, "%m: ROTATE needs D <= 2^(LOG2N-2) (D=%0d)", D);
   end
 
   // ---------------------------------------------------------------- delay line (FIFO of D)

@@ -40,8 +40,8 @@ module fft_twiddle #(
   localparam int DW = NUM_CH * 2 * W;
   localparam int PRW = W + COEF_W;   // product width
 
-  if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad
-    $fatal(1, "fft_twiddle: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
+  if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad_log2m
+    $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
   end
 
   // ---------------------------------------------------------------- ROM index from the tag

@@ -38,8 +38,8 @@ module fft_window #(
 
   localparam int DW = NUM_CH * 2 * W;
 
-  if (W < DATA_W + GUARD_W || GUARD_W > COEF_FRAC || LOG2N > ROM_LOG2) begin : g_bad
-    $fatal(1, "fft_window: need W >= DATA_W+GUARD_W, GUARD_W <= 16 (GUARD_W=%0d)", GUARD_W);
+  if (W < DATA_W + GUARD_W || GUARD_W > COEF_FRAC || LOG2N > ROM_LOG2) begin : g_bad_guard_w
+    $fatal(1, "%m: need W >= DATA_W+GUARD_W, GUARD_W <= 16 (GUARD_W=%0d)", GUARD_W);
   end
 
   if (WINDOW) begin : g_win

@@ -52,13 +52,13 @@ module frame_align #(
   localparam int CHP_W  = (FRAME_CHIRPS > 1) ? $clog2(FRAME_CHIRPS) : 1;
 
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
-    $fatal(1, "frame_align: NUM_RX=%0d not in 1..64", NUM_RX);
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
   if (N_RANGE < 2 || N_RANGE > 65536) begin : g_bad_n_range
-    $fatal(1, "frame_align: N_RANGE=%0d not in 2..65536", N_RANGE);
+    $fatal(1, "%m: N_RANGE=%0d not in 2..65536", N_RANGE);
   end
   if (FRAME_CHIRPS < 1 || FRAME_CHIRPS > (1 << 24)) begin : g_bad_frame_chirps
-    $fatal(1, "frame_align: FRAME_CHIRPS=%0d not in 1..2^24", FRAME_CHIRPS);
+    $fatal(1, "%m: FRAME_CHIRPS=%0d not in 1..2^24", FRAME_CHIRPS);
   end
 
   typedef enum logic [1:0] {PASS, FILL, DISCARD} state_t;
