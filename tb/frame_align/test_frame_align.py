@@ -179,5 +179,6 @@ PARAMS = [dict(NUM_RX=2, DATA_W=16, N_RANGE=4, FRAME_CHIRPS=6),
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: f"rx{p['NUM_RX']}_n{p['N_RANGE']}")
 def test_frame_align(parameters: dict) -> None:
-    run_cocotb("frame_align", rtl_sources("common/*.sv", "buffers/frame_align.sv"), "test_frame_align",
+    run_cocotb("frame_align", rtl_sources("common/*.sv", "buffers/frame_align.sv"),
+               "test_frame_align",
                Path(__file__).parent, parameters)
