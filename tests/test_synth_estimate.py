@@ -50,8 +50,8 @@ def test_yosys_reads_every_module(tmp_path: Path) -> None:
     """The plain file list, read as written, elaborates every module from any folder."""
     files = " ".join(os.path.relpath(p, tmp_path) for p in rtl_files())
     tops = [p.stem for p in rtl_files() if not p.stem.endswith("_pkg")]
-    script = "".join(f"design -reset; read_verilog -sv -DSYNTHESIS {files}; "
-                     f"hierarchy -check -top {top};\n" for top in tops)
+    script = f"read_verilog -sv -DSYNTHESIS {files}\ndesign -save all\n" + "".join(
+        f"design -load all; hierarchy -check -top {top}\n" for top in tops)
     (tmp_path / "read.ys").write_text(script)
     proc = subprocess.run([*yosys_command(), "-q", "read.ys"], cwd=tmp_path,
                           capture_output=True, text=True, check=False)
