@@ -10,7 +10,7 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint bench bench-rtl gnn-dataset gnn-train gnn-eval \
+.PHONY: all setup demo test test-python sim lint gen bench bench-rtl gnn-dataset gnn-train gnn-eval \
         clean help
 all: test
 
@@ -20,6 +20,7 @@ help:
 	@echo "make test            whole regression (pytest -n $(JOBS))"
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
+	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
@@ -54,6 +55,11 @@ sim: $(STAMP)
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
 	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth
+
+# Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
+gen: $(STAMP)
+	$(RUN) python -m model.fft_rom
+	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
