@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 from host.capture import read_capture
-from host.cli import main as radar_main
 from host.udp import Impairments, UdpSender
+from radar.cli import main as radar_main
 from radar.view.browser import chromium_missing_reason, launch, start_view
 
 _REASON = chromium_missing_reason()

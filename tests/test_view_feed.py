@@ -13,8 +13,8 @@ import pytest
 from host.capture import frame_packets
 from host.pointcloud import PointCloud
 from host.stream import StreamDecoder
+from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import get_preset
-from model.packetizer import cube_to_payload, packetize, words_to_bytes
 from model.reference import cube_to_dma_order, range_doppler_power
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth, missing_packets

@@ -13,8 +13,8 @@ import pytest
 
 from host.pointcloud import PointCloud
 from model.config import get_preset
-from radar.view.cli import is_loopback
-from radar.view.cli import main as view_main
+from radar.cli import main as radar_main
+from radar.commands.view import is_loopback
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
 from radar.view.server import ViewServer
@@ -107,13 +107,13 @@ def test_server_flow_control_and_assets():
 def test_loopback_only_without_flag(capsys):
     assert is_loopback("127.0.0.1") and is_loopback("::1") and is_loopback("localhost")
     assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.4")
-    assert view_main(["--host", "0.0.0.0", "--scene", "table1"]) == 2
+    assert radar_main(["view", "--host", "0.0.0.0", "--scene", "table1"]) == 2
     assert "--allow-remote" in capsys.readouterr().err
 
 
 def test_bad_replay_file_is_one_line_error(tmp_path, capsys):
     bad = tmp_path / "x.dmacap"
     bad.write_bytes(b"nope")
-    assert view_main(["--replay", str(bad), "--port", "0"]) == 2
+    assert radar_main(["view", "--replay", str(bad), "--port", "0"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("radar view: error:") and err.count("\n") == 1

@@ -10,4 +10,6 @@ Data flow (each stage one module)::
         -> per browser: JSON message (downsampled, quantised)     radar.view.render
         -> aiohttp WebSocket, one frame in flight per browser     radar.view.server
         -> plotly.js page shipped in the package                  radar/view/static/
+
+The command itself (options, wiring of the stages) is :mod:`radar.commands.view`.
 """

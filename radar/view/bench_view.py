@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from host.capture import CaptureInfo, frame_packets, write_capture
-from model.pipeline import PipelineParams, chain_gain
+from model.radar_pipeline import PipelineParams, chain_gain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene

@@ -81,10 +81,10 @@ class ViewProcess:
 
 
 def start_view(args: list[str], timeout_s: float = 60.0) -> ViewProcess:
-    """Start ``python -m radar.view ARGS --port 0`` and wait for its banner line."""
+    """Start ``radar view ARGS --port 0`` and wait for its banner line."""
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     err = tempfile.TemporaryFile("w+")  # noqa: SIM115 - read only when the start fails
-    proc = subprocess.Popen([sys.executable, "-m", "radar.view", *args, "--port", "0"],
+    proc = subprocess.Popen([sys.executable, "-m", "radar.cli", "view", *args, "--port", "0"],
                             stdout=subprocess.PIPE, stderr=err, text=True, env=env)
     deadline = time.monotonic() + timeout_s
     assert proc.stdout is not None

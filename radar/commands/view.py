@@ -1,4 +1,5 @@
-"""``radar view``: serve the live view of a UDP stream, a replayed capture or a scene.
+"""``radar view``: serve the live view (:mod:`radar.view`) of a UDP stream, a replayed
+capture or a scene.
 
     radar view --replay FILE.dmacap [--fps 20] [--loss P]   a capture, looped
     radar view --udp-port P [--preset full]                 what `radar replay`/the board sends
@@ -21,14 +22,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from host.backends import cube_from_adc
 from host.capture import read_capture
-from host.cli import CliError, _add_detection_options, _params
 from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
-from model.pipeline import PipelineParams, chain_gain
+from model.radar_pipeline import PipelineParams, chain_gain
 from model.scene import EGO_SPEED_KMH, load_scene
 from model.simulate import simulate_scene
+from radar.common import CliError, add_detection_options, detection_params
+from radar.sources import get_source
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
 from radar.view.server import ViewServer
@@ -104,16 +105,17 @@ def build(args: argparse.Namespace, stop: threading.Event
     # the Table I scene's ego speed for its simulation; a capture or a link does not say
     ego = args.ego_speed if args.ego_speed is not None else (
         EGO_SPEED_KMH / 3.6 if args.scene and scene.name == "table1" else 0.0)
-    processor = Processor(cfg, feed, health, _params(args), _gnn(args), ego, source=desc)
+    processor = Processor(cfg, feed, health, detection_params(args), _gnn(args), ego, source=desc)
     threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
                                 daemon=True)]
     if args.scene:
         if args.frames < 1:
             raise CliError("--frames: must be >= 1")
 
+        source = get_source(args.backend)
+
         def make_cube(k: int):  # noqa: ANN202 - complex (n_virtual, n_range, n_doppler)
-            return cube_from_adc(simulate_scene(scene, frame_index=k).samples, cfg,
-                                 args.backend)
+            return source.cube(simulate_scene(scene, frame_index=k).samples, cfg)
 
         threads.append(threading.Thread(target=scene_loop, name="view-scene", daemon=True,
                                         args=(make_cube, args.frames, processor, health,
@@ -173,9 +175,7 @@ def cmd_view(args: argparse.Namespace) -> int:
         return 0
 
 
-def add_view_parser(sub: Any) -> argparse.ArgumentParser:
-    """Add ``view`` to an ``argparse`` sub-parser collection."""
-    presets = sorted(PRESETS)
+def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v = sub.add_parser(
         "view", help="live browser view: range-Doppler maps, point cloud, link health",
         description="Serve a live view (like TI's mmWave Demo Visualizer) at "
@@ -223,23 +223,5 @@ def add_view_parser(sub: Any) -> argparse.ArgumentParser:
                         "(default: 27.78 for --scene table1, else 0)")
     v.add_argument("--duration", type=float, default=None,
                    help="stop after this many seconds (default: run until Ctrl-C)")
-    _add_detection_options(v)
+    add_detection_options(v)
     v.set_defaults(func=cmd_view)
-    return v
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m radar.view`` (the same as ``radar view``)."""
-    p = argparse.ArgumentParser(prog="radar")
-    sub = p.add_subparsers(dest="command", required=True)
-    add_view_parser(sub)
-    args = p.parse_args(["view", *(sys.argv[1:] if argv is None else argv)])
-    try:
-        return int(args.func(args))
-    except CliError as exc:
-        print(f"radar view: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())
