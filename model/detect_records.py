@@ -2,7 +2,7 @@
 with the host decoder: the one place that defines the layout, docs/detect.md).
 
 A *word* is ``num_rx`` 32-bit lanes (uint32 ``(num_rx,)``, lane 0 in the least significant
-bits), as in ``model/packetizer.py``. One frame of the record stream is exactly
+bits), as in ``model/axis_packetizer.py``. One frame of the record stream is exactly
 ``frame_words(num_tx, num_rx, max_detections)`` words (it then goes through
 ``axis_packetizer``: packet header, sequence numbers, loss detection):
 

@@ -53,7 +53,7 @@ def cube_to_words(cube: np.ndarray, data_w: int = 16) -> np.ndarray:
     """Doppler-FFT cube -> mode-1 input words.
 
     cube: integer-valued complex ``(num_tx, n_range, n_doppler, num_rx)`` (the mode-0 order of
-    ``model.packetizer.cube_to_payload``). Returns uint64 ``(n_range * num_tx * n_doppler,
+    ``model.axis_packetizer.cube_to_payload``). Returns uint64 ``(n_range * num_tx * n_doppler,
     num_rx)`` packed ``{Q, I}`` lanes in (r, t, d) order.
     """
     c = np.asarray(cube).transpose(1, 0, 2, 3)

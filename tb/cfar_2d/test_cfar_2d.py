@@ -9,12 +9,12 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
 from cocotb.triggers import with_timeout
 from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
 from model import cfar_2d as cm
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 KIND_NAMES = cm.KINDS
 N_CHANNELS = 4  # virtual channels of the test maps (Gamma(4) noise)

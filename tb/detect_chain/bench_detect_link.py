@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 
 from model import detect_records as dr
+from model.axis_packetizer import packets_per_frame
 from model.config import PRESETS
-from model.packetizer import packets_per_frame
 
 
 def link_bytes(words: int, num_rx: int, packet_words: int) -> int:

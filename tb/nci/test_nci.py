@@ -9,13 +9,13 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
 from cocotb.triggers import with_timeout
 from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
 from model import nci as nci_model
-from model.packetizer import words_to_bytes
+from model.axis_packetizer import words_to_bytes
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
