@@ -87,43 +87,43 @@ module cfar_2d #(
 
   // Parameter checks: stop elaboration on illegal values.
   if (N_RANGE < 4 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
-    $fatal(1, "cfar_2d: N_RANGE=%0d must be a power of two in 4..4096 (instance %m)", N_RANGE);
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 4..4096", N_RANGE);
   end
   if (N_DOPPLER < 4 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
-    $fatal(1, "cfar_2d: N_DOPPLER=%0d must be a power of two in 4..4096 (instance %m)",
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 4..4096",
            N_DOPPLER);
   end
   if (POW_W < 8 || POW_W > 62) begin : g_bad_pow_w
-    $fatal(1, "cfar_2d: POW_W=%0d not in 8..62 (instance %m)", POW_W);
+    $fatal(1, "%m: POW_W=%0d not in 8..62", POW_W);
   end
   if (GUARD_R < 0 || GUARD_R > 15 || GUARD_D < 0 || GUARD_D > 15) begin : g_bad_guard
-    $fatal(1, "cfar_2d: GUARD_R=%0d/GUARD_D=%0d not in 0..15 (instance %m)", GUARD_R, GUARD_D);
+    $fatal(1, "%m: GUARD_R=%0d/GUARD_D=%0d not in 0..15", GUARD_R, GUARD_D);
   end
   if (TRAIN_R < 1 || TRAIN_R > 15 || TRAIN_D < 1 || TRAIN_D > 15) begin : g_bad_train
-    $fatal(1, "cfar_2d: TRAIN_R=%0d/TRAIN_D=%0d not in 1..15 (instance %m)", TRAIN_R, TRAIN_D);
+    $fatal(1, "%m: TRAIN_R=%0d/TRAIN_D=%0d not in 1..15", TRAIN_R, TRAIN_D);
   end
   if (2 * PD + 1 > N_DOPPLER) begin : g_bad_train_d
-    $fatal(1, "cfar_2d: TRAIN_D/GUARD_D: window %0d wider than N_DOPPLER=%0d (instance %m)",
+    $fatal(1, "%m: TRAIN_D/GUARD_D: window %0d wider than N_DOPPLER=%0d",
            2 * PD + 1, N_DOPPLER);
   end
   if (KIND < 0 || KIND > 2) begin : g_bad_kind
-    $fatal(1, "cfar_2d: KIND=%0d not 0 (CA), 1 (GO) or 2 (SO) (instance %m)", KIND);
+    $fatal(1, "%m: KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", KIND);
   end
   if (BLANK_TOP < 0 || N_EFF < 2 * PR + 1) begin : g_bad_blank_top
-    $fatal(1, "cfar_2d: BLANK_TOP=%0d leaves %0d rows, need >= %0d (instance %m)",
+    $fatal(1, "%m: BLANK_TOP=%0d leaves %0d rows, need >= %0d",
            BLANK_TOP, N_EFF, 2 * PR + 1);
   end
   if (SCALE_W < 2 || SCALE_W > 48 || SCALE_FRAC < 0 || SCALE_FRAC >= SCALE_W)
   begin : g_bad_scale_w
-    $fatal(1, "cfar_2d: SCALE_W=%0d/SCALE_FRAC=%0d: need 2..48 and 0 <= FRAC < W (instance %m)",
+    $fatal(1, "%m: SCALE_W=%0d/SCALE_FRAC=%0d: need 2..48 and 0 <= FRAC < W",
            SCALE_W, SCALE_FRAC);
   end
   if (CW_W > 4096) begin : g_bad_column_word
-    $fatal(1, "cfar_2d: (2*PR+2)*POW_W=%0d bits per column above 4096 (instance %m)", CW_W);
+    $fatal(1, "%m: (2*PR+2)*POW_W=%0d bits per column above 4096", CW_W);
   end
   if (IN_W < POW_W || CNT_W < 1 || SUM_W != POW_W + CNT_W || OUT_W < POW_W + SUM_W + CNT_W + 1)
   begin : g_bad_derived
-    $fatal(1, "cfar_2d: IN_W/CNT_W/SUM_W/OUT_W are derived, do not override (instance %m)");
+    $fatal(1, "%m: IN_W/CNT_W/SUM_W/OUT_W are derived, do not override");
   end
 
   // ---------------------------------------------------------------------------------------
@@ -366,8 +366,8 @@ module cfar_2d #(
     end else begin
       m_stall_q <= m_axis_tvalid && !m_axis_tready;
       if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("cfar_2d: TVALID dropped while stalled");
-        assert (fifo_tdata == m_held_q) else $error("cfar_2d: TDATA/TLAST/TUSER changed while stalled");
+        assert (m_axis_tvalid) else $error("%m: TVALID dropped while stalled");
+        assert (fifo_tdata == m_held_q) else $error("%m: TDATA/TLAST/TUSER changed while stalled");
       end
     end
     m_held_q <= fifo_tdata;

@@ -68,7 +68,7 @@ module detect_chain #(
   if (POW_W != 32 + $clog2(NUM_TX * NUM_RX) ||
       FRAME_WORDS != MAX_DETECTIONS * ((8 + NUM_RX - 1) / NUM_RX + NUM_TX)
                      + (8 + NUM_RX - 1) / NUM_RX) begin : g_bad_derived
-    $fatal(1, "detect_chain: POW_W/FRAME_WORDS are derived, do not override (instance %m)");
+    $fatal(1, "%m: POW_W/FRAME_WORDS are derived, do not override");
   end
 
   // ---------------------------------------------------------------------------------------

@@ -74,37 +74,37 @@ module detect_records #(
 
   // Parameter checks: stop elaboration on illegal values.
   if (NUM_TX < 1 || NUM_TX > 16 || (1 << $clog2(NUM_TX)) != NUM_TX) begin : g_bad_num_tx
-    $fatal(1, "detect_records: NUM_TX=%0d must be a power of two in 1..16 (instance %m)",
+    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16",
            NUM_TX);
   end
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
-    $fatal(1, "detect_records: NUM_RX=%0d not in 1..64 (instance %m)", NUM_RX);
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
   if (N_RANGE < 4 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
-    $fatal(1, "detect_records: N_RANGE=%0d must be a power of two in 4..4096 (instance %m)",
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 4..4096",
            N_RANGE);
   end
   if (N_DOPPLER < 4 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
-    $fatal(1, "detect_records: N_DOPPLER=%0d must be a power of two in 4..4096 (instance %m)",
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 4..4096",
            N_DOPPLER);
   end
   if (POW_W < 1 || POW_W > 64 || SUM_W < 1 || SUM_W > 64 || CNT_W < 1 || CNT_W > 16)
   begin : g_bad_cell_w
-    $fatal(1, "detect_records: POW_W=%0d/SUM_W=%0d must be 1..64, CNT_W=%0d 1..16 (instance %m)",
+    $fatal(1, "%m: POW_W=%0d/SUM_W=%0d must be 1..64, CNT_W=%0d 1..16",
            POW_W, SUM_W, CNT_W);
   end
   if (SNAP_ROWS < 4 || SNAP_ROWS > 64 || (1 << BS) != SNAP_ROWS) begin : g_bad_snap_rows
-    $fatal(1, "detect_records: SNAP_ROWS=%0d must be a power of two in 4..64 (instance %m)",
+    $fatal(1, "%m: SNAP_ROWS=%0d must be a power of two in 4..64",
            SNAP_ROWS);
   end
   if (MAX_DETECTIONS < 1 || MAX_DETECTIONS > 65535) begin : g_bad_max_detections
-    $fatal(1, "detect_records: MAX_DETECTIONS=%0d not in 1..65535 (instance %m)",
+    $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535",
            MAX_DETECTIONS);
   end
   if (HDR_WORDS != (8 + NUM_RX - 1) / NUM_RX || REC_WORDS != HDR_WORDS + NUM_TX ||
       FRAME_WORDS != MAX_DETECTIONS * REC_WORDS + HDR_WORDS ||
       CELL_W != ((POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8) begin : g_bad_derived
-    $fatal(1, "detect_records: CELL_W/HDR_WORDS/REC_WORDS/FRAME_WORDS are derived (instance %m)");
+    $fatal(1, "%m: CELL_W/HDR_WORDS/REC_WORDS/FRAME_WORDS are derived");
   end
 
   // ---------------------------------------------------------------------------------------
@@ -329,11 +329,11 @@ module detect_records #(
     end else begin
       m_stall_q <= m_axis_tvalid && !m_axis_tready;
       if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("detect_records: TVALID dropped while stalled");
+        assert (m_axis_tvalid) else $error("%m: TVALID dropped while stalled");
         assert (fifo_tdata == m_held_q)
-          else $error("detect_records: TDATA/TLAST changed while stalled");
+          else $error("%m: TDATA/TLAST changed while stalled");
       end
-      if (snap_wr) assert (snap_room) else $error("detect_records: snapshot written without room");
+      if (snap_wr) assert (snap_room) else $error("%m: snapshot written without room");
     end
     m_held_q <= fifo_tdata;
   end

@@ -55,22 +55,22 @@ module nci #(
 
   // Parameter checks: stop elaboration on illegal values.
   if (NUM_TX < 1 || NUM_TX > 16) begin : g_bad_num_tx
-    $fatal(1, "nci: NUM_TX=%0d not in 1..16 (instance %m)", NUM_TX);
+    $fatal(1, "%m: NUM_TX=%0d not in 1..16", NUM_TX);
   end
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
-    $fatal(1, "nci: NUM_RX=%0d not in 1..64 (instance %m)", NUM_RX);
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
   if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
-    $fatal(1, "nci: N_RANGE=%0d must be a power of two in 2..4096 (instance %m)", N_RANGE);
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
   end
   if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
-    $fatal(1, "nci: N_DOPPLER=%0d must be a power of two in 2..4096 (instance %m)", N_DOPPLER);
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
   end
   if (DATA_W < 2 || DATA_W > 32) begin : g_bad_data_w
-    $fatal(1, "nci: DATA_W=%0d not in 2..32 (instance %m)", DATA_W);
+    $fatal(1, "%m: DATA_W=%0d not in 2..32", DATA_W);
   end
   if (POW_W != 2 * DATA_W + $clog2(NUM_TX * NUM_RX) || OUT_W < POW_W) begin : g_bad_pow_w
-    $fatal(1, "nci: POW_W/OUT_W are derived, do not override (instance %m)");
+    $fatal(1, "%m: POW_W/OUT_W are derived, do not override");
   end
 
   // ---------------------------------------------------------------------------------------
@@ -189,8 +189,8 @@ module nci #(
     end else begin
       m_stall_q <= m_axis_tvalid && !m_axis_tready;
       if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("nci: TVALID dropped while stalled");
-        assert (fifo_tdata == m_held_q) else $error("nci: TDATA/TLAST/TUSER changed while stalled");
+        assert (m_axis_tvalid) else $error("%m: TVALID dropped while stalled");
+        assert (fifo_tdata == m_held_q) else $error("%m: TDATA/TLAST/TUSER changed while stalled");
       end
     end
     m_held_q <= fifo_tdata;
