@@ -1,9 +1,13 @@
 """Detection on range-Doppler maps: the paper's threshold, 2-D CA-CFAR and OS-CFAR, peak
 grouping.
 
-Maps are float (n_range, n_doppler) powers with the Doppler axis in natural FFT order. The
-Doppler axis is circular (wraps around); the range axis is not: near its ends the training
-window is cut off and the threshold factor is recomputed for the cells that remain.
+Maps are float (n_range, n_doppler) powers with the Doppler axis in natural FFT order. Both
+axes are circular: the Doppler FFT's, and the range FFT's too because the IF is sampled
+complex (bin N-k is the negative beat frequency -k fs/N, ``model.config``). CFAR windows and
+peak grouping therefore wrap around at the range edges instead of being cut: a strong near
+target's window sidelobes that wrap into the top bins meet a training window that holds the
+target itself, exactly as its sidelobes on the other side do. Which bins may be *reported*
+is a separate rule, ``RadarConfig.detection_bins`` (applied by :func:`detection_mask`).
 
 Thresholds for a configured false-alarm probability are derived, not tuned. A cell of a
 map that integrates ``n_channels`` independent channels non-coherently is Gamma(L, theta)
@@ -108,13 +112,26 @@ def os_factor(pfa: float, n_channels: int, n_train: int, k: int) -> float:
                                  xtol=1e-6))
 
 
+def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
+    """ValueError when the CFAR window (guard + training cells, both sides, plus the cell
+    under test) does not fit the (n_range, n_doppler) map ``shape``: on a circular axis the
+    window would then count cells twice."""
+    for axis, name in enumerate(("range", "Doppler")):
+        span = 2 * (params.guard[axis] + params.train[axis]) + 1
+        if span > shape[axis]:
+            raise ValueError(f"CFAR window: 2 x (guard {params.guard[axis]} + train "
+                             f"{params.train[axis]}) + 1 = {span} {name} cells does not fit "
+                             f"the map's {shape[axis]} {name} bins")
+
+
 def _pad(power: np.ndarray, params: CfarParams) -> tuple[np.ndarray, np.ndarray]:
-    """Map padded with wrap in Doppler and zeros in range, and the matching validity mask."""
+    """Map padded circularly on both axes, and the matching validity mask (all ones: kept so
+    a cut window could be expressed again)."""
     (gr, gd), (tr, td) = params.guard, params.train
     pr, pd = gr + tr, gd + td
-    valid = np.ones_like(power)
-    padded = np.pad(np.pad(power, ((0, 0), (pd, pd)), mode="wrap"), ((pr, pr), (0, 0)))
-    vpad = np.pad(np.pad(valid, ((0, 0), (pd, pd)), mode="wrap"), ((pr, pr), (0, 0)))
+    check_window(params, power.shape)
+    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
+    vpad = np.ones_like(padded)
     return padded, vpad
 
 
@@ -161,9 +178,17 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3)
                 ) -> np.ndarray:
     """Peak grouping: cells of ``mask`` that are the maximum of their (range, Doppler)
-    neighbourhood (Doppler circular). Returns int (n, 2) of (range_bin, doppler_bin)."""
-    mx = maximum_filter(power, size=size, mode=("nearest", "wrap"))
+    neighbourhood (both axes circular). Returns int (n, 2) of (range_bin, doppler_bin)."""
+    mx = maximum_filter(power, size=size, mode="wrap")
     return np.argwhere(mask & (power >= mx))
+
+
+def detection_mask(n_range: int, n_doppler: int, bins: tuple[int, int]) -> np.ndarray:
+    """bool (n_range, n_doppler): True in the range bins ``bins[0] <= r < bins[1]`` a
+    detector may report (``RadarConfig.detection_bins``: DC guard and negative-beat guard)."""
+    mask = np.zeros((n_range, n_doppler), bool)
+    mask[bins[0]:bins[1]] = True
+    return mask
 
 
 def paper_threshold(cube: np.ndarray, threshold_db: float) -> tuple[np.ndarray, np.ndarray]:
