@@ -66,6 +66,19 @@ def neighbour_edges(xy: np.ndarray, cfg: GraphConfig) -> np.ndarray:
     return np.stack([idx[ok], tgt[ok]]).astype(np.int64)
 
 
+MAX_EGO_SPEED_MPS = 150.0
+"""Largest ego speed accepted for velocity compensation, m/s (540 km/h)."""
+
+
+def check_ego_speed(ego_speed_mps: float) -> float:
+    """ValueError unless ``ego_speed_mps`` is a finite speed within +-MAX_EGO_SPEED_MPS."""
+    if isinstance(ego_speed_mps, bool) or not isinstance(ego_speed_mps, int | float) or not \
+            -MAX_EGO_SPEED_MPS <= ego_speed_mps <= MAX_EGO_SPEED_MPS:
+        raise ValueError(f"ego speed: must be a finite number of m/s within "
+                         f"+-{MAX_EGO_SPEED_MPS:g}, got {ego_speed_mps!r}")
+    return float(ego_speed_mps)
+
+
 def compensated_velocity(cloud: PointCloud, ego_speed_mps: float) -> np.ndarray:
     """Radial velocity over ground, m/s (n,): static points -> 0 for ego motion along +x."""
     return cloud.radial_velocity_mps + ego_speed_mps * np.cos(np.radians(cloud.azimuth_deg))
@@ -77,6 +90,7 @@ def build_graph(cloud: PointCloud, ego_speed_mps: float = 0.0,
     (n, 2) in m, ``edge_index`` int64 (2, E), ``edge_attr`` float32 (E, 4)
     (:data:`EDGE_FEATURES`)."""
     cfg = cfg or GraphConfig()
+    check_ego_speed(ego_speed_mps)
     xy = np.stack([cloud.x_m, cloud.y_m], axis=1).astype(float)
     if not np.all(np.isfinite(xy)):
         raise ValueError("cloud: x_m/y_m contain NaN or infinity")

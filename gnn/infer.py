@@ -10,7 +10,7 @@ import torch
 
 from gnn.checkpoint import load_checkpoint
 from gnn.detection import Detection, decode
-from gnn.graph import GraphConfig, build_graph
+from gnn.graph import GraphConfig, build_graph, check_ego_speed
 from gnn.model import RadarGnn
 from host.pointcloud import PointCloud
 
@@ -55,6 +55,7 @@ def detect_objects(cloud: PointCloud, ego_speed_mps: float = 0.0,
     indices into the cloud). ``ego_speed_mps``: ego speed along +x (m/s, 0 for a static
     radar). Uses the shipped checkpoint unless ``checkpoint`` names another."""
     global _DEFAULT
+    check_ego_speed(ego_speed_mps)  # before loading torch weights: fail fast
     if checkpoint is not None:
         det = GnnDetector.from_checkpoint(checkpoint)
     else:

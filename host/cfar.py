@@ -34,6 +34,10 @@ from scipy.signal import fftconvolve
 # |sum w^2 e^{-j2pi i n/N}|^2 / (sum w^2)^2 -> 1, 4/9, 1/36 for i = 0, 1, 2; 0 beyond.
 HANN_POWER_CORRELATION = (1.0, 4.0 / 9.0, 1.0 / 36.0)
 RECT_POWER_CORRELATION = (1.0,)
+OS_MAX_ELEMENTS = 2 * 10**8
+"""OS-CFAR holds (cells x training cells) values at once: bound on that product."""
+MAX_WINDOW_CELLS = 2048
+"""Largest guard or training extent per side (half the largest FFT the core supports)."""
 
 
 @dataclass(frozen=True)
@@ -52,12 +56,16 @@ class CfarParams:
     os_rank: float = 0.75
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.pfa < 0.5:
-            raise ValueError(f"pfa: must be in (0, 0.5), got {self.pfa}")
+        if isinstance(self.pfa, bool) or not isinstance(self.pfa, int | float) or \
+                not 1e-15 <= self.pfa < 0.5:
+            raise ValueError(f"pfa: must be in [1e-15, 0.5), got {self.pfa}")
         if self.kind not in ("ca", "os"):
             raise ValueError(f"kind: must be 'ca' or 'os', got {self.kind!r}")
-        if any(g < 0 for g in self.guard) or any(t < 1 for t in self.train):
-            raise ValueError("guard must be >= 0 and train >= 1 cells per side")
+        for name, cells, lo in (("guard", self.guard, 0), ("train", self.train, 1)):
+            if len(cells) != 2 or any(isinstance(c, bool) or not isinstance(c, int | np.integer)
+                                      or not lo <= c <= MAX_WINDOW_CELLS for c in cells):
+                raise ValueError(f"{name}: must be two integers (range, Doppler) in "
+                                 f"{lo}..{MAX_WINDOW_CELLS} cells per side, got {cells}")
         if not 0.0 < self.os_rank < 1.0:
             raise ValueError(f"os_rank: must be in (0, 1), got {self.os_rank}")
 
@@ -72,13 +80,25 @@ def _kernel(params: CfarParams) -> np.ndarray:
 
 def _correlation_sum(kernel: np.ndarray, rho_r: tuple[float, ...],
                      rho_d: tuple[float, ...]) -> float:
-    """sum over training-cell pairs of their power correlation (separable windows)."""
-    idx = np.argwhere(kernel > 0)
-    dr = np.abs(idx[:, None, 0] - idx[None, :, 0])
-    dd = np.abs(idx[:, None, 1] - idx[None, :, 1])
-    rr = np.array(rho_r + (0.0,) * (kernel.shape[0] + 1))[dr]
-    rd = np.array(rho_d + (0.0,) * (kernel.shape[1] + 1))[dd]
-    return float(np.sum(rr * rd))
+    """sum over training-cell pairs of their power correlation (separable windows).
+
+    Only offsets where rho != 0 contribute, so the pair count per offset (the kernel's
+    autocorrelation there) is taken by shifting the mask: O(cells), not O(cells^2)."""
+    total = 0.0
+    nr, nd = kernel.shape
+    for dr, cr in enumerate(rho_r):
+        for dd, cd in enumerate(rho_d):
+            if dr >= nr or dd >= nd:
+                continue
+            pairs = float(np.sum(kernel[dr:, dd:] * kernel[:nr - dr, :nd - dd]))
+            if dd and dr:  # (+dr, +dd) and (+dr, -dd), each counted for both orders
+                pairs += float(np.sum(kernel[dr:, :nd - dd] * kernel[:nr - dr, dd:]))
+                total += 2 * cr * cd * pairs
+            elif dd or dr:
+                total += 2 * cr * cd * pairs
+            else:
+                total += pairs
+    return total
 
 
 def effective_cells(params: CfarParams, windowed: tuple[bool, bool] = (True, True)) -> float:
@@ -122,6 +142,11 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
             raise ValueError(f"CFAR window: 2 x (guard {params.guard[axis]} + train "
                              f"{params.train[axis]}) + 1 = {span} {name} cells does not fit "
                              f"the map's {shape[axis]} {name} bins")
+    n_train = int(_kernel(params).sum())
+    if params.kind == "os" and n_train * shape[0] * shape[1] > OS_MAX_ELEMENTS:
+        raise ValueError(f"CFAR window: OS-CFAR sorts {n_train} training cells for each of "
+                         f"{shape[0] * shape[1]} cells, more than this host allows "
+                         f"({OS_MAX_ELEMENTS:.0e} values); use fewer training cells or CA")
 
 
 def _pad(power: np.ndarray, params: CfarParams) -> tuple[np.ndarray, np.ndarray]:

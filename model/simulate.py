@@ -34,6 +34,19 @@ import numpy as np
 from model.config import C0, RadarConfig, db_to_lin, dbm_to_w
 from model.scene import Scatterers, Scene
 
+MAX_FRAME_INDEX = 1_000_000
+"""Largest frame index (2.5 h of the full preset's frames; the phase of t_c stays exact)."""
+
+
+def check_frame_index(frame_index: int) -> int:
+    """ValueError unless ``frame_index`` is an integer in 0..MAX_FRAME_INDEX."""
+    if isinstance(frame_index, bool) or not isinstance(frame_index, int | np.integer) or \
+            not 0 <= frame_index <= MAX_FRAME_INDEX:
+        raise ValueError(f"frame: must be an integer in 0..{MAX_FRAME_INDEX}, got "
+                         f"{frame_index!r}")
+    return int(frame_index)
+
+
 CHIRP_CHUNK = 64
 """Chirps per batched matrix product (bounds the (chunk, scatterers, samples) temporary)."""
 FAST_SPLIT = 16
@@ -222,6 +235,7 @@ def simulate_frame(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = True
                    noise: bool = True, rng: np.random.Generator | None = None,
                    frame_index: int = 0) -> AdcFrame:
     """One frame of quantised ADC samples (see :class:`AdcFrame`) for ``sc``."""
+    check_frame_index(frame_index)
     rng = rng if rng is not None else np.random.default_rng(0)
     x, dropped = simulate_baseband(cfg, sc, beamforming=beamforming, frame_index=frame_index)
     if noise:
@@ -237,6 +251,7 @@ def simulate_scene(scene: Scene, frame_index: int = 0) -> AdcFrame:
     Noise for frame k uses the seed sequence (scene.seed, k), so frames are reproducible
     and independent.
     """
+    check_frame_index(frame_index)
     rng = np.random.default_rng([scene.seed, frame_index])
     return simulate_frame(scene.config, scene.scatterers(), beamforming=scene.tx_beamforming,
                           noise=scene.noise, rng=rng, frame_index=frame_index)
