@@ -118,3 +118,23 @@ def table3(matches: list[Match], cloud: PointCloud, cfg: RadarConfig,
             f"{t.azimuth_deg:>6.1f} {cloud.azimuth_deg[j]:>7.2f} {abs(m.azimuth_err_deg):>6.2f}"
             f" | {', '.join(flags)}")
     return "\n".join(lines)
+
+
+def alias_note(targets: tuple[PointTarget, ...], cfg: RadarConfig, prefix: str = "V"
+               ) -> str | None:
+    """A sentence for figures explaining the targets whose velocity is beyond +-vmax
+    (labels ``prefix`` + 1-based index), or None when there are none."""
+    vmax = cfg.max_velocity_mps
+    fast = [(i, t) for i, t in enumerate(targets) if not -vmax <= t.radial_velocity_mps < vmax]
+    if not fast:
+        return None
+    names = ", ".join(f"{prefix}{i + 1} ({t.radial_velocity_mps:+.1f} m/s, shows at "
+                      f"{alias_velocity(t.radial_velocity_mps, cfg):+.2f})" for i, t in fast)
+    if cfg.num_tx > 1:
+        return (f"{names}: beyond the unambiguous +-{vmax:.2f} m/s. This map compensates the "
+                f"TDM slot delay with the aliased Doppler, which mis-phases the {cfg.num_tx} "
+                f"TX slots and smears the target across azimuth; the point cloud tests the "
+                f"unfolded hypotheses and places it correctly.")
+    return (f"{names}: beyond the unambiguous +-{vmax:.2f} m/s. With one TX there is no TDM "
+            f"phase to correct (azimuth is right) and nothing to unfold with: its velocity "
+            f"is reported aliased and flagged ambiguous.")

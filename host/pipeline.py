@@ -4,7 +4,9 @@ Steps (DESIGN.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel
-   0; peak grouping keeps local maxima.
+   0; peak grouping keeps local maxima; only ``RadarConfig.detection_bins`` are reported
+   (the top range bins are negative beat frequencies), and cells within
+   ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
 2. Range and Doppler refined by log-parabolic (Gaussian) interpolation around each peak.
 3. TDM Doppler phase compensation per TX slot, with velocity unfolding. The measured
    Doppler fixes the velocity only modulo the alias period 2 vmax: the hypotheses are
@@ -39,6 +41,7 @@ from host.cfar import (
     detection_mask,
     local_peaks,
     paper_threshold,
+    sidelobe_masked,
 )
 from host.pointcloud import PointCloud
 from model.config import RadarConfig, dbm_to_w
@@ -71,6 +74,9 @@ class DetectionParams:
     excludes the others when it beats them by the margin. ``max_speed_mps``: fastest radial
     speed considered when unfolding and flagging ``ambiguous`` (module docstring, step 3).
     Reported range bins are ``RadarConfig.detection_bins`` (DC and negative-beat guards).
+    ``sidelobe_margin_db``: a detected cell must exceed the window sidelobes of every
+    stronger cell in its Doppler column and range row by this much (``host.cfar.
+    sidelobe_masked``; beyond the +-2-bin main lobe); None turns the masking off.
     """
 
     detector: str = "ca"
@@ -84,6 +90,7 @@ class DetectionParams:
     unfold_min_snr_db: float = 30.0
     unfold_margin_db: float = 0.45
     max_speed_mps: float = MAX_RADIAL_SPEED_MPS
+    sidelobe_margin_db: float | None = 10.0
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
@@ -143,6 +150,8 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
         cells = local_peaks(nci, nci > threshold)
     ok = detection_mask(cfg.n_range, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]
+    if params.sidelobe_margin_db is not None and len(cells):
+        cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
     return cells, noise_map[cells[:, 0], cells[:, 1]], nci
 
 

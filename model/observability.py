@@ -5,9 +5,10 @@ can come from it, whatever the detector settings:
 
 - ``passed``: its range is <= 0 during the frame (it has driven past the radar); the
   simulator drops it (``model.simulate.passed_radar``);
-- ``too_close``: closer than the DC guard (``RadarConfig.min_detection_range_m``);
-- ``beyond_max_range``: beyond ``RadarConfig.max_detection_range_m`` (the top range bins
-  are the negative-beat guard band, and beyond ``max_range_m`` the anti-alias filter);
+- ``too_close``: its peak falls in the DC guard bins (``RadarConfig.detection_bins``);
+- ``beyond_max_range``: its peak falls in the top guard bins, i.e. beyond about
+  ``RadarConfig.max_detection_range_m`` (the negative-beat guard band; beyond
+  ``max_range_m`` the anti-alias filter removes it);
 - ``tx_null``: the echo is too weak to detect because the TX subarray pattern has a null
   there (3 elements at lambda/2: nulls at +-41.8 deg);
 - ``too_weak``: the expected SNR after full coherent integration (range, Doppler and all
@@ -21,6 +22,7 @@ next to a simulated point cloud, not part of detection.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,6 +75,10 @@ def scatterer_reasons(cfg: RadarConfig, sc: Scatterers, beamforming: bool,
     """Per scatterer: None when observable, else (reason, detail)."""
     r = frame_centre_range_m(cfg, sc, frame_index)
     passed = passed_radar(cfg, sc, frame_index)
+    # the peak lands in the nearest bin: reportable when that bin is in detection_bins
+    rbin = np.array([cfg.range_bin_of(x, v) for x, v in zip(r, sc.radial_velocity_mps,
+                                                             strict=True)])
+    lo, hi = cfg.detection_bins
     snr = integrated_snr_db(cfg, sc, beamforming, frame_index)
     with np.errstate(divide="ignore"):
         af_db = 10 * np.log10(subarray_factor_power(cfg, sc.azimuth_deg)) if beamforming \
@@ -82,10 +88,10 @@ def scatterer_reasons(cfg: RadarConfig, sc: Scatterers, beamforming: bool,
         if passed[i]:
             out.append(("passed", f"range {r[i]:.2f} m <= 0 during the frame (passed the "
                                   f"radar)"))
-        elif r[i] < cfg.min_detection_range_m:
+        elif rbin[i] < lo - 0.5:
             out.append(("too_close", f"range {r[i]:.2f} m inside the DC guard "
-                                     f"(< {cfg.min_detection_range_m:.2f} m)"))
-        elif r[i] >= cfg.max_detection_range_m:
+                                     f"(< {(lo - 0.5) * cfg.range_bin_m:.2f} m)"))
+        elif rbin[i] >= hi - 0.5:
             out.append(("beyond_max_range", f"range {r[i]:.1f} m beyond the "
                                             f"{cfg.max_detection_range_m:.1f} m maximum "
                                             f"detection range of {cfg.name}"))
@@ -113,8 +119,7 @@ def unobservable_targets(scene: Scene, frame_index: int = 0) -> list[Unobservabl
         if reasons[i] is not None:
             out.append(Unobservable(f"targets[{i}]", frame_index, *reasons[i]))
     for j in range(len(scene.objects)):
-        idx = np.flatnonzero(sc.object_id == j)
-        idx = idx[idx >= n_targets]
+        idx = np.flatnonzero(sc.object_id == j)  # point targets have object_id -1
         rs = [reasons[k] for k in idx]
         if rs and all(x is not None for x in rs):
             reason, _ = Counter(x[0] for x in rs).most_common(1)[0]  # type: ignore[index]
@@ -133,3 +138,39 @@ def summarize(items: list[Unobservable]) -> dict[str, object]:
     entries = [{"target": t, "reason": r, "frames": [u.frame for u in g],
                 "detail": g[0].detail} for (t, r), g in groups.items()]
     return {"unobservable_targets": len({u.target for u in items}), "unobservable": entries}
+
+
+def beyond_max_speed(scene: Scene, max_speed_mps: float) -> list[str]:
+    """Targets / objects of ``scene`` whose radial speed exceeds ``max_speed_mps``: the host
+    unfolds velocities only within that speed, so theirs will be reported as an alias,
+    possibly without the ``ambiguous`` flag. One sentence each."""
+    sc = scene.scatterers()
+    out = []
+    for i, t in enumerate(scene.targets):
+        if abs(t.radial_velocity_mps) > max_speed_mps:
+            out.append(f"targets[{i}]: radial velocity {t.radial_velocity_mps:g} m/s beyond "
+                       f"the assumed maximum speed {max_speed_mps:g} m/s")
+    for j in range(len(scene.objects)):
+        v = np.abs(sc.radial_velocity_mps[sc.object_id == j])
+        if v.size and v.max() > max_speed_mps:
+            out.append(f"objects[{j}]: radial velocity up to {v.max():.1f} m/s beyond the "
+                       f"assumed maximum speed {max_speed_mps:g} m/s")
+    return out
+
+
+def scene_report(scene: Scene, frames: Iterable[int], max_speed_mps: float
+                 ) -> tuple[dict[str, object], list[str]]:
+    """What a command that simulates ``frames`` of ``scene`` should tell its user: the JSON
+    fields (``unobservable_targets``, ``unobservable``, ``velocity_beyond_max_speed``) and
+    one warning line per unobservable (target, reason) and per too-fast target."""
+    items = [u for k in frames for u in unobservable_targets(scene, k)]
+    doc = summarize(items)
+    fast = beyond_max_speed(scene, max_speed_mps)
+    doc["velocity_beyond_max_speed"] = fast
+    lines = []
+    for e in doc["unobservable"]:  # type: ignore[union-attr]
+        fr = e["frames"]
+        when = f"frame {fr[0]}" if len(fr) == 1 else f"{len(fr)} frames ({fr[0]}..{fr[-1]})"
+        lines.append(f"{e['target']} not observable in {when}: {e['detail']}")
+    lines += [f"{f}: its velocity will be reported as an alias" for f in fast]
+    return doc, lines
