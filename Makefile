@@ -68,15 +68,15 @@ include synth/synth.mk
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 
 gnn-dataset: $(STAMP)
-	$(RUN) python -m gnn.cli dataset --train 700 --val 500 --test 200 --workers 2
+	$(RUN) radar gnn dataset --train 700 --val 500 --test 200 --workers 2
 
 gnn-train: $(STAMP)
-	$(RUN) python -m gnn.cli train --epochs 50 --hidden 64 --layers 3 \
+	$(RUN) radar gnn train --epochs 50 --hidden 64 --layers 3 \
 	  --data $(GNN_CACHE)/train.npz $(GNN_CACHE)/val.npz
 
 gnn-eval: $(STAMP)
 	mkdir -p $(OUT)
-	$(RUN) python -m gnn.cli eval --json $(OUT)/gnn_eval.json
+	$(RUN) radar gnn eval --json $(OUT)/gnn_eval.json
 	$(RUN) python -m gnn.bench_infer
 
 clean:

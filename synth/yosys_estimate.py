@@ -121,12 +121,21 @@ def _top_job(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int
                note="whole top (rtl/top/radar_pipeline.sv)")
 
 
+def _dims(preset: str) -> tuple[int, int, int, int]:
+    """(NUM_TX, NUM_RX, N_RANGE, N_DOPPLER) of a preset (:func:`model.config.hdl_parameters`)."""
+    from model.config import get_preset, hdl_parameters
+
+    p = hdl_parameters(get_preset(preset))
+    return p["NUM_TX"], p["NUM_RX"], p["N_RANGE"], p["N_DOPPLER"]
+
+
 def job_sets() -> dict[str, list[Job]]:
     """The named job sets: ``ci`` (quick), ``paper-fpga``, ``full`` and ``all``."""
-    paper = _jobs_for("paper-fpga", 1, 4, 64, 256) + [_top_job("paper-fpga", 1, 4, 64, 256)]
+    paper = _jobs_for("paper-fpga", *_dims("paper-fpga")) + [
+        _top_job("paper-fpga", *_dims("paper-fpga"))]
     # full: the 128 Mib frame of the corner turn (and so the top) cannot fit the device
     # (docs/buffers.md); the range and Doppler FFTs are the same 256-point 16-lane core.
-    full = [j for j in _jobs_for("full", 4, 16, 256, 256)
+    full = [j for j in _jobs_for("full", *_dims("full"))
             if j.top != "corner_turn" and not j.name.endswith("doppler_fft")]
     full = [replace(j, name="full/range_doppler_fft", instances=2)
             if j.name.endswith("range_fft") else j for j in full]
