@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 from torch_geometric.data import Data
 
 from host.pointcloud import PointCloud
+from model.scene import check_ego_speed
 
 NODE_FEATURES = ("rcs_dbsm/10", "snr_db/20", "vr_comp/5", "vx_comp/5", "vy_comp/5",
                  "cos_az", "sin_az", "degree/k")
@@ -64,19 +65,6 @@ def neighbour_edges(xy: np.ndarray, cfg: GraphConfig) -> np.ndarray:
     ok = np.isfinite(dist)
     tgt = np.broadcast_to(np.arange(n)[:, None], idx.shape)
     return np.stack([idx[ok], tgt[ok]]).astype(np.int64)
-
-
-MAX_EGO_SPEED_MPS = 150.0
-"""Largest ego speed accepted for velocity compensation, m/s (540 km/h)."""
-
-
-def check_ego_speed(ego_speed_mps: float) -> float:
-    """ValueError unless ``ego_speed_mps`` is a finite speed within +-MAX_EGO_SPEED_MPS."""
-    if isinstance(ego_speed_mps, bool) or not isinstance(ego_speed_mps, int | float) or not \
-            -MAX_EGO_SPEED_MPS <= ego_speed_mps <= MAX_EGO_SPEED_MPS:
-        raise ValueError(f"ego speed: must be a finite number of m/s within "
-                         f"+-{MAX_EGO_SPEED_MPS:g}, got {ego_speed_mps!r}")
-    return float(ego_speed_mps)
 
 
 def compensated_velocity(cloud: PointCloud, ego_speed_mps: float) -> np.ndarray:

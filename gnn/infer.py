@@ -10,9 +10,10 @@ import torch
 
 from gnn.checkpoint import load_checkpoint
 from gnn.detection import Detection, decode
-from gnn.graph import GraphConfig, build_graph, check_ego_speed
+from gnn.graph import GraphConfig, build_graph
 from gnn.model import RadarGnn
 from host.pointcloud import PointCloud
+from model.scene import check_ego_speed
 
 
 class GnnDetector:

@@ -358,6 +358,19 @@ TABLE1_VEHICLES: tuple[tuple[float, float, float, float], ...] = (
 )
 
 
+MAX_EGO_SPEED_MPS = 150.0
+"""Largest ego speed accepted for velocity compensation, m/s (540 km/h)."""
+
+
+def check_ego_speed(ego_speed_mps: float) -> float:
+    """ValueError unless ``ego_speed_mps`` is a finite speed within +-MAX_EGO_SPEED_MPS."""
+    if isinstance(ego_speed_mps, bool) or not isinstance(ego_speed_mps, int | float) or not \
+            -MAX_EGO_SPEED_MPS <= ego_speed_mps <= MAX_EGO_SPEED_MPS:
+        raise ValueError(f"ego speed: must be a finite number of m/s within "
+                         f"+-{MAX_EGO_SPEED_MPS:g}, got {ego_speed_mps!r}")
+    return float(ego_speed_mps)
+
+
 def default_ego_speed_mps(scene: Scene) -> float:
     """Ego speed along +x a scene implies, m/s: the Table I scene's 100 km/h, else 0 (a
     static radar). ``radar detect --gnn`` and ``radar gnn detect`` both default to it."""

@@ -131,7 +131,7 @@ def test_scene_total_scatterers_and_seed():
 
 
 def test_ego_speed_checked():
-    from gnn.graph import check_ego_speed
+    from model.scene import check_ego_speed
 
     for bad in (NAN, INF, 1e4, "fast"):
         with pytest.raises(ValueError, match="ego speed"):
