@@ -166,7 +166,7 @@ def plot_point_cloud(x: np.ndarray, y: np.ndarray, snr_db: np.ndarray, path: Pat
     ax.set_ylim(y0 - 0.08 * span, y1 + 0.12 * span)
     ax.set_xlabel("-y (m, right)")
     ax.set_ylabel("x (m, forward)")
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")
     ax.grid(alpha=0.3)
     ax.legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.9)
     ax.set_title(title)

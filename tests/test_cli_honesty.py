@@ -97,17 +97,6 @@ def test_receive_nothing_exits_1_and_writes_json(tmp_path, capsys):
     assert json.loads(out.read_text())["datagrams"] == 0
 
 
-def test_capture_full_default_fits_udp(tmp_path):
-    from host.capture import read_capture
-    from host.udp import UDP_MAX_PAYLOAD
-
-    cap = tmp_path / "f.dmacap"
-    assert main(["capture", "--scene", _scene(tmp_path, {"preset": "full", **NEAR}),
-                 "--frames", "1", "--out", str(cap)]) == 0
-    info, packets = read_capture(cap)
-    assert info.packet_words == 1022 and max(len(p) for p in packets) <= UDP_MAX_PAYLOAD
-
-
 BAD = [
     ["detect", "--train", "100", "300"], ["detect", "--guard", "200", "2"],
     ["detect", "--pfa", "nan"], ["detect", "--pfa", "0"], ["detect", "--pfa", "1e-20"],
