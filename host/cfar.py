@@ -241,9 +241,11 @@ def sidelobe_envelope(n: int, windowed: bool) -> np.ndarray:
     k = np.arange(n)
     k = np.where(k > n // 2, k - n, k)
     delta = np.linspace(-0.5, 0.5, 21)
-    x = (k[:, None] + delta[None, :]).reshape(-1)
-    resp = np.abs(np.exp(-2j * np.pi * np.outer(x, np.arange(n)) / n) @ w) / w.sum()
-    env = np.max(resp.reshape(n, -1) ** 2, axis=1)
+    # response at k + delta for every k: the DFT of w * exp(-j 2 pi delta t / n), one FFT
+    # per fractional offset
+    shifted = w[None, :] * np.exp(-2j * np.pi * np.outer(delta, np.arange(n)) / n)
+    resp = np.abs(np.fft.fft(shifted, axis=1)) / w.sum()                  # (delta, k)
+    env = np.max(resp**2, axis=0)
     env[np.abs(k) <= MAIN_LOBE_BINS] = 0.0
     return env
 

@@ -90,6 +90,18 @@ def test_very_strong_near_target_sidelobes_are_masked(preset):
     assert len(cloud) == 1 and cloud.range_m[0] < 2.0
 
 
+@pytest.mark.parametrize("preset", ["full", "paper-fpga"])
+def test_nothing_reported_from_the_top_guard_bins(preset):
+    """A strong target whose peak falls in the negative-beat guard band gives no point (the
+    bins cannot tell it from a near target's wrapped sidelobes) and is named unobservable."""
+    cfg = get_preset(preset)
+    r = (cfg.n_range - 1.6) * cfg.range_bin_m
+    scene = _scene(preset, r, v=0.0, rcs=1e5)
+    cloud = process_frame(simulate_scene(scene).samples, cfg)
+    assert len(cloud) == 0, cloud.range_m
+    assert [u.reason for u in unobservable_targets(scene)] == ["beyond_max_range"]
+
+
 def test_cfar_window_wraps_in_range():
     """A strong cell at bin 1: the cells at the top of the range axis see it in their
     training window (circular), so its sidelobe there is not detected."""
