@@ -89,6 +89,20 @@ def test_capture_replay_receive_with_defaults(tmp_path, faults):
     assert sum(p["frame"] == 0 for p in doc["points"]) >= 3
 
 
+def test_receive_ctrl_c_writes_json_no_traceback(tmp_path, capsys):
+    import os
+    import signal
+
+    out = tmp_path / "rx.json"
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    assert main(["receive", "--port", str(_free_port()), "--timeout", "30", "--json",
+                 str(out)]) == 130
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "interrupted" in err
+    assert json.loads(out.read_text())["interrupted"] is True
+
+
 def test_receive_nothing_exits_1_and_writes_json(tmp_path, capsys):
     out = tmp_path / "rx.json"
     assert main(["receive", "--port", str(_free_port()), "--timeout", "0.5", "--json",
