@@ -97,6 +97,8 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
     vmin = min(np.median(d) for d in dbs)
     fig, axes = plt.subplots(1, len(maps), figsize=(5.5 * len(maps), 4.5), dpi=110,
                              sharey=True, squeeze=False)
+    if note:  # room for the note under the axes, before the colour bar takes its share
+        fig.subplots_adjust(bottom=0.2)
     for ax, d, (_, title) in zip(axes[0], dbs, maps, strict=True):
         im = ax.pcolormesh(az[ok], rng, d, shading="nearest", cmap="viridis", vmin=vmin,
                            vmax=vmax)
@@ -107,7 +109,7 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
     axes[0][0].set_ylabel("range (m)")
     fig.colorbar(im, ax=axes[0].tolist(), label="power (dB, LSB^2)")
     if note:
-        fig.text(0.01, 0.005, note, fontsize=7, va="bottom", wrap=True)
+        fig.text(0.01, 0.01, note, fontsize=7, va="bottom", wrap=True)
     return _save(fig, path, tight=False)
 
 
