@@ -53,7 +53,7 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
-	$(RUN) ruff check model host gnn tb tests tools synth
+	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate

@@ -48,14 +48,13 @@ def bursty_pause(seed: int, max_run: int = 200, busy_fraction: float = 0.3) -> I
 def unpack_frame(frame: AxiStreamFrame, lanes: int) -> tuple[np.ndarray, list[int]]:
     """A received AXI-Stream frame -> (uint32 words (beats, lanes), TUSER of each beat)."""
     words = bytes_to_words(bytes(frame.tdata), lanes)
-    tuser = frame.tuser
-    if tuser is None:
-        user = [0] * len(words)
-    elif isinstance(tuser, int):
-        user = [tuser] * len(words)
-    else:
-        user = [int(tuser[i * 4 * lanes]) for i in range(len(words))]
-    return words, user
+    n, tuser = len(words), frame.tuser
+    if not tuser:  # no TUSER port (None or empty)
+        return words, [0] * n
+    if isinstance(tuser, int):
+        return words, [tuser] * n
+    stride = len(tuser) // max(n, 1)  # one entry per byte (or per beat)
+    return words, [int(tuser[i * stride]) for i in range(n)]
 
 
 class AxisTB:

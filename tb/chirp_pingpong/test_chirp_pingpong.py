@@ -51,10 +51,9 @@ class TB(AxisTB):
         return out
 
     def status(self) -> dict[str, int]:
-        d = self.dut
-        return {k: int(getattr(d, k).value) for k in (
+        return self.read_status((
             "status_overflow", "status_framing_error", "drop_count", "chirps_dropped",
-            "framing_error_count", "chirps_out")}
+            "framing_error_count", "chirps_out"))
 
     @staticmethod
     def compare(got: list[cp.OutChirp], exp: list[cp.OutChirp]) -> None:

@@ -46,9 +46,8 @@ class TB(AxisTB):
         return frames
 
     def status(self) -> dict[str, int]:
-        d = self.dut
-        return {k: int(getattr(d, k).value) for k in (
-            "status_framing_error", "framing_error_count", "frames_in", "frames_out")}
+        return self.read_status((
+            "status_framing_error", "framing_error_count", "frames_in", "frames_out"))
 
     def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
         for k, (g, f) in enumerate(zip(got, sent, strict=True)):
