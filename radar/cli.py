@@ -6,6 +6,7 @@
     radar capture  --scene ... --out FILE.dmacap      (DMA packets of simulated frames)
     radar replay   --capture FILE.dmacap --port P     (send as the board would, over UDP)
     radar receive  --port P --preset ... --json OUT   (decode UDP packets -> point cloud)
+    radar view     --replay F | --udp-port P | --scene S   (live browser view)
     radar gnn      dataset|train|eval|detect ...      (the GNN object detector)
 
 One module per command group under :mod:`radar.commands`. Bad input ends with exit status 2
@@ -18,10 +19,10 @@ import argparse
 import sys
 
 from model.config import PRESETS
-from radar.commands import demo, detect, gnn, link, simulate
+from radar.commands import demo, detect, gnn, link, simulate, view
 from radar.common import CliError
 
-COMMAND_GROUPS = (simulate, detect, demo, link)
+COMMAND_GROUPS = (simulate, detect, demo, link, view)
 """Command modules, each with ``add_parsers(sub, presets)``, in ``--help`` order."""
 
 

@@ -19,7 +19,7 @@ from model.config import RadarConfig
 from model.radar_pipeline import PipelineParams
 from rtlsim.toolchain import build_and_test, rtl_sources
 
-PIPELINE_SOURCES = ("fft/*.sv", "buffers/*.sv", "top/*.sv")
+PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "top/*.sv")
 
 
 def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,

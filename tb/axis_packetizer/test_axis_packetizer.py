@@ -251,7 +251,8 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_axis_packetizer(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("axis_packetizer", rtl_sources("buffers/*.sv"), "test_axis_packetizer", here,
+    run_cocotb("axis_packetizer", rtl_sources("common/*.sv", "buffers/*.sv"),
+               "test_axis_packetizer", here,
                parameters={"DATA_W": 16, **parameters})
 
 

@@ -200,5 +200,6 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_chirp_pingpong(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("chirp_pingpong", rtl_sources("buffers/*.sv"), "test_chirp_pingpong", here,
+    run_cocotb("chirp_pingpong", rtl_sources("common/*.sv", "buffers/*.sv"),
+               "test_chirp_pingpong", here,
                parameters={"DATA_W": 16, **parameters})

@@ -170,7 +170,7 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_corner_turn(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("corner_turn", rtl_sources("buffers/*.sv"), "test_corner_turn", here,
+    run_cocotb("corner_turn", rtl_sources("common/*.sv", "buffers/*.sv"), "test_corner_turn", here,
                parameters={"DATA_W": 16, **parameters})
 
 

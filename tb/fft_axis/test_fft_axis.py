@@ -21,7 +21,7 @@ from cocotbext.axi import AxiStreamFrame
 
 from model import fft_axis as ff
 from model.axis_packetizer import bytes_to_words, words_to_bytes
-from model.fft_rom import write_rom_pkg
+from model.fft_rom import PKG_PATH, render_rom_pkg
 from rtlsim.axis import AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
@@ -377,9 +377,12 @@ if os.environ.get("FFT_AXIS_FULL", "0") not in ("", "0"):
 def run(parameters: dict, testcase: str | None = None,
         extra_env: dict[str, str] | None = None) -> None:
     """Build (once) and run the cocotb tests for one parameter set."""
-    write_rom_pkg()  # the Verilator PCH workaround lives in rtlsim.toolchain
+    # the generated ROM package is never rewritten here (parallel workers, and a stale file
+    # must not be hidden from the up-to-date test): a stale one fails, naming `make gen`
+    if PKG_PATH.read_text() != render_rom_pkg():
+        raise RuntimeError(f"{PKG_PATH} is stale: run `make gen`")
     here = Path(__file__).resolve().parent
-    run_cocotb("fft_axis", rtl_sources("fft/*.sv"), "test_fft_axis", here,
+    run_cocotb("fft_axis", rtl_sources("common/*.sv", "fft/*.sv"), "test_fft_axis", here,
                parameters=parameters, testcase=testcase, extra_env=extra_env)
 
 

@@ -1,4 +1,4 @@
-"""cocotb testbench of ``rtl/top/frame_align.sv`` against ``model/frame_align.py``.
+"""cocotb testbench of ``rtl/buffers/frame_align.sv`` against ``model/frame_align.py``.
 
 Chirp sequences: clean back-to-back frames, chirps lost inside a frame (next chirp marked as
 a gap), a lost frame-start chirp, an early frame start, chirps without frame start after
@@ -169,5 +169,6 @@ PARAMS = [dict(NUM_RX=2, DATA_W=16, N_RANGE=4, FRAME_CHIRPS=6),
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: f"rx{p['NUM_RX']}_n{p['N_RANGE']}")
 def test_frame_align(parameters: dict) -> None:
-    run_cocotb("frame_align", rtl_sources("top/frame_align.sv"), "test_frame_align",
+    run_cocotb("frame_align", rtl_sources("common/*.sv", "buffers/frame_align.sv"),
+               "test_frame_align",
                Path(__file__).parent, parameters)
