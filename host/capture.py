@@ -43,6 +43,15 @@ class CaptureInfo:
         return (self.num_rx, self.num_tx, self.n_range, self.n_doppler) == (
             cfg.num_rx, cfg.num_tx, cfg.n_range, cfg.n_doppler)
 
+    def config(self, configs: Iterable[RadarConfig]) -> RadarConfig:
+        """The configuration among ``configs`` with this capture's geometry (ValueError if
+        none): the capture header carries what ``radar receive`` would otherwise need."""
+        for cfg in configs:
+            if self.matches(cfg):
+                return cfg
+        raise ValueError(f"capture geometry {self.num_tx} TX x {self.num_rx} RX, "
+                         f"{self.n_range} x {self.n_doppler} matches no preset")
+
 
 def frame_packets(cube: np.ndarray, cfg: RadarConfig, packet_words: int, frame_id: int
                   ) -> list[bytes]:

@@ -7,8 +7,9 @@ A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per p
 - ``vx_mps``/``vy_mps``: the radial velocity projected on the line of sight (m/s)
 - ``power_db``: cell power after angle FFT, dB re 1 LSB^2; ``snr_db``: over the local noise
 - ``rcs_dbsm``: RCS estimate from the radar equation, dB re 1 m^2
-- ``range_bin``, ``doppler_bin`` (signed), ``ambiguous`` (bool: the velocity may be aliased,
-  i.e. it lies within one velocity bin of +-vmax or the detection is otherwise flagged)
+- ``range_bin``, ``doppler_bin`` (signed, unfolded), ``ambiguous`` (bool: another velocity
+  within the assumed maximum speed explains the measurement, or the velocity was unfolded by
+  the TDM test; ``host.pipeline`` step 3)
 
 JSON (``to_json_dict``, read back by ``from_json_dict``) follows DESIGN.md section 4:
 ``{"preset", "frames", "points": [...]}`` with the required fields range_m, azimuth_deg,

@@ -29,15 +29,26 @@ RECT_POWER_CORRELATION = (1.0,)
 
 def correlation_sum(mask: np.ndarray, rho_r: tuple[float, ...],
                     rho_d: tuple[float, ...]) -> float:
-    """sum over training-cell pairs of their power correlation (separable windows).
+    """sum over training-cell pairs of their power correlation (separable windows);
+    mask: (rows, cols) training-cell mask (1 = training cell, 0 = not).
 
-    mask: (rows, cols) training-cell mask (nonzero = training cell)."""
-    idx = np.argwhere(mask > 0)
-    dr = np.abs(idx[:, None, 0] - idx[None, :, 0])
-    dd = np.abs(idx[:, None, 1] - idx[None, :, 1])
-    rr = np.array(rho_r + (0.0,) * (mask.shape[0] + 1))[dr]
-    rd = np.array(rho_d + (0.0,) * (mask.shape[1] + 1))[dd]
-    return float(np.sum(rr * rd))
+    Only offsets where rho != 0 contribute, so the pair count per offset (the mask's
+    autocorrelation there) is taken by shifting the mask: O(cells), not O(cells^2)."""
+    total = 0.0
+    nr, nd = mask.shape
+    for dr, cr in enumerate(rho_r):
+        for dd, cd in enumerate(rho_d):
+            if dr >= nr or dd >= nd:
+                continue
+            pairs = float(np.sum(mask[dr:, dd:] * mask[:nr - dr, :nd - dd]))
+            if dd and dr:  # (+dr, +dd) and (+dr, -dd), each counted for both orders
+                pairs += float(np.sum(mask[dr:, :nd - dd] * mask[:nr - dr, dd:]))
+                total += 2 * cr * cd * pairs
+            elif dd or dr:
+                total += 2 * cr * cd * pairs
+            else:
+                total += pairs
+    return total
 
 
 def effective_cells_mask(mask: np.ndarray, windowed: tuple[bool, bool] = (True, True)) -> float:

@@ -19,6 +19,15 @@ Where the paper's numbers disagree (DESIGN.md section 2):
 
 Sampling is complex (I/Q), so a beat frequency in [0, fs) maps to range bins 0..N-1 and the
 maximum range is ``n_range * range_bin_m``.
+
+Range bins and the range edge: the range FFT of a complex IF signal is circular. Bin N-k is
+the beat frequency -k fs/N just as much as (N-k) fs/N: a target at range <= 0 (one that has
+driven past the radar), and the window sidelobes of a strong near target, land in the top
+bins. The detectors therefore treat the range axis as circular (CFAR windows wrap, they are
+not cut) and never report the ``NEGATIVE_BEAT_GUARD_BINS`` top bins nor the
+``DC_GUARD_BINS`` lowest ones (DC offset / TX leakage); :meth:`RadarConfig.detection_bins` is
+that one rule, for the host CFAR and the FPGA detector alike, and
+:attr:`RadarConfig.max_detection_range_m` the largest range a detection can report.
 """
 
 from __future__ import annotations
@@ -35,6 +44,14 @@ BOLTZMANN = 1.380649e-23
 
 FFT_MIN, FFT_MAX = 16, 4096
 """Transform lengths the open FFT core supports (DESIGN.md 3.1)."""
+
+DC_GUARD_BINS = 1
+"""Range bins 0..DC_GUARD_BINS-1 are never detections (DC offset, TX-RX leakage)."""
+NEGATIVE_BEAT_GUARD_BINS = 4
+"""Top range bins N-4..N-1 are never detections: with complex sampling they hold negative
+beat frequencies (range < 0), i.e. only the wrapped window sidelobes of near targets
+(periodic Hann main lobe +-2 bins, first sidelobes at +-2.5 bins) and targets that have
+passed the radar."""
 
 
 def db_to_lin(db: float) -> float:
@@ -194,6 +211,22 @@ class RadarConfig:
     def max_range_m(self) -> float:
         """Largest unambiguous range, n_range * range_bin (beat frequency = fs), m."""
         return self.n_range * self.range_bin_m
+
+    @property
+    def detection_bins(self) -> tuple[int, int]:
+        """Range bins a detector may report: ``lo <= bin < hi`` (see the module docstring:
+        DC guard below, negative-beat guard at the top of the circular range axis)."""
+        return DC_GUARD_BINS, self.n_range - NEGATIVE_BEAT_GUARD_BINS
+
+    @property
+    def max_detection_range_m(self) -> float:
+        """Largest range a detection can report, the start of the top guard band, m."""
+        return self.detection_bins[1] * self.range_bin_m
+
+    @property
+    def min_detection_range_m(self) -> float:
+        """Smallest range a detection can report (end of the DC guard), m."""
+        return self.detection_bins[0] * self.range_bin_m
 
     def beat_frequency_hz(self, range_m: float, radial_velocity_mps: float = 0.0) -> float:
         """Beat frequency of a target, S * 2R / c plus its Doppler shift 2v / lambda, Hz."""

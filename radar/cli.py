@@ -53,6 +53,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"radar {args.command}: error: {exc.strerror or exc}: "
               f"{getattr(exc, 'filename', '') or ''}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"radar {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

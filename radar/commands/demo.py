@@ -9,10 +9,10 @@ import time
 from pathlib import Path
 
 from host.cfar import paper_threshold
-from host.evaluate import match_targets, table3
+from host.evaluate import alias_note, match_targets, table3
 from host.pipeline import DetectionParams, process_cube
 from model.reference import range_doppler_power
-from model.scene import EGO_SPEED_KMH, Scene, table1_scene
+from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
 from radar.figures import truth_range_doppler, truth_xy
 from radar.objects import gnn_objects, object_boxes
@@ -65,19 +65,22 @@ def cmd_demo(args: argparse.Namespace) -> int:
     ra_nobf, _ = range_azimuth_power(cube_nobf, cfg)
     figs.append(plot_range_azimuth_pair(
         [(ra_bf, "TX subarray beamforming (3 elements)"), (ra_nobf, "single TX element")],
-        az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom))
-    objects = gnn_objects(cloud, EGO_SPEED_KMH / 3.6) if not args.no_gnn else []
+        az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom,
+        note=alias_note(scene.targets, cfg)))
+    ego = default_ego_speed_mps(scene)  # the same default as radar detect / radar gnn detect
+    objects = gnn_objects(cloud, ego) if not args.no_gnn else []
     if not args.no_gnn:
-        print(f"GNN (synthetic-trained checkpoint; ego {EGO_SPEED_KMH:.0f} km/h is beyond its "
+        print(f"GNN (synthetic-trained checkpoint; ego {ego * 3.6:.0f} km/h is beyond its "
               f"training range): " + (", ".join(
                   f"{o['class']} {o['score']:.2f} at ({o['x_m']:.1f}, {o['y_m']:.1f}) m"
                   for o in objects) or "no objects"))
+    missed = [f"V{i + 1}" for i, m in enumerate(matches) if m.index < 0]
     figs.append(plot_point_cloud(cloud.x_m, cloud.y_m, cloud.snr_db, out / "point_cloud.png",
                                  f"{cfg.name}: Table I point cloud" + (
                                      " and GNN objects" if objects else ""),
-                                 truth_xy(scene), object_boxes(objects)))
+                                 truth_xy(scene, "V"), object_boxes(objects), missed))
     doc = cloud.to_json_dict(cfg.name, 1)
-    doc["objects"] = objects
+    doc.update({"ego_speed_mps": ego, "objects": objects})
     (out / "table1_points.json").write_text(json.dumps(doc, indent=1))
     print(f"figures in {out}/: " + ", ".join(p.name for p in figs)
           + f" ({time.perf_counter() - t0:.1f} s)")

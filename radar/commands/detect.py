@@ -15,31 +15,38 @@ import numpy as np
 
 from host.pipeline import process_cube
 from host.pointcloud import PointCloud
+from model.observability import scene_report
 from model.simulate import simulate_scene
 from radar.common import (
     CliError,
     add_detection_options,
+    count,
     detection_params,
     ego_speed_mps,
     out_file,
     progress,
     scene_of,
+    warn,
 )
 from radar.figures import detect_plots
 from radar.objects import describe, gnn_objects, object_boxes
 from radar.sources import SOURCES, SourceError, get_source
 
+MAX_DETECT_FRAMES = 10_000
+"""Largest --frames (90 s of radar time; the command keeps every cloud in memory)."""
+
 
 def cmd_detect(args: argparse.Namespace) -> int:
     scene = scene_of(args)
     out = out_file(args.json, ".json", "--json")
-    if args.frames < 1:
-        raise CliError("--frames: must be >= 1")
+    count(args.frames, "--frames", MAX_DETECT_FRAMES)
     cfg = scene.config
-    params = detection_params(args, scene.tx_beamforming)
+    params = detection_params(args, scene.tx_beamforming, cfg)
     clouds, per_frame, objects = [], [], []
     last_cube = None
     ego = ego_speed_mps(args, scene)
+    report, warnings = scene_report(scene, range(args.frames), params.max_speed_mps)
+    warn(warnings, "detect")
     t0 = time.perf_counter()
     saturated: list[int] = []
 
@@ -59,10 +66,17 @@ def cmd_detect(args: argparse.Namespace) -> int:
             last_cube = cube
     except SourceError as exc:
         raise CliError(f"--backend {args.backend}: {exc}") from None
+    except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
+        raise CliError(str(exc)) from None
+    clipped = [k for k, n in enumerate(saturated) if n]
+    if clipped:
+        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
+              f"harmonics of the clipped echo can appear as false points"], "detect")
     cloud = PointCloud.concat(clouds)
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
     doc.update({"backend": args.backend, "detector": args.detector, "scene": scene.name,
-                "frame_info": per_frame})
+                "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
+                "frame_info": per_frame, **report})
     if args.gnn:
         doc["objects"] = objects
     out.write_text(json.dumps(doc, indent=1))
@@ -88,7 +102,8 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="; ".join(f"{name}: {src.help}" for name, src in SOURCES.items()))
     d.add_argument("--plots", default=None, help="folder for a range-Doppler map and the "
                                                  "x-y point cloud of the last frame")
-    d.add_argument("--frames", type=int, default=1, help="frames to process (default 1)")
+    d.add_argument("--frames", type=int, default=1,
+                   help=f"frames to process, 1..{MAX_DETECT_FRAMES} (default 1)")
     d.add_argument("--preset", choices=presets, default=None,
                    help="override the scene's radar preset")
     d.add_argument("--gnn", action="store_true",
@@ -96,6 +111,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "\"objects\" (class, score, rotated box, point indices) to the JSON")
     d.add_argument("--ego-speed", type=float, default=None,
                    help="ego speed along +x for the GNN's velocity compensation, m/s "
-                        "(default: 27.78 for table1, else 0)")
+                        "(default: 27.78 for table1, else 0; written to the JSON, where "
+                        "`radar gnn detect --points` picks it up)")
     add_detection_options(d)
     d.set_defaults(func=cmd_detect)

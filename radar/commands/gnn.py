@@ -89,7 +89,10 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     src.add_argument("--points", default=None, help="point cloud JSON (DESIGN.md section 4)")
     src.add_argument("--scene", default=None,
                      help="scene JSON or built-in name, simulated through the host chain")
-    p.add_argument("--ego-speed", type=float, default=0.0, help="ego speed along +x, m/s")
+    p.add_argument("--ego-speed", type=float, default=None,
+                   help="ego speed along +x, m/s (default as `radar detect --gnn`: the "
+                        "scene's, 27.78 for table1, else 0; with --points the ego_speed_mps "
+                        "recorded in the JSON, else 0)")
     p.add_argument("--checkpoint", default=None, help="checkpoint (default: shipped one)")
     p.add_argument("--json", default=None, metavar="OUT.json", help="write the objects here")
     p.set_defaults(func=_guarded(tasks.cmd_detect))

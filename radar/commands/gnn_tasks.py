@@ -84,15 +84,21 @@ def cmd_eval(args: argparse.Namespace) -> int:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     from gnn.infer import detect_objects
+    from model.scene import check_ego_speed, default_ego_speed_mps
 
+    # the ego speed defaults as in `radar detect --gnn`: the scene's (100 km/h for table1,
+    # else 0), and for a point cloud JSON the ego_speed_mps that `radar detect` wrote in it
     if args.points is not None:
         cloud = read_points(Path(args.points))
+        ego = args.ego_speed if args.ego_speed is not None else _json_ego(Path(args.points))
     else:
         from gnn.render import render_points
         from model.scene import load_scene
 
-        cloud = render_points(load_scene(args.scene), "pipeline")
-    objs = detect_objects(cloud, args.ego_speed, args.checkpoint)
+        scene = load_scene(args.scene)
+        cloud = render_points(scene, "pipeline")
+        ego = args.ego_speed if args.ego_speed is not None else default_ego_speed_mps(scene)
+    objs = detect_objects(cloud, check_ego_speed(ego), args.checkpoint)
     text = json.dumps({"points": len(cloud), "objects": objs}, indent=1)
     if args.json is not None:
         Path(args.json).write_text(text + "\n")
@@ -101,6 +107,14 @@ def cmd_detect(args: argparse.Namespace) -> int:
               f"{o['length_m']:5.2f} x {o['width_m']:4.2f} m  {o['heading_deg']:7.1f} deg  "
               f"{len(o['points'])} points")
     return 0
+
+
+def _json_ego(path: Path) -> float:
+    """``ego_speed_mps`` recorded in a point cloud JSON by ``radar detect`` (0 if absent)."""
+    value = json.loads(path.read_text()).get("ego_speed_mps", 0.0)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"points: {path}: ego_speed_mps must be a number, got {value!r}")
+    return float(value)
 
 
 def read_points(path: Path) -> PointCloud:

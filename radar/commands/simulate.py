@@ -3,27 +3,33 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 
-from model.simulate import simulate_scene
-from radar.common import CliError, out_file, scene_of
+from host.pipeline import MAX_RADIAL_SPEED_MPS
+from model.observability import scene_report
+from model.simulate import MAX_FRAME_INDEX, check_frame_index, simulate_scene
+from radar.common import CliError, out_file, scene_of, warn
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     scene = scene_of(args)
     out = out_file(args.out, ".npy", "--out")
-    if args.frame < 0:
-        raise CliError("--frame: must be >= 0")
+    try:
+        check_frame_index(args.frame)
+    except ValueError as exc:
+        raise CliError(f"--{exc}") from None
+    _, warnings = scene_report(scene, [args.frame], MAX_RADIAL_SPEED_MPS)
+    warn(warnings, "simulate")
     frame = simulate_scene(scene, frame_index=args.frame)
     np.save(out, frame.samples)
     print(f"wrote {out}: complex64 {frame.samples.shape} (chirps in transmit order, rx, "
           f"samples), preset {scene.config.name}, {len(scene.scatterers())} scatterers, "
-          f"{frame.saturated} saturated I/Q values, {frame.dropped_scatterers} scatterers "
-          f"beyond the IF band")
+          f"{frame.saturated} saturated I/Q values, {frame.passed_scatterers} scatterers "
+          f"at range <= 0 (passed the radar) and {frame.beyond_if_scatterers} beyond the IF "
+          f"band not simulated")
     if frame.saturated:
-        print(f"warning: {frame.saturated} ADC values clipped at full scale", file=sys.stderr)
+        warn([f"{frame.saturated} ADC values clipped at full scale"], "simulate")
     return 0
 
 
@@ -39,5 +45,6 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     s.add_argument("--preset", choices=presets, default=None,
                    help="override the scene's radar preset")
     s.add_argument("--frame", type=int, default=0,
-                   help="frame index: targets move v*frame*frame_time, fresh noise (default 0)")
+                   help=f"frame index 0..{MAX_FRAME_INDEX}: targets move v*frame*frame_time, "
+                        f"fresh noise (default 0)")
     s.set_defaults(func=cmd_simulate)

@@ -133,7 +133,7 @@ def build(args: argparse.Namespace, stop: threading.Event
     else:
         try:
             rx = UdpReceiver(args.udp_host, args.udp_port)
-        except OSError as exc:
+        except (OSError, ValueError) as exc:  # ValueError: port outside 0..65535
             raise CliError(f"--udp-port: {exc}") from None
         desc = f"UDP {args.udp_host}:{rx.port}"
         processor.source = desc
