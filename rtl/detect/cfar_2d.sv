@@ -357,22 +357,13 @@ module cfar_2d #(
   logic unused_ok;
   assign unused_ok = ^s_axis_tdata;
 
-`ifndef SYNTHESIS
-  logic          m_stall_q;
-  logic [FW-1:0] m_held_q;
-  always_ff @(posedge clk) begin
-    if (rst) begin
-      m_stall_q <= 1'b0;
-    end else begin
-      m_stall_q <= m_axis_tvalid && !m_axis_tready;
-      if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("%m: TVALID dropped while stalled");
-        assert (fifo_tdata == m_held_q) else $error("%m: TDATA/TLAST/TUSER changed while stalled");
-      end
-    end
-    m_held_q <= fifo_tdata;
-  end
-`endif
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(IN_W + 1), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(OUT_W + 1 + $clog2(N_RANGE) + $clog2(N_DOPPLER))) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
 
 endmodule
 

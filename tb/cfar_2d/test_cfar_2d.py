@@ -199,5 +199,5 @@ if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     f"{k}{v}" for k, v in p.items()))
 def test_cfar_2d(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("buffers/buf_*.sv"), *rtl_sources("detect/cfar_2d.sv")]
+    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/cfar_2d.sv")]
     run_cocotb("cfar_2d", sources, "test_cfar_2d", here, parameters=parameters)

@@ -175,6 +175,6 @@ if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     f"{k}{v}" for k, v in p.items()) if isinstance(p, dict) else f"pfa{p:g}")
 def test_detect_chain(parameters: dict, pfa: float) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("buffers/buf_*.sv"), *rtl_sources("detect/*.sv")]
+    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/*.sv")]
     run_cocotb("detect_chain", sources, "test_detect_chain", here, parameters=parameters,
                extra_env={"DETECT_PFA": repr(pfa)})

@@ -176,5 +176,5 @@ if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     f"{k}{v}" for k, v in p.items()))
 def test_nci(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("buffers/buf_*.sv"), *rtl_sources("detect/nci.sv")]
+    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/nci.sv")]
     run_cocotb("nci", sources, "test_nci", here, parameters={"DATA_W": 16, **parameters})
