@@ -57,6 +57,7 @@ lint: $(STAMP)
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
+	$(RUN) python -m model.bench_model
 	$(RUN) python -m host.bench_host
 
 bench-rtl: $(STAMP)
