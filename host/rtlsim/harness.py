@@ -151,14 +151,18 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
                 chain: PipelineParams | None = None, *, seed: int = 1,
                 adc_gap: float = 0.0, dma_stall: float = 0.0, chirp_gap: int = 0,
                 segment_frames: int = 0, mem_latency: int = 20, mem_stall: float = 0.0,
-                frame_store: bool = False, timeout: int | None = None) -> HarnessRun:
+                frame_store: bool = False, timeout: int | None = None,
+                quiet: int = 0) -> HarnessRun:
     """Stream ``adc_frames`` (each complex (n_chirps, num_rx, n_range) int16 I/Q) through the
     Verilated ``radar_pipeline``.
 
     ``adc_gap``: probability of TVALID low per clock; ``chirp_gap``: idle clocks after each
     chirp; ``dma_stall``: probability of TREADY low per clock; ``segment_frames``: frames
     between resets (0: one reset at the start only); ``mem_latency`` / ``mem_stall``: the
-    AXI4 memory model of a ``FRAME_STORE = 1`` top. Deterministic for a given ``seed``.
+    AXI4 memory model of a ``FRAME_STORE = 1`` top; ``quiet``: end a segment once its input
+    is sent and the DMA was idle that many clocks (for runs that lose frames on purpose; 0:
+    every packet must arrive, else RuntimeError after ``timeout`` idle clocks).
+    Deterministic for a given ``seed``.
     """
     chain = chain or PipelineParams()
     if not adc_frames:
@@ -180,7 +184,7 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
                "--frames", str(len(adc_frames)), "--segment-frames", str(segment_frames),
                "--packets-per-frame", str(ppf), "--seed", str(seed),
                "--adc-gap", repr(float(adc_gap)), "--dma-stall", repr(float(dma_stall)),
-               "--chirp-gap", str(chirp_gap), "--timeout", str(timeout),
+               "--chirp-gap", str(chirp_gap), "--timeout", str(timeout), "--quiet", str(quiet),
                "--mem-latency", str(mem_latency), "--mem-stall", repr(float(mem_stall))]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:

@@ -17,7 +17,8 @@
 // segment). Random ADC gaps (TVALID low with probability --adc-gap per cycle, plus
 // --chirp-gap idle cycles after each chirp), DMA backpressure (TREADY low with probability
 // --dma-stall) and memory stalls come from one seed (--seed): the same arguments give the
-// same cycles. Exit status: 0 ok, 2 bad arguments or files, 3 timeout (no DMA word for
+// same cycles. --quiet N: a segment also ends once its input is sent and no DMA word came
+// for N cycles (for runs that lose frames on purpose; 0: every packet must arrive). Exit status: 0 ok, 2 bad arguments or files, 3 timeout (no DMA word for
 // --timeout cycles while packets are missing).
 #include <verilated.h>
 
@@ -51,6 +52,7 @@ struct Args {
   double dma_stall = 0.0;
   int chirp_gap = 0;
   uint64_t timeout = 1000000;
+  uint64_t quiet = 0;
   int mem_latency = 20;
   double mem_stall = 0.0;
 };
@@ -79,6 +81,7 @@ Args parse(int argc, char** argv) {
     else if (k == "--dma-stall") a.dma_stall = std::atof(v.c_str());
     else if (k == "--chirp-gap") a.chirp_gap = std::atoi(v.c_str());
     else if (k == "--timeout") a.timeout = std::strtoull(v.c_str(), nullptr, 0);
+    else if (k == "--quiet") a.quiet = std::strtoull(v.c_str(), nullptr, 0);
     else if (k == "--mem-latency") a.mem_latency = std::atoi(v.c_str());
     else if (k == "--mem-stall") a.mem_stall = std::atof(v.c_str());
     else fail(2, "unknown option " + k);
@@ -225,6 +228,7 @@ class Harness {
         ++idx;
         valid = false;
       }
+      if (a_.quiet && idx == end && cycles_ - last_dma_cycle_ > a_.quiet) break;
       if (cycles_ - last_dma_cycle_ > a_.timeout)
         fail(3, "timeout: no DMA word for " + std::to_string(a_.timeout) + " cycles, " +
                     std::to_string(seg_packets_) + " of " + std::to_string(want) +
