@@ -10,7 +10,7 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint bench bench-rtl gnn-dataset gnn-train gnn-eval \
+.PHONY: all setup demo test test-python sim lint bench bench-rtl soak gnn-dataset gnn-train gnn-eval \
         clean help
 all: test
 
@@ -22,6 +22,7 @@ help:
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
@@ -63,6 +64,12 @@ bench: $(STAMP)
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
+	$(RUN) python -m host.rtlsim.bench_harness
+
+# not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
+SOAK_FRAMES ?= 1000
+soak: $(STAMP)
+	$(RUN) python -m host.rtlsim.soak --frames $(SOAK_FRAMES)
 
 include synth/synth.mk
 

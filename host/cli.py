@@ -102,9 +102,10 @@ def _model_frames(scene: Scene, frames: int, params: DetectionParams, backend: s
 
 
 def _rtl_frames(scene: Scene, frames: int, params: DetectionParams):
-    """The same through the Verilated radar_pipeline: simulated ADC frames stream through
-    the RTL back to back; its DMA packets are decoded like the board's."""
-    from host.rtlsim.pipeline_rtl import run_pipeline_rtl
+    """The same through the Verilated radar_pipeline (the C++ harness, host.rtlsim.harness):
+    simulated ADC frames stream through the RTL back to back; its DMA packets are decoded
+    like the board's."""
+    from host.rtlsim.harness import run_pipeline
     from host.stream import StreamDecoder
 
     cfg = scene.config
@@ -118,7 +119,7 @@ def _rtl_frames(scene: Scene, frames: int, params: DetectionParams):
     print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters); the first "
           f"build takes a minute or two", file=sys.stderr)
     try:
-        packets, status = run_pipeline_rtl([a.samples for a in adcs], cfg, chain)
+        packets, status = run_pipeline([a.samples for a in adcs], cfg, chain)
     except (RuntimeError, FileNotFoundError, ImportError) as exc:
         raise CliError(f"--backend rtl: {exc}") from None
     dec = StreamDecoder(cfg, chain.packet_words)
