@@ -31,6 +31,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "harness_config.h"
@@ -105,8 +106,9 @@ class Harness {
     rng_adc_.seed(harness::stream_seed(a.seed, 1));
     rng_dma_.seed(harness::stream_seed(a.seed, 2));
 #ifdef HARNESS_FRAME_STORE
-    mem_.reset(new harness::Axi4Mem(a.mem_latency, a.mem_stall,
-                                    harness::stream_seed(a.seed, 3)));
+    mem_.reset(new harness::Axi4Mem(
+        a.mem_latency, a.mem_stall, harness::stream_seed(a.seed, 3),
+        static_cast<int>(sizeof(std::declval<Top>().m_axi_mem_wdata))));
 #endif
     load_adc();
   }
@@ -247,7 +249,8 @@ class Harness {
 #undef HARNESS_STATUS_FIELD
 #ifdef HARNESS_FRAME_STORE
     s += ", \"mem_writes\": " + std::to_string(mem_->beats_written()) +
-         ", \"mem_reads\": " + std::to_string(mem_->beats_read());
+         ", \"mem_reads\": " + std::to_string(mem_->beats_read()) +
+         ", \"mem_protocol_errors\": " + std::to_string(mem_->protocol_errors());
 #endif
     return s + "}";
   }
