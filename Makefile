@@ -64,7 +64,7 @@ bench: $(STAMP)
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
-	$(RUN) python -m host.rtlsim.bench_harness
+	$(RUN) python tb/radar_pipeline/bench_harness.py
 
 # not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
 SOAK_FRAMES ?= 1000

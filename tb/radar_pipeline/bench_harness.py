@@ -1,6 +1,6 @@
 """Benchmark: the Verilator-native C++ harness against the cocotb path, same RTL, same run.
 
-    python -m host.rtlsim.bench_harness [--frames 3] [--full]
+    tools/venv-run python tb/radar_pipeline/bench_harness.py [--frames 3] [--full]
 
 Rows (``paper-fpga`` top, frames back to back at one sample per clock, DMA always ready):
 clocks simulated, the simulation loop's cycles per second and the end-to-end wall time per
@@ -17,15 +17,20 @@ Timing is reported, never asserted in tests.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import os
+import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("COCOTB_LOG_LEVEL", "WARNING")
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE.parent), str(HERE)]
+
+from bench_radar_pipeline import measure  # noqa: E402
 
 from host.rtlsim.harness import build_harness, run_harness  # noqa: E402
 from host.rtlsim.pipeline_rtl import run_pipeline_rtl  # noqa: E402
-from host.rtlsim.toolchain import REPO, SIM_BUILD  # noqa: E402
+from host.rtlsim.toolchain import SIM_BUILD  # noqa: E402
 from model.config import get_preset  # noqa: E402
 from model.pipeline import PipelineParams, dma_packets  # noqa: E402
 from model.scene import table1_scene  # noqa: E402
@@ -35,11 +40,7 @@ from model.simulate import simulate_scene  # noqa: E402
 def cocotb_loop_speed() -> float:
     """Cycles per second of the cocotb simulation loop alone (the ``throughput_latency``
     test of tb/radar_pipeline, 3 paper-fpga frames, via its benchmark script)."""
-    path = REPO / "tb" / "radar_pipeline" / "bench_radar_pipeline.py"
-    spec = importlib.util.spec_from_file_location("bench_radar_pipeline", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    r = mod.measure("paper-fpga")
+    r = measure("paper-fpga")
     return r["sim_cycles"] / r["wall_s"]
 
 
