@@ -294,8 +294,9 @@ def _fft_chunk(p: np.ndarray, n: int, inverse: bool, scale_sch: int, w: int, gua
         p, out = out, p
         if tw[s] is not None:  # twiddle after the pair (s-1, s): exact in complex128
             z = p.astype(np.float64).view(np.complex128)[..., 0]     # (c, n, lanes)
-            z *= tw[s][None, :, None]
-            zf = _rint_scaled(z.view(np.float64).reshape(p.shape), COEF_FRAC)
+            z *= tw[s][None, :, None]                    # twiddles pre-scaled by 2**-16
+            zf = np.rint(z.view(np.float64).reshape(p.shape), out=z.view(np.float64)
+                         .reshape(p.shape))
             sat_w.bound = np.floor(sat_w.bound * TWIDDLE_GAIN) + 1.0
             ov = _or(ov, sat_w(zf))
             p[...] = zf
@@ -331,8 +332,10 @@ def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = Fal
         if s + 1 < lg:
             kk = twiddle_index(n, n >> (s - 1))
             sgn = 1.0 if inverse else -1.0        # (re + j im) * (C -+ j S)
-            tw[s] = cos_t[kk].astype(np.float64) + 1j * sgn * sin_t[kk].astype(np.float64)
-    h = hann_window(n).astype(np.float64)[None, :, None, None] if window else None
+            tw[s] = (cos_t[kk] + 1j * sgn * sin_t[kk]) * 2.0 ** -COEF_FRAC
+    # window and its rounding shift in one exact factor (x * h < 2**31, scaled by 2**-k)
+    h = (hann_window(n) * 2.0 ** (guard_w - COEF_FRAC))[None, :, None, None] if window \
+        else None
     br = bitrev(n)
     y = np.empty((frames, n, lanes, 2), dtype=dt)
     ov = np.zeros((frames, n), dtype=bool)
@@ -340,8 +343,7 @@ def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = Fal
     for f0 in range(0, frames, step):
         sl = slice(f0, min(f0 + step, frames))
         if window:
-            x = _rint_scaled(p[sl].astype(np.float64, order="C") * h,
-                             COEF_FRAC - guard_w).astype(dt)
+            x = np.rint(p[sl] * h).astype(dt, order="C")
         else:
             x = p[sl].astype(dt, order="C") * float(1 << guard_w)
         out, o = _fft_chunk(x, n, inverse, scale_sch, w, guard_w, data_w, tw)
