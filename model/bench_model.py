@@ -53,7 +53,8 @@ def main() -> None:
         t_float = best_of(lambda a=adc, c=cfg: radar_cube(a, c), args.repeat)
         goal = ""
         if preset == "full":
-            goal = "<= 1 s " + ("met" if t_fast <= 1.0 else "MISSED")
+            goal = "<= 1 s: wall " + ("met" if t_fast <= 1.0 else "MISSED") + ", CPU " + (
+                "met" if cpu_fast <= 1.0 else "MISSED")
         print(f"{preset:<11} {t_ref:>11.3f} {t_fast:>8.3f} {t_ref / t_fast:>6.1f} "
               f"{cpu_fast:>10.3f} {t_dma:>13.3f} {t_float:>11.3f} {goal:>8}")
     print("fast cpu s: CPU time of the fast path (close to its wall time on an idle machine)")
