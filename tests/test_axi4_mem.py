@@ -24,6 +24,7 @@ struct Top {
   CData s_axis_adc_tuser;
   VlWide<4> m_axis_dma_tdata; CData m_axis_dma_tvalid, m_axis_dma_tready, m_axis_dma_tlast;
   CData status_adc_overflow; IData packets_out;
+  CData m_axi_mem_awid, m_axi_mem_arid, m_axi_mem_bid, m_axi_mem_rid;
   QData m_axi_mem_awaddr; CData m_axi_mem_awlen, m_axi_mem_awsize, m_axi_mem_awburst;
   CData m_axi_mem_awvalid, m_axi_mem_awready;
   VlWide<16> m_axi_mem_wdata; QData m_axi_mem_wstrb; CData m_axi_mem_wlast, m_axi_mem_wvalid,

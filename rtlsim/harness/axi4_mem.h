@@ -13,6 +13,7 @@
 // - Protocol checks, counted (protocol_errors()) and the first one kept (first_error()):
 //   INCR burst crossing 4 KiB, WLAST on the wrong beat, unaligned WRAP or bad WRAP length,
 //   burst type 3, size above the data width.
+// - IDs: BID / RID echo AWID / ARID; responses stay in order (allowed for any IDs).
 //
 // Core API (no Verilator types; unit-checked by axi4_mem_test.cpp): set In, read Out,
 // call clock(). Out is what the slave drives during the current cycle; clock(in, cycle)
@@ -41,6 +42,7 @@ class Axi4Mem {
 
   struct In {
     bool awvalid = false;
+    uint32_t awid = 0, arid = 0;
     uint64_t awaddr = 0;
     uint32_t awlen = 0, awsize = 0, awburst = 1;
     bool wvalid = false;
@@ -56,7 +58,7 @@ class Axi4Mem {
   struct Out {
     bool awready = false, wready = false, bvalid = false, arready = false, rvalid = false;
     bool rlast = false;
-    uint32_t bresp = 0, rresp = 0;
+    uint32_t bresp = 0, rresp = 0, bid = 0, rid = 0;
     uint32_t rdata[kMaxWords] = {};
   };
 
@@ -72,7 +74,7 @@ class Axi4Mem {
   void clock(const In& in, uint64_t cycle) {
     // AW
     if (in.awvalid && out_.awready) {
-      Burst b = make_burst(in.awaddr, in.awlen, in.awsize, in.awburst, cycle);
+      Burst b = make_burst(in.awaddr, in.awlen, in.awsize, in.awburst, cycle, in.awid);
       aw_.push_back(b);
     }
     // W: data of the oldest accepted write address
@@ -96,7 +98,7 @@ class Axi4Mem {
                                   std::to_string(b.len + 1) + "-beat write");
       ++written_;
       if (last) {
-        b_.push_back(cycle + latency_);
+        b_.push_back({cycle + latency_, b.id});
         aw_.pop_front();
       } else {
         ++b.beat;
@@ -109,7 +111,8 @@ class Axi4Mem {
     }
     // AR
     if (in.arvalid && out_.arready) ar_.push_back(make_burst(in.araddr, in.arlen, in.arsize,
-                                                            in.arburst, cycle + latency_));
+                                                            in.arburst, cycle + latency_,
+                                                            in.arid));
     // R
     if (out_.rvalid && in.rready) {
       Burst& b = ar_.front();
@@ -147,6 +150,8 @@ class Axi4Mem {
     top.m_axi_mem_wready = out_.wready;
     top.m_axi_mem_bvalid = out_.bvalid;
     top.m_axi_mem_bresp = out_.bresp;
+    top.m_axi_mem_bid = out_.bid;
+    top.m_axi_mem_rid = out_.rid;
     top.m_axi_mem_arready = out_.arready;
     top.m_axi_mem_rvalid = out_.rvalid;
     top.m_axi_mem_rlast = out_.rlast;
@@ -157,6 +162,8 @@ class Axi4Mem {
   void sample(T& top, uint64_t cycle) {
     In in;
     in.awvalid = top.m_axi_mem_awvalid;
+    in.awid = top.m_axi_mem_awid;
+    in.arid = top.m_axi_mem_arid;
     in.awaddr = top.m_axi_mem_awaddr;
     in.awlen = top.m_axi_mem_awlen;
     in.awsize = top.m_axi_mem_awsize;
@@ -181,9 +188,15 @@ class Axi4Mem {
     uint64_t addr;
     uint32_t len, size, type, beat;
     uint64_t ready_at;
+    uint32_t id;
+  };
+  struct Resp {
+    uint64_t ready_at;
+    uint32_t id;
   };
 
-  Burst make_burst(uint64_t addr, uint32_t len, uint32_t size, uint32_t type, uint64_t at) {
+  Burst make_burst(uint64_t addr, uint32_t len, uint32_t size, uint32_t type, uint64_t at,
+                   uint32_t id) {
     if (len > 255) error("burst length " + std::to_string(len + 1) + " > 256");
     if ((1 << size) > bytes_) error("AxSIZE " + std::to_string(size) + " above data width");
     if (type == 3) error("reserved burst type 3");
@@ -197,7 +210,7 @@ class Axi4Mem {
       if (len != 1 && len != 3 && len != 7 && len != 15) error("WRAP length not 2/4/8/16");
       if (addr & ((uint64_t{1} << size) - 1)) error("unaligned WRAP burst");
     }
-    return Burst{addr, len & 255u, size, type, 0, at};
+    return Burst{addr, len & 255u, size, type, 0, at, id};
   }
 
   uint64_t beat_addr(const Burst& b) const {
@@ -222,7 +235,10 @@ class Axi4Mem {
     out_.awready = aw_.size() < kMaxOutstanding && !chance(rng_, stall_);
     out_.wready = !aw_.empty() && !chance(rng_, stall_);
     out_.arready = ar_.size() < kMaxOutstanding && !chance(rng_, stall_);
-    if (!bvalid_held_) bvalid_held_ = !b_.empty() && b_.front() <= cycle && !chance(rng_, stall_);
+    if (!bvalid_held_) {
+      bvalid_held_ = !b_.empty() && b_.front().ready_at <= cycle && !chance(rng_, stall_);
+      if (bvalid_held_) out_.bid = b_.front().id;
+    }
     out_.bvalid = bvalid_held_;
     out_.bresp = 0;
     if (!rvalid_held_) {
@@ -234,6 +250,7 @@ class Axi4Mem {
         std::memset(out_.rdata, 0, sizeof(out_.rdata));
         for (int i = 0; i < bytes_; ++i) dst[i] = byte(a - (a % bytes_) + i);
         out_.rlast = b.beat == b.len;
+        out_.rid = b.id;
       }
     }
     out_.rvalid = rvalid_held_;
@@ -256,7 +273,7 @@ class Axi4Mem {
   std::mt19937_64 rng_;
   Out out_;
   std::deque<Burst> aw_, ar_;
-  std::deque<uint64_t> b_;
+  std::deque<Resp> b_;
   bool rvalid_held_ = false, bvalid_held_ = false;
   uint64_t written_ = 0, read_ = 0, errors_ = 0;
   std::string first_error_;

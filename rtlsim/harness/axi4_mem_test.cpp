@@ -73,6 +73,7 @@ uint64_t run(int latency, double stall, uint64_t seed, int bytes, int n_ops) {
       if (op.write) {
         in.awvalid = !addr_done;
         in.awaddr = op.addr;
+        in.awid = static_cast<uint32_t>(op.addr >> 12) & 7u;
         in.awlen = op.len;
         in.wvalid = addr_done && beat <= op.len && (rng() % 4 != 0);
         if (in.wvalid) {
@@ -84,6 +85,7 @@ uint64_t run(int latency, double stall, uint64_t seed, int bytes, int n_ops) {
         if (out.bvalid) {
           check(wlast_sent && cycle >= wlast_cycle + latency,
                 "B before latency: cycle " + std::to_string(cycle));
+          check(out.bid == (static_cast<uint32_t>(op.addr >> 12) & 7u), "BID not AWID");
           if (in.bready) done = true;
         }
         if (in.awvalid && out.awready) addr_done = true;
@@ -97,6 +99,7 @@ uint64_t run(int latency, double stall, uint64_t seed, int bytes, int n_ops) {
       } else {
         in.arvalid = !addr_done;
         in.araddr = op.addr;
+        in.arid = static_cast<uint32_t>(op.addr >> 12) & 7u;
         in.arlen = op.len;
         in.rready = rng() % 3 != 0;
         if (prev_rvalid_stalled) {
@@ -112,6 +115,7 @@ uint64_t run(int latency, double stall, uint64_t seed, int bytes, int n_ops) {
                       " cycles after AR, latency " + std::to_string(latency));
           }
           check(out.rlast == (beat == op.len), "RLAST on beat " + std::to_string(beat));
+          check(out.rid == (static_cast<uint32_t>(op.addr >> 12) & 7u), "RID not ARID");
           if (in.rready) {
             const uint8_t* got = reinterpret_cast<const uint8_t*>(out.rdata);
             const uint64_t base = op.addr + uint64_t{beat} * bytes;
