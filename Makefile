@@ -10,7 +10,8 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint bench bench-rtl soak gnn-dataset gnn-train gnn-eval \
+.PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
+        gnn-eval \
         clean help
 all: test
 
@@ -20,6 +21,7 @@ help:
 	@echo "make test            whole regression (pytest -n $(JOBS))"
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
+	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
@@ -54,7 +56,12 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
-	$(RUN) ruff check model host gnn tb tests tools synth
+	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth
+
+# Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
+gen: $(STAMP)
+	$(RUN) python -m model.fft_rom
+	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
@@ -69,22 +76,22 @@ bench-rtl: $(STAMP)
 # not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
 SOAK_FRAMES ?= 1000
 soak: $(STAMP)
-	$(RUN) python -m host.rtlsim.soak --frames $(SOAK_FRAMES)
+	$(RUN) python -m rtlsim.harness.soak --frames $(SOAK_FRAMES)
 
 include synth/synth.mk
 
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 
 gnn-dataset: $(STAMP)
-	$(RUN) python -m gnn.cli dataset --train 700 --val 500 --test 200 --workers 2
+	$(RUN) radar gnn dataset --train 700 --val 500 --test 200 --workers 2
 
 gnn-train: $(STAMP)
-	$(RUN) python -m gnn.cli train --epochs 50 --hidden 64 --layers 3 \
+	$(RUN) radar gnn train --epochs 50 --hidden 64 --layers 3 \
 	  --data $(GNN_CACHE)/train.npz $(GNN_CACHE)/val.npz
 
 gnn-eval: $(STAMP)
 	mkdir -p $(OUT)
-	$(RUN) python -m gnn.cli eval --json $(OUT)/gnn_eval.json
+	$(RUN) radar gnn eval --json $(OUT)/gnn_eval.json
 	$(RUN) python -m gnn.bench_infer
 
 clean:

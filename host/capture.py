@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import RadarConfig
-from model.packetizer import cube_to_payload, packetize, words_to_bytes
 from model.reference import cube_to_dma_order
 
 MAGIC = b"RDMACAP1"

@@ -148,10 +148,7 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
                  frame: int = 0) -> PointCloud:
     """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
     params = params or DetectionParams()
-    expected = (cfg.n_virtual, cfg.n_range, cfg.n_doppler)
-    if cube.shape != expected:
-        raise ValueError(f"cube: expected shape {expected} for preset {cfg.name!r}, got "
-                         f"{cube.shape}")
+    cfg.check_cube(cube)
     cells, noise, nci = detect_cells(cube, cfg, params)
     logp = np.log(np.maximum(nci, 1e-30))
     nr, nd = cfg.n_range, cfg.n_doppler

@@ -1,8 +1,8 @@
 """Incremental decoding of the FPGA's DMA stream into radar cubes.
 
 The packet format (header word layout, payload order) is defined once, in
-``model.packetizer`` (mirrored by ``rtl/buffers/axis_packetizer.sv``); this module groups
-arriving packets into frames and hands each frame to ``model.packetizer.depacketize``, which
+``model.axis_packetizer`` (mirrored by ``rtl/buffers/axis_packetizer.sv``); this module groups
+arriving packets into frames and hands each frame to ``model.axis_packetizer.depacketize``, which
 places every intact packet by its sequence number and reports what is wrong.
 
 Input comes either as packets (one UDP datagram = one TLAST-closed DMA packet, the paper's
@@ -21,14 +21,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from model.config import RadarConfig
-from model.packetizer import (
+from model.axis_packetizer import (
     MAGIC,
     check_geometry,
     depacketize,
     packets_per_frame,
     parse_header,
 )
+from model.config import RadarConfig
 
 MAX_STREAM_PROBLEMS = 1000
 """Stream-level problem messages kept (counters keep counting past it)."""
@@ -37,14 +37,14 @@ MAX_STREAM_PROBLEMS = 1000
 def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
     """Frame payload, uint32 (frame_words, num_rx) in DMA order -> radar cube complex64
     (n_virtual, n_range, n_doppler). Same result as ``model.reference.dma_order_to_cube(
-    model.packetizer.payload_to_cube(...))`` but transposes the int16 I/Q pairs before
+    model.axis_packetizer.payload_to_cube(...))`` but transposes the int16 I/Q pairs before
     widening them (about 4x faster on a ``full`` frame)."""
     iq = np.ascontiguousarray(words, dtype="<u4").view("<i2").reshape(
         cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx, 2).transpose(0, 3, 1, 2, 4)
     cube = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.complex64)
     cube.real = iq[..., 0]  # I: low half of the word (little-endian)
     cube.imag = iq[..., 1]  # Q: high half
-    return cube.reshape(cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    return cube.reshape(cfg.cube_shape)
 
 
 @dataclass

@@ -18,7 +18,7 @@ import time
 from collections.abc import Callable
 
 from model.config import get_preset
-from model.pipeline import dma_packets, run_chain
+from model.radar_pipeline import dma_packets, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene

@@ -26,6 +26,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+import numpy as np
+
 C0 = 299_792_458.0
 """Speed of light in vacuum, m/s."""
 BOLTZMANN = 1.380649e-23
@@ -245,6 +247,31 @@ class RadarConfig:
         """Largest positive ADC code, 2**(adc_bits-1) - 1."""
         return 2 ** (self.adc_bits - 1) - 1
 
+    # ---- array shapes ---------------------------------------------------------------------
+    @property
+    def adc_shape(self) -> tuple[int, int, int]:
+        """Shape of one ADC frame: (n_chirps in transmit order, num_rx, n_range samples)."""
+        return (self.n_chirps, self.num_rx, self.n_range)
+
+    @property
+    def cube_shape(self) -> tuple[int, int, int]:
+        """Shape of one radar cube: (n_virtual, n_range, n_doppler)."""
+        return (self.n_virtual, self.n_range, self.n_doppler)
+
+    def check_adc(self, adc: np.ndarray, what: str = "adc") -> None:
+        """ValueError naming the expected and actual shape unless ``adc`` is one ADC frame
+        of this configuration, (n_chirps, num_rx, n_range)."""
+        if np.shape(adc) != self.adc_shape:
+            raise ValueError(f"{what}: expected shape {self.adc_shape} (chirps, rx, samples) "
+                             f"for preset {self.name!r}, got {np.shape(adc)}")
+
+    def check_cube(self, cube: np.ndarray, what: str = "cube") -> None:
+        """ValueError naming the expected and actual shape unless ``cube`` is one radar cube
+        of this configuration, (n_virtual, n_range, n_doppler)."""
+        if np.shape(cube) != self.cube_shape:
+            raise ValueError(f"{what}: expected shape {self.cube_shape} for preset "
+                             f"{self.name!r}, got {np.shape(cube)}")
+
     # ---- front end ------------------------------------------------------------------------
     @property
     def noise_power_w(self) -> float:
@@ -293,6 +320,20 @@ PRESETS: dict[str, RadarConfig] = {
         name="full", num_tx=4, num_rx=16, n_range=256, n_doppler=256,
         sample_rate_hz=32.5e6, chirp_period_s=8.76e-6, design_max_range_m=300.0),
 }
+
+
+DATA_W = 16
+"""Bits of I and of Q on every sample stream of the RTL (DESIGN.md section 3)."""
+
+
+def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
+    """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,
+    N_DOPPLER and DATA_W, then ``overrides`` (e.g. ``PACKET_WORDS=1024``) added or replacing.
+    The one place that maps a preset to HDL parameters (tests, RTL source, synthesis)."""
+    params = {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
+              "N_DOPPLER": cfg.n_doppler, "DATA_W": DATA_W}
+    params.update(overrides)
+    return params
 
 
 def get_preset(name: str) -> RadarConfig:

@@ -139,7 +139,7 @@ def simulate_baseband(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = T
     amp = tone_amplitude_lsb(cfg, Scatterers(r, sc.azimuth_deg[keep], v, sc.rcs_m2[keep],
                                              sc.object_id[keep]), beamforming)
     lam, slope = cfg.wavelength_m, cfg.slope_hz_per_s
-    out = np.zeros((cfg.n_chirps, cfg.num_rx, cfg.n_range), dtype=np.complex128)
+    out = np.zeros(cfg.adc_shape, dtype=np.complex128)
     if r.size == 0:
         return out, dropped
 

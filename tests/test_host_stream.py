@@ -123,7 +123,7 @@ def test_raw_byte_stream_resynchronises():
 
 def test_hardware_flags_reported_once():
     frames = cubes(SMALL, 2)
-    from model.packetizer import cube_to_payload, packetize, words_to_bytes
+    from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
     from model.reference import cube_to_dma_order
     pk = [words_to_bytes(p) for k, c in enumerate(frames) for p in packetize(
         cube_to_payload(cube_to_dma_order(c, SMALL)), PW, k, overflow=True)]
@@ -226,7 +226,7 @@ def test_capture_round_trip(tmp_path):
 
 def test_fast_payload_conversion_equals_model():
     from host.stream import payload_words_to_cube
-    from model.packetizer import cube_to_payload, payload_to_cube
+    from model.axis_packetizer import cube_to_payload, payload_to_cube
     from model.reference import cube_to_dma_order, dma_order_to_cube
     c = cubes(SMALL, 1, seed=9)[0]
     words = cube_to_payload(cube_to_dma_order(c, SMALL))

@@ -8,7 +8,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def test_rtl_lint_clean():
-    from host.rtlsim.toolchain import ensure_verilator_env
+    from rtlsim.toolchain import ensure_verilator_env
 
     ensure_verilator_env()
     r = subprocess.run(["bash", str(REPO / "tools" / "lint.sh")], cwd=REPO,

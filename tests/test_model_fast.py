@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model import fft_fixed as ff
+from model import fft_axis as ff
 from model.config import RadarConfig
-from model.pipeline import PipelineParams, run_chain
+from model.radar_pipeline import PipelineParams, run_chain
 from model.scene import table1_scene
 from model.simulate import simulate_scene
 

@@ -28,13 +28,13 @@ sys.path[:0] = [str(HERE.parent), str(HERE)]
 
 from bench_radar_pipeline import measure  # noqa: E402
 
-from host.rtlsim.harness import build_harness, run_harness  # noqa: E402
-from host.rtlsim.pipeline_rtl import run_pipeline_rtl  # noqa: E402
-from host.rtlsim.toolchain import SIM_BUILD  # noqa: E402
 from model.config import get_preset  # noqa: E402
-from model.pipeline import PipelineParams, dma_packets  # noqa: E402
+from model.radar_pipeline import PipelineParams, dma_packets  # noqa: E402
 from model.scene import table1_scene  # noqa: E402
 from model.simulate import simulate_scene  # noqa: E402
+from rtlsim.harness import build_harness, run_harness  # noqa: E402
+from rtlsim.pipeline_rtl import run_pipeline_rtl  # noqa: E402
+from rtlsim.toolchain import SIM_BUILD  # noqa: E402
 
 
 def cocotb_loop_speed() -> float:

@@ -1,4 +1,4 @@
-"""The Verilator-native harness (``host.rtlsim.harness``, C++ main) against the bit-accurate
+"""The Verilator-native harness (``rtlsim.harness``, C++ main) against the bit-accurate
 model and against the cocotb path, on the small 4-TX parameter set of
 ``test_radar_pipeline.py`` (one harness build, seconds to run).
 
@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 from test_radar_pipeline import CONFIGS, adc_frames, assert_packets_equal
 
-from host.rtlsim.harness import run_harness, run_pipeline
-from host.rtlsim.pipeline_rtl import run_pipeline_rtl
-from host.rtlsim.toolchain import RTL
-from model.pipeline import dma_packets
+from model.radar_pipeline import dma_packets
+from rtlsim.harness import run_harness, run_pipeline
+from rtlsim.pipeline_rtl import run_pipeline_rtl
+from rtlsim.toolchain import RTL
 
 NAME = "small4"
 CFG, CHAIN = CONFIGS[NAME]

@@ -2,7 +2,7 @@
 harness) with random ADC gaps, DMA stalls and periodic resets; every frame bit-exact
 against the bit-accurate model.
 
-    python -m host.rtlsim.soak [--frames 1000] [--chunk 50] [--reset-every 10] [--seed 1]
+    python -m rtlsim.harness.soak [--frames 1000] [--chunk 50] [--reset-every 10] [--seed 1]
 
 Frames are the Table I scene's consecutive frames (independent noise). They go in chunks,
 one harness run each, with a timing profile drawn per chunk (ADC rate, chirp gaps, DMA
@@ -21,11 +21,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from host.rtlsim.harness import HarnessRun, build_harness, run_harness
 from model.config import get_preset
-from model.pipeline import PipelineParams, dma_packets
+from model.radar_pipeline import PipelineParams, dma_packets
 from model.scene import table1_scene
 from model.simulate import simulate_scene
+from rtlsim.harness import HarnessRun, build_harness, run_harness
 
 PROFILES = (
     {"adc_gap": 0.0, "chirp_gap": 64, "dma_stall": 0.3},
