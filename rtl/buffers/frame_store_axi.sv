@@ -40,11 +40,15 @@ module frame_store_axi #(
   // AXI4 ID width in bits, 1..8 (the store uses ID 0 only: responses arrive in order).
   parameter int AXI_ID_W = 1,
   // Byte address of the two frame areas, 4 KiB aligned; the areas must fit in AXI_ADDR_W.
-  parameter logic [63:0] MEM_BASE = 64'h0,
+  // (waiver: command-line overrides such as -GMEM_BASE=4096 arrive as 32-bit constants)
+  /* verilator lint_off WIDTHEXPAND */
+  parameter longint unsigned MEM_BASE = 0,
+  /* verilator lint_on WIDTHEXPAND */
   // AXI4 transactions outstanding per direction (AW without B, AR without last R), 1..32.
   parameter int MAX_OUTSTANDING = 8,
-  // Write FIFO entries (max(word, AXI beat) wide), power of two, 4..1024.
-  parameter int WFIFO_DEPTH = 32
+  // Write FIFO entries (max(word, AXI beat) wide), power of two, 4..1024, at least two write
+  // bursts (an AW is issued only once its whole burst waits in the FIFO).
+  parameter int WFIFO_DEPTH = 64
 ) (
   input  wire logic                          clk,
   input  wire logic                          rst,
@@ -121,6 +125,7 @@ module frame_store_axi #(
   localparam int     RB_BEATS    = int'(RB_BYTES / AXI_B);
   localparam int     RB_UNITS    = RB_BEATS / BPU;
   localparam int     STRIP_UNITS = int'(STRIP_BYTES * 8 / longint'(UNIT_W));
+  localparam int     WB_UNITS    = int'(WB_BYTES * 8 / longint'(UNIT_W));
   localparam int     STRIP_WORDS = TILE_R * N_DOPPLER;
   localparam longint FRAME_BYTES = STRIP_BYTES * S * NUM_TX;
   localparam int     WBURSTS     = NUM_TX * N_DOPPLER * S;          // write bursts per frame
@@ -180,7 +185,7 @@ module frame_store_axi #(
     $fatal(1, "frame_store_axi (%m): TILE_R=%0d gives %0d-byte rows, need %0d..4096 (one AXI beat to 4 KiB)",
            TILE_R, WB_BYTES, AXI_B);
   end
-  if (MEM_BASE[11:0] != 12'h000) begin : g_bad_mem_base
+  if (MEM_BASE % 4096 != 0) begin : g_bad_mem_base
     $fatal(1, "frame_store_axi (%m): MEM_BASE=0x%0h is not 4 KiB aligned", MEM_BASE);
   end
   if (MEM_BASE + 2 * FRAME_BYTES > (64'd1 << AXI_ADDR_W)) begin : g_bad_mem_base_range
@@ -194,6 +199,10 @@ module frame_store_axi #(
   begin : g_bad_wfifo_depth
     $fatal(1, "frame_store_axi (%m): WFIFO_DEPTH=%0d must be a power of two in 4..1024",
            WFIFO_DEPTH);
+  end
+  if (WFIFO_DEPTH < 2 * WB_UNITS) begin : g_bad_wfifo_bursts
+    $fatal(1, "frame_store_axi (%m): WFIFO_DEPTH=%0d holds less than two %0d-entry write bursts",
+           WFIFO_DEPTH, WB_UNITS);
   end
 
   // ---- frame bookkeeping (frame counters mod 4; differences are 0..2) --------------------
@@ -240,6 +249,11 @@ module frame_store_axi #(
   logic [WBW:0]    w_open_q;     // AW issued, W burst not yet complete (<= WBURSTS)
   logic [WBTW-1:0] w_beat_q;     // beat within the current W burst
   logic [WBW-1:0]  b_idx_q;
+  localparam int WUW = (WB_UNITS > 1) ? $clog2(WB_UNITS) : 1;
+  localparam int AVW = $clog2(WFIFO_DEPTH + 1);
+  logic [WUW-1:0]  wu_idx_q;     // unit within the burst being filled into the FIFO
+  logic [AVW-1:0]  avail_q;      // complete bursts in the FIFO without an AW yet
+  logic            pk_hs, burst_in;
   logic            aw_hs, w_hs, w_end, b_hs, w_ok;
   logic [63:0]     aw_off;
 
@@ -253,7 +267,12 @@ module frame_store_axi #(
            + (aw_f_q[0] ? 64'(FRAME_BYTES) : 64'd0);
   end
 
-  assign m_axi_mem_awvalid = !rst && (aw_lead != 2'd2) && (aw_out_q < OUTW'(MAX_OUTSTANDING));
+  // AW only for a burst whose data all waits in the FIFO (W then follows at full rate) and
+  // whose frame area has been read back
+  assign pk_hs    = pk_tvalid && pk_tready;
+  assign burst_in = pk_hs && (wu_idx_q == WUW'(WB_UNITS - 1));
+  assign m_axi_mem_awvalid = !rst && (avail_q != '0) && (aw_lead != 2'd2)
+                             && (aw_out_q < OUTW'(MAX_OUTSTANDING));
   assign m_axi_mem_awaddr  = AXI_ADDR_W'(MEM_BASE + aw_off);
   assign m_axi_mem_awid    = '0;
   assign m_axi_mem_awlen   = 8'(WB_BEATS - 1);
@@ -421,6 +440,8 @@ module frame_store_axi #(
       w_open_q      <= '0;
       w_beat_q      <= '0;
       b_idx_q       <= '0;
+      wu_idx_q      <= '0;
+      avail_q       <= '0;
       ar_idx_q      <= '0;
       ar_out_q      <= '0;
       credit_q      <= CRW'(BUF_DEPTH);
@@ -447,6 +468,8 @@ module frame_store_axi #(
       end
 
       // ---- AW / W / B
+      if (pk_hs) wu_idx_q <= (wu_idx_q == WUW'(WB_UNITS - 1)) ? '0 : wu_idx_q + 1'b1;
+      avail_q <= avail_q + AVW'(burst_in) - AVW'(aw_hs);
       if (aw_hs) begin
         aw_idx_q <= aw_idx_q + 1'b1;
         if (aw_idx_q == WBW'(WBURSTS - 1)) aw_f_q <= aw_f_q + 1'b1;
