@@ -24,7 +24,8 @@ import numpy as np
 from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.fft_fixed import fft_fixed
-from model.packetizer import check_geometry, cube_to_payload, packetize
+from model.frame_store_axi import StoreGeometry, store_frames
+from model.packetizer import check_geometry, cube_to_payload, pack_iq, packetize, unpack_iq
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -37,7 +38,9 @@ class PipelineParams:
     """HDL parameters of ``radar_pipeline`` beyond the radar configuration.
 
     ``packet_words``: PACKET_WORDS; ``window``: WINDOW (periodic Hann before both FFTs);
-    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER.
+    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER;
+    ``frame_store``: FRAME_STORE (corner turn in external memory over AXI4, same payload),
+    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R.
     """
 
     packet_words: int = 1024
@@ -45,6 +48,15 @@ class PipelineParams:
     range_scale_sch: int = RANGE_SCALE_SCH
     doppler_scale_sch: int = DOPPLER_SCALE_SCH
     header: bool = True
+    frame_store: bool = False
+    axi_data_w: int = 128
+    fs_tile_r: int = 16
+
+    def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
+        """The external frame store's geometry (FRAME_STORE = 1)."""
+        return StoreGeometry(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+                             n_doppler=cfg.n_doppler, tile_r=self.fs_tile_r,
+                             axi_data_w=self.axi_data_w)
 
     def frame_words(self, cfg: RadarConfig) -> int:
         """Payload words per frame, num_tx * n_range * n_doppler."""
@@ -98,7 +110,10 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
     rng = fft_fixed(np.transpose(adc, (0, 2, 1)), window=params.window,
                     scale_sch=params.range_scale_sch)
     words = rng.y.reshape(-1, cfg.num_rx)                       # chirp-major input order
-    turned = corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+    if params.frame_store:     # through the external layout's bursts and strip buffer
+        turned = unpack_iq(store_frames([pack_iq(words)], params.store_geometry(cfg))[0])
+    else:
+        turned = corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
     dop = fft_fixed(turned.reshape(-1, cfg.n_doppler, cfg.num_rx), window=params.window,
                     scale_sch=params.doppler_scale_sch)
     payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
