@@ -21,7 +21,7 @@ help:
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make bench           model and host benchmarks (print tables)"
-	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
@@ -62,6 +62,7 @@ bench: $(STAMP)
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
+	$(RUN) python tb/frame_store_axi/bench_frame_store_axi.py
 
 include synth/synth.mk
 
