@@ -246,7 +246,7 @@ module frame_store_axi #(
   // AW: one burst per (chirp, strip) in input order: index = (d*NUM_TX + t)*S + s
   logic [WBW-1:0]  aw_idx_q;
   logic [OUTW-1:0] aw_out_q;     // AW issued, BRESP not yet in
-  logic [WBW:0]    w_open_q;     // AW issued, W burst not yet complete (<= WBURSTS)
+  logic signed [WBW+1:0] w_open_q; // AWs accepted minus W bursts completed (-1..WBURSTS)
   logic [WBTW-1:0] w_beat_q;     // beat within the current W burst
   logic [WBW-1:0]  b_idx_q;
   localparam int WUW = (WB_UNITS > 1) ? $clog2(WB_UNITS) : 1;
@@ -283,7 +283,11 @@ module frame_store_axi #(
   assign m_axi_mem_awprot  = 3'b000;
   assign aw_hs = m_axi_mem_awvalid && m_axi_mem_awready;
 
-  assign w_ok              = (w_open_q != '0);
+  // W of a burst may start as soon as its AW is presented (AXI4: the master never waits for
+  // AWREADY before WVALID; a slave may wait for WVALID before AWREADY). With no accepted AW
+  // still owed data, the data at the FIFO head belongs to the AW being presented; a burst
+  // whose W finished before its AW was accepted (w_open_q = -1) lets nothing more through.
+  assign w_ok              = (w_open_q > 0) || (w_open_q == 0 && m_axi_mem_awvalid);
   assign m_axi_mem_wvalid  = wb_tvalid && w_ok;
   assign wb_tready         = m_axi_mem_wready && w_ok;
   assign m_axi_mem_wdata   = wb_tdata;
@@ -475,7 +479,7 @@ module frame_store_axi #(
         if (aw_idx_q == WBW'(WBURSTS - 1)) aw_f_q <= aw_f_q + 1'b1;
       end
       aw_out_q <= aw_out_q + OUTW'(aw_hs) - OUTW'(b_hs);
-      w_open_q <= w_open_q + (WBW+1)'(aw_hs) - (WBW+1)'(w_end);
+      w_open_q <= w_open_q + $signed((WBW+2)'(aw_hs)) - $signed((WBW+2)'(w_end));
       if (w_hs) w_beat_q <= m_axi_mem_wlast ? '0 : w_beat_q + 1'b1;
       if (b_hs) begin
         b_idx_q <= b_idx_q + 1'b1;

@@ -257,6 +257,18 @@ async def test_slow_memory(dut):
 
 
 @cocotb.test()
+async def test_read_waits_for_bresp(dut):
+    """Writes slow (W and B stall 90 %), reads fast: a frame is read only after every BRESP
+    of it is in, never from memory its writes have not reached yet."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.ram.set_pause([None, random_pause(0.9, 60), random_pause(0.9, 61), None, None])
+    frames = [tb.random_frame() for _ in range(3)]
+    got = await tb.run_frames(frames)
+    tb.check_payload(got, frames)
+
+
+@cocotb.test()
 async def test_slverr(dut):
     """One AXI beat of area 0 answers SLVERR: flagged and counted (one per bad write burst,
     one per bad read beat), frames keep flowing, only the words of that beat are lost."""
