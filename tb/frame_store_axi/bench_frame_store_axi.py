@@ -40,7 +40,9 @@ directions; MIG's AXI port is 512 bits at 300 MHz)."""
 PRESET_STORES = {
     # name: (preset, tile_r, axi_data_w)
     "paper-fpga": ("paper-fpga", 16, 128),
+    "paper-fpga/32": ("paper-fpga", 32, 128),
     "full": ("full", 16, 512),
+    "full/32": ("full", 32, 512),
 }
 
 
@@ -59,7 +61,7 @@ def model_table() -> None:
     pm = fs.DramPageModel()
     print("Model: address layout per preset (steady state, 4 frames; write of k+1 interleaved "
           "with read of k)")
-    print(f"{'preset':<11} {'AXI':>4} {'TILE_R':>6} {'frame MiB':>9} {'mem MiB':>7} "
+    print(f"{'preset':<13} {'AXI':>4} {'TILE_R':>6} {'frame MiB':>9} {'mem MiB':>7} "
           f"{'AXI MB/frame':>12} {'buffer Mib':>10} {'need GB/s':>9} {'port GB/s':>9} "
           f"{'of port':>7} {'of DDR4':>7} {'row hits':>8}  bursts per frame (dir x beats)")
     for name, (preset, tile_r, axi_w) in PRESET_STORES.items():
@@ -70,7 +72,7 @@ def model_table() -> None:
         one = fs.interleaved_trace(g, 1)
         need = 2 * g.frame_bytes * fps                      # write + read per second
         port = 2 * g.axi_bytes * CLOCK_HZ                   # AW/W and AR/R run concurrently
-        print(f"{name:<11} {axi_w:>4} {tile_r:>6} {g.frame_bytes / 2**20:>9.2f} "
+        print(f"{name:<13} {axi_w:>4} {tile_r:>6} {g.frame_bytes / 2**20:>9.2f} "
               f"{g.memory_bytes / 2**20:>7.2f} {2 * g.frame_bytes / 1e6:>12.2f} "
               f"{g.strip_buffer_bits / 2**20:>10.2f} {need / 1e9:>9.2f} {port / 1e9:>9.2f} "
               f"{need / port:>7.1%} {need / DRAM_PEAK:>7.1%} {hits / total:>8.2%}  "
