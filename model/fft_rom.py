@@ -1,5 +1,5 @@
 """Single source of the FFT coefficient ROMs shared by the RTL (``rtl/fft/fft_rom_pkg.sv``)
-and the bit-accurate model (:mod:`model.fft_fixed`).
+and the bit-accurate model (:mod:`model.fft_axis`).
 
 Two tables of ``ROM_SIZE = 4096`` entries cover every transform length N = 16..4096:
 
@@ -9,9 +9,9 @@ Two tables of ``ROM_SIZE = 4096`` entries cover every transform length N = 16..4
 - ``HANN[k] = rint(2**16 * (0.5 - 0.5*cos(2*pi*k/4096)))``: periodic Hann, Q1.16, 0..65536;
   the N-point window is ``HANN[n*4096/N]`` (exactly the periodic N-point Hann sampled).
 
-``rint`` is numpy's round-half-to-even. Run ``python -m model.fft_rom`` to rewrite the
-SystemVerilog package (the testbench does it before every build; the file is only rewritten
-when its contents change).
+``rint`` is numpy's round-half-to-even. ``make gen`` (``python -m model.fft_rom``) rewrites
+the SystemVerilog package (only when its contents change); the unit test
+``tb/fft_axis/test_fft_axis_model.py`` and the FFT testbench fail when it is stale.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+
+from model.reference import hann_periodic
 
 ROM_LOG2 = 12
 """log2 of the ROM length: the largest supported transform is 2**ROM_LOG2 points."""
@@ -46,8 +48,7 @@ def sin_table() -> np.ndarray:
 
 def hann_table() -> np.ndarray:
     """int64 (4096,): Q1.16 periodic Hann of length 4096 (values 0..65536)."""
-    k = np.arange(ROM_SIZE)
-    w = 0.5 - 0.5 * np.cos(2.0 * np.pi * k / ROM_SIZE)
+    w = hann_periodic(ROM_SIZE)
     return np.rint((1 << COEF_FRAC) * w).astype(np.int64)
 
 
@@ -57,13 +58,14 @@ def hann_window(n: int) -> np.ndarray:
 
 
 def _sv_table(name: str, values: np.ndarray) -> str:
+    """A ROM as a SystemVerilog function with one ``case`` item per entry: the form every
+    tool reads (Yosys' ``read_verilog -sv`` refuses unpacked constant arrays) and one that
+    needs no ``$readmemh`` path. Called as ``fft_rom_pkg::NAME(index)``."""
     mask = (1 << COEF_W) - 1
-    words = [f"{COEF_W}'h{int(v) & mask:05X}" for v in values]
-    lines = []
-    for i in range(0, len(words), 8):
-        lines.append("    " + ", ".join(words[i:i + 8]))
-    body = ",\n".join(lines)
-    return (f"  localparam logic [COEF_W-1:0] {name} [ROM_SIZE] = '{{\n{body}\n  }};\n")
+    items = "".join(f"      {ROM_LOG2}'d{k}: {name} = {COEF_W}'h{int(v) & mask:05X};\n"
+                    for k, v in enumerate(values))
+    return (f"  function automatic logic [COEF_W-1:0] {name}(input logic [ROM_LOG2-1:0] k);\n"
+            f"    case (k)\n{items}    endcase\n  endfunction\n")
 
 
 def render_rom_pkg() -> str:
@@ -82,9 +84,9 @@ def render_rom_pkg() -> str:
         "  // Coefficient width (signed two's complement) and fraction bits (Q1.16).\n"
         f"  localparam int COEF_W = {COEF_W};\n"
         f"  localparam int COEF_FRAC = {COEF_FRAC};\n"
-        "  // COS[k] = rint(2^16 cos(2 pi k / 4096)); SIN[k] is COS[(k - 1024) mod 4096].\n"
+        "  // COS(k) = rint(2^16 cos(2 pi k / 4096)); SIN(k) is COS((k - 1024) mod 4096).\n"
         + _sv_table("COS", cos_table())
-        + "  // HANN[k] = rint(2^16 (0.5 - 0.5 cos(2 pi k / 4096))), periodic Hann.\n"
+        + "  // HANN(k) = rint(2^16 (0.5 - 0.5 cos(2 pi k / 4096))), periodic Hann.\n"
         + _sv_table("HANN", hann_table())
         + "endpackage\n/* verilator lint_on UNUSEDPARAM */\n\n`default_nettype wire\n"
     )

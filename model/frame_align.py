@@ -1,4 +1,4 @@
-"""Bit-accurate model of ``rtl/top/frame_align.sv``: keeps the chirp stream frame-aligned
+"""Bit-accurate model of ``rtl/buffers/frame_align.sv``: keeps the chirp stream frame-aligned
 after the ADC ping-pong lost chirps.
 
 Input chirps carry two flags on their first sample: ``sof`` (frame start) and ``gap`` (chirps

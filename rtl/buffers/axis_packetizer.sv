@@ -72,28 +72,28 @@ module axis_packetizer #(
   localparam logic [7:0] MAGIC = 8'hA5;
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_0
-    $fatal(1, "axis_packetizer: NUM_RX=%0d not in 1..64", NUM_RX);
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
-  if (DATA_W != 16) begin : g_bad_param_1
-    $fatal(1, "axis_packetizer: DATA_W=%0d, only 16 is legal", DATA_W);
+  if (DATA_W != 16) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d, only 16 is legal", DATA_W);
   end
-  if (PACKET_WORDS < 2 || PACKET_WORDS > 65535) begin : g_bad_param_2
-    $fatal(1, "axis_packetizer: PACKET_WORDS=%0d not in 2..65535", PACKET_WORDS);
+  if (PACKET_WORDS < 2 || PACKET_WORDS > 65535) begin : g_bad_packet_words
+    $fatal(1, "%m: PACKET_WORDS=%0d not in 2..65535", PACKET_WORDS);
   end
-  if (FRAME_WORDS < 1 || FRAME_WORDS > (1 << 30)) begin : g_bad_param_3
-    $fatal(1, "axis_packetizer: FRAME_WORDS=%0d not in 1..2^30", FRAME_WORDS);
+  if (FRAME_WORDS < 1 || FRAME_WORDS > (1 << 30)) begin : g_bad_frame_words
+    $fatal(1, "%m: FRAME_WORDS=%0d not in 1..2^30", FRAME_WORDS);
   end
-  if (NPKT > 4096) begin : g_bad_param_4
-    $fatal(1, "axis_packetizer: FRAME_WORDS/PACKET_WORDS gives %0d > 4096 packets per frame",
+  if (NPKT > 4096) begin : g_bad_frame_packets
+    $fatal(1, "%m: FRAME_WORDS/PACKET_WORDS gives %0d > 4096 packets per frame",
            NPKT);
   end
-  if (NUM_BANKS < 2 || NUM_BANKS > 16 || (1 << BANK_W) != NUM_BANKS) begin : g_bad_param_5
-    $fatal(1, "axis_packetizer: NUM_BANKS=%0d must be a power of two in 2..16", NUM_BANKS);
+  if (NUM_BANKS < 2 || NUM_BANKS > 16 || (1 << BANK_W) != NUM_BANKS) begin : g_bad_num_banks
+    $fatal(1, "%m: NUM_BANKS=%0d must be a power of two in 2..16", NUM_BANKS);
   end
   if (TLAST_PERIOD < 0 || (TLAST_PERIOD > 0 && (FRAME_WORDS % TLAST_PERIOD) != 0))
-  begin : g_bad_param_6
-    $fatal(1, "axis_packetizer: TLAST_PERIOD=%0d must be 0 or divide FRAME_WORDS", TLAST_PERIOD);
+  begin : g_bad_tlast_period
+    $fatal(1, "%m: TLAST_PERIOD=%0d must be 0 or divide FRAME_WORDS", TLAST_PERIOD);
   end
 
   // ---------------------------------------------------------------------------------------
@@ -307,24 +307,13 @@ module axis_packetizer #(
   assign frame_count          = frame_cnt_q;
   assign packet_count         = packet_cnt_q;
 
-`ifndef SYNTHESIS
-  // AXI4-Stream source rules: TVALID/TDATA/TLAST held while stalled.
-  logic             m_stall_q;
-  logic [WORD_W:0]  m_held_q;
-  always_ff @(posedge clk) begin
-    if (rst) begin
-      m_stall_q <= 1'b0;
-    end else begin
-      m_stall_q <= m_axis_tvalid && !m_axis_tready;
-      if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("axis_packetizer: TVALID dropped while stalled");
-        assert ({m_axis_tlast, m_axis_tdata} == m_held_q)
-          else $error("axis_packetizer: TDATA/TLAST changed while stalled");
-      end
-    end
-    m_held_q <= {m_axis_tlast, m_axis_tdata};
-  end
-`endif
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(NUM_RX*32 + 2), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tuser, s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(NUM_RX*32 + 1)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tlast, m_axis_tdata}));
 
 endmodule
 

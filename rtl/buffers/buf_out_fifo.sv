@@ -25,11 +25,11 @@ module buf_out_fifo #(
   localparam int PTR_W = $clog2(DEPTH);
 
   // Parameter checks: stop elaboration on illegal values.
-  if (DEPTH < 4 || DEPTH > 64 || (1 << PTR_W) != DEPTH) begin : g_bad_param_0
-    $fatal(1, "buf_out_fifo: DEPTH=%0d must be a power of two in 4..64", DEPTH);
+  if (DEPTH < 4 || DEPTH > 64 || (1 << PTR_W) != DEPTH) begin : g_bad_depth
+    $fatal(1, "%m: DEPTH=%0d must be a power of two in 4..64", DEPTH);
   end
-  if (WIDTH < 1 || WIDTH > 8192) begin : g_bad_param_1
-    $fatal(1, "buf_out_fifo: WIDTH=%0d out of range", WIDTH);
+  if (WIDTH < 1 || WIDTH > 8192) begin : g_bad_width
+    $fatal(1, "%m: WIDTH=%0d out of range", WIDTH);
   end
 
   logic [WIDTH-1:0] mem_q [DEPTH];

@@ -23,14 +23,14 @@ module buf_sdp_ram #(
 );
 
   // Parameter checks: stop elaboration on illegal values.
-  if (WIDTH < 1 || WIDTH > 4096) begin : g_bad_param_0
-    $fatal(1, "buf_sdp_ram: WIDTH=%0d out of range 1..4096", WIDTH);
+  if (WIDTH < 1 || WIDTH > 4096) begin : g_bad_width
+    $fatal(1, "%m: WIDTH=%0d out of range 1..4096", WIDTH);
   end
-  if (DEPTH < 2 || DEPTH > (1 << 24)) begin : g_bad_param_1
-    $fatal(1, "buf_sdp_ram: DEPTH=%0d out of range 2..2^24", DEPTH);
+  if (DEPTH < 2 || DEPTH > (1 << 24)) begin : g_bad_depth
+    $fatal(1, "%m: DEPTH=%0d out of range 2..2^24", DEPTH);
   end
-  if (ADDR_W != $clog2(DEPTH)) begin : g_bad_param_2
-    $fatal(1, "buf_sdp_ram: ADDR_W must equal $clog2(DEPTH)");
+  if (ADDR_W != $clog2(DEPTH)) begin : g_bad_addr_w
+    $fatal(1, "%m: ADDR_W must equal $clog2(DEPTH)");
   end
 
   // No reset on the array or the read register: lets synthesis map both into the RAM

@@ -55,23 +55,23 @@ module corner_turn #(
   localparam int SH_W   = $clog2(B);
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_param_0
-    $fatal(1, "corner_turn: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_num_tx
+    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
   end
-  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_param_1
-    $fatal(1, "corner_turn: NUM_RX=%0d not in 1..64", NUM_RX);
+  if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
-  if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_param_2
-    $fatal(1, "corner_turn: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
+  if (N_RANGE < 2 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 2..4096", N_RANGE);
   end
-  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_param_3
-    $fatal(1, "corner_turn: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
+  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
   end
-  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_param_4
-    $fatal(1, "corner_turn: DATA_W=%0d not in 8..32", DATA_W);
+  if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
   end
-  if (B > 24) begin : g_bad_param_5
-    $fatal(1, "corner_turn: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
+  if (B > 24) begin : g_bad_frame_words
+    $fatal(1, "%m: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
   end
 
   // rotl(x, s) on B bits, 0 <= s < B
@@ -202,24 +202,19 @@ module corner_turn #(
   assign frames_in            = frames_in_q;
   assign frames_out           = frames_out_q;
 
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(NUM_RX*2*DATA_W + 1), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(NUM_RX*2*DATA_W + 2)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
+
 `ifndef SYNTHESIS
-  logic              m_stall_q;
-  logic [WORD_W+1:0] m_held_q;
+  // block invariant (in place): never write a slot of the frame being read before reading it
   always_ff @(posedge clk) begin
-    if (rst) begin
-      m_stall_q <= 1'b0;
-    end else begin
-      m_stall_q <= m_axis_tvalid && !m_axis_tready;
-      if (m_stall_q) begin
-        assert (m_axis_tvalid) else $error("corner_turn: TVALID dropped while stalled");
-        assert ({m_axis_tuser, m_axis_tlast, m_axis_tdata} == m_held_q)
-          else $error("corner_turn: TDATA/TLAST/TUSER changed while stalled");
-      end
-      // the in-place invariant: never write a slot of the frame being read before reading it
-      if (wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)
-        else $error("corner_turn: writer overtook reader");
-    end
-    m_held_q <= {m_axis_tuser, m_axis_tlast, m_axis_tdata};
+    if (!rst && wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)
+      else $error("corner_turn: writer overtook reader");
   end
 `endif
 

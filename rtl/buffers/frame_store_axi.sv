@@ -541,27 +541,34 @@ module frame_store_axi #(
   assign unused_ok = ^{m_axi_mem_bid, m_axi_mem_rid, r_acc_q};
   /* verilator lint_on UNUSEDSIGNAL */
 
+  // AXI4-Stream / AXI4 handshake rules on every port and channel (rtl/common/axis_checker.sv:
+  // VALID held until READY, payload stable while stalled)
+  axis_checker #(.PAYLOAD_W(WORD_W + 1), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(WORD_W + 2)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(AXI_ADDR_W + 8)) u_chk_aw (
+    .clk, .rst, .tvalid(m_axi_mem_awvalid), .tready(m_axi_mem_awready),
+    .payload({m_axi_mem_awlen, m_axi_mem_awaddr}));
+  axis_checker #(.PAYLOAD_W(AXI_DATA_W + 1)) u_chk_w (
+    .clk, .rst, .tvalid(m_axi_mem_wvalid), .tready(m_axi_mem_wready),
+    .payload({m_axi_mem_wlast, m_axi_mem_wdata}));
+  axis_checker #(.PAYLOAD_W(AXI_ID_W + 2), .ASSUME(1'b1)) u_chk_b (
+    .clk, .rst, .tvalid(m_axi_mem_bvalid), .tready(m_axi_mem_bready),
+    .payload({m_axi_mem_bid, m_axi_mem_bresp}));
+  axis_checker #(.PAYLOAD_W(AXI_ADDR_W + 8)) u_chk_ar (
+    .clk, .rst, .tvalid(m_axi_mem_arvalid), .tready(m_axi_mem_arready),
+    .payload({m_axi_mem_arlen, m_axi_mem_araddr}));
+  axis_checker #(.PAYLOAD_W(AXI_ID_W + AXI_DATA_W + 3), .ASSUME(1'b1)) u_chk_r (
+    .clk, .rst, .tvalid(m_axi_mem_rvalid), .tready(m_axi_mem_rready),
+    .payload({m_axi_mem_rid, m_axi_mem_rresp, m_axi_mem_rlast, m_axi_mem_rdata}));
+
 `ifndef SYNTHESIS
-  // Protocol and invariants (the shared checker covers the AXI4-Stream side once it exists).
-  logic aw_stall_q, ar_stall_q;
-  logic [AXI_ADDR_W-1:0] aw_held_q, ar_held_q;
-  logic              m_stall_q;
-  logic [WORD_W+1:0] m_held_q;
+  // block invariants: AXI4 4 KiB rule, strip buffer never over-reserved
   always_ff @(posedge clk) begin
-    if (rst) begin
-      aw_stall_q <= 1'b0;
-      ar_stall_q <= 1'b0;
-      m_stall_q  <= 1'b0;
-    end else begin
-      aw_stall_q <= m_axi_mem_awvalid && !m_axi_mem_awready;
-      ar_stall_q <= m_axi_mem_arvalid && !m_axi_mem_arready;
-      m_stall_q  <= m_axis_tvalid && !m_axis_tready;
-      if (aw_stall_q) assert (m_axi_mem_awvalid && m_axi_mem_awaddr == aw_held_q)
-        else $error("frame_store_axi: AWVALID/AWADDR changed while stalled");
-      if (ar_stall_q) assert (m_axi_mem_arvalid && m_axi_mem_araddr == ar_held_q)
-        else $error("frame_store_axi: ARVALID/ARADDR changed while stalled");
-      if (m_stall_q) assert (m_axis_tvalid && {m_axis_tuser, m_axis_tlast, m_axis_tdata} == m_held_q)
-        else $error("frame_store_axi: m_axis changed while stalled");
+    if (!rst) begin
       if (m_axi_mem_awvalid)
         assert ({1'b0, m_axi_mem_awaddr[11:0]} + 13'(WB_BYTES) <= 13'h1000)
           else $error("frame_store_axi: write burst crosses 4 KiB");
@@ -571,9 +578,6 @@ module frame_store_axi #(
       if (r_unit) assert (credit_q <= CRW'(BUF_DEPTH))
         else $error("frame_store_axi: strip buffer over-reserved");
     end
-    aw_held_q <= m_axi_mem_awaddr;
-    ar_held_q <= m_axi_mem_araddr;
-    m_held_q  <= {m_axis_tuser, m_axis_tlast, m_axis_tdata};
   end
 `endif
 

@@ -40,7 +40,6 @@ module fft_axis #(
   // whose computation saturated (any lane, any stage), the cycle after its handshake.
   output logic event_tlast_unexpected, event_tlast_missing, event_overflow
 );
-  import fft_pkg::*;
 
   localparam int LOG2N = $clog2(N);
   localparam int W     = DATA_W + 1 + GUARD_W;   // internal bits per component
@@ -50,16 +49,16 @@ module fft_axis #(
 
   // ---------------------------------------------------------------- parameter checks
   if (N < 16 || N > 4096 || (1 << LOG2N) != N) begin : g_bad_n
-    $fatal(1, "fft_axis: parameter N=%0d must be a power of two in 16..4096", N);
+    $fatal(1, "%m: N=%0d must be a power of two in 16..4096", N);
   end
-  if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_ch
-    $fatal(1, "fft_axis: parameter NUM_CH=%0d must be in 1..16", NUM_CH);
+  if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_num_ch
+    $fatal(1, "%m: NUM_CH=%0d must be in 1..16", NUM_CH);
   end
-  if (DATA_W < 8 || DATA_W > 24) begin : g_bad_dw
-    $fatal(1, "fft_axis: parameter DATA_W=%0d must be in 8..24", DATA_W);
+  if (DATA_W < 8 || DATA_W > 24) begin : g_bad_data_w
+    $fatal(1, "%m: DATA_W=%0d must be in 8..24", DATA_W);
   end
-  if (GUARD_W < 0 || GUARD_W > 16 || W > 27) begin : g_bad_gw
-    $fatal(1, "fft_axis: parameter GUARD_W=%0d needs 0..16 and DATA_W+1+GUARD_W <= 27",
+  if (GUARD_W < 0 || GUARD_W > 16 || W > 27) begin : g_bad_guard_w
+    $fatal(1, "%m: GUARD_W=%0d needs 0..16 and DATA_W+1+GUARD_W <= 27",
            GUARD_W);
   end
 
@@ -157,9 +156,9 @@ module fft_axis #(
     cv_d  = '0;
     cv_ov = st_ov[LOG2N];
     for (int c = 0; c < 2 * NUM_CH; c++) begin
-      v = round_conv(64'(signed'(st_data[LOG2N][c*W +: W])), GUARD_W);
-      cv_ov = cv_ov | sat_ov(v, DATA_W);
-      cv_d[c*DATA_W +: DATA_W] = DATA_W'(sat_val(v, DATA_W));
+      v = fft_pkg::round_conv(64'(signed'(st_data[LOG2N][c*W +: W])), GUARD_W);
+      cv_ov = cv_ov | fft_pkg::sat_ov(v, DATA_W);
+      cv_d[c*DATA_W +: DATA_W] = DATA_W'(fft_pkg::sat_val(v, DATA_W));
     end
   end
 
@@ -184,8 +183,8 @@ module fft_axis #(
   fft_reorder #(.N(N), .WIDTH(ODW + 1)) u_reorder (
     .clk, .rst,
     .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
-    .m_data(m_word), .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),
-    .m_last(m_axis_tlast), .m_user(m_axis_tuser)
+    .m_axis_tdata(m_word), .m_axis_tvalid(m_axis_tvalid), .m_axis_tready(m_axis_tready),
+    .m_axis_tlast(m_axis_tlast), .m_axis_tuser(m_axis_tuser)
   );
   assign m_axis_tdata = m_word[ODW-1:0];
 
@@ -206,34 +205,14 @@ module fft_axis #(
   assign event_tlast_missing    = ev_miss_q;
   assign event_overflow         = ev_ov_q;
 
-  // ---------------------------------------------------------------- protocol assertions
-`ifndef SYNTHESIS
-  logic             chk_q, s_stall_q, m_stall_q;
-  logic [ODW-1:0]   s_data_q, m_data_q;
-  logic             s_last_q, m_last_q;
-  logic [LOG2N-1:0] m_user_q;
-  always_ff @(posedge clk) begin
-    chk_q     <= !rst;
-    s_stall_q <= s_axis_tvalid && !s_axis_tready;
-    m_stall_q <= m_axis_tvalid && !m_axis_tready;
-    s_data_q  <= s_axis_tdata;
-    s_last_q  <= s_axis_tlast;
-    m_data_q  <= m_axis_tdata;
-    m_last_q  <= m_axis_tlast;
-    m_user_q  <= m_axis_tuser;
-    if (chk_q && !rst) begin
-      if (s_stall_q) begin
-        assert (s_axis_tvalid && s_axis_tdata == s_data_q && s_axis_tlast == s_last_q)
-          else $error("fft_axis: s_axis TVALID dropped or TDATA/TLAST changed while stalled");
-      end
-      if (m_stall_q) begin
-        assert (m_axis_tvalid && m_axis_tdata == m_data_q && m_axis_tlast == m_last_q &&
-                m_axis_tuser == m_user_q)
-          else $error("fft_axis: m_axis TVALID dropped or payload changed while stalled");
-      end
-    end
-  end
-`endif
+  // ---------------------------------------------------------------- protocol checks
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(ODW + 1), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(ODW + 1 + LOG2N)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
 endmodule
 
 `default_nettype wire

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Fixed-point helpers of the streaming FFT: convergent rounding and saturation.
+// Called package-scoped (fft_pkg::round_conv(...)); results are assigned to the function
+// name (no `return`) so Yosys' read_verilog -sv reads the file as written.
 `default_nettype none
 
 package fft_pkg;
@@ -10,12 +12,15 @@ package fft_pkg;
     logic signed [63:0] q;
     logic [63:0] mask;
     logic half, rest;
-    if (k == 0) return v;
-    q = v >>> k;
-    half = v[k-1];
-    mask = (64'd1 << (k - 1)) - 64'd1;
-    rest = |(v & mask);
-    return q + ((half && (rest || q[0])) ? 64'sd1 : 64'sd0);
+    if (k == 0) begin
+      round_conv = v;
+    end else begin
+      q = v >>> k;
+      half = v[k-1];
+      mask = (64'd1 << (k - 1)) - 64'd1;
+      rest = |(v & mask);
+      round_conv = q + ((half && (rest || q[0])) ? 64'sd1 : 64'sd0);
+    end
   endfunction
 
   // True when v does not fit a w-bit two's complement number.
@@ -23,7 +28,7 @@ package fft_pkg;
     logic signed [63:0] hi, lo;
     hi = (64'sd1 <<< (w - 1)) - 64'sd1;
     lo = -(64'sd1 <<< (w - 1));
-    return (v > hi) || (v < lo);
+    sat_ov = (v > hi) || (v < lo);
   endfunction
 
   // v clipped to the w-bit two's complement range (result in the low w bits).
@@ -32,9 +37,9 @@ package fft_pkg;
     logic signed [63:0] hi, lo;
     hi = (64'sd1 <<< (w - 1)) - 64'sd1;
     lo = -(64'sd1 <<< (w - 1));
-    if (v > hi) return hi;
-    if (v < lo) return lo;
-    return v;
+    if (v > hi) sat_val = hi;
+    else if (v < lo) sat_val = lo;
+    else sat_val = v;
   endfunction
 endpackage
 

@@ -19,16 +19,16 @@ module fft_reorder #(
   input  logic [WIDTH-1:0]        wr_data,
   output logic                    wr_ok,
   // Read side (natural order, registered outputs).
-  output logic [WIDTH-1:0]        m_data,
-  output logic                    m_valid,
-  input  logic                    m_ready,
-  output logic                    m_last,
-  output logic [$clog2(N)-1:0]    m_user
+  output logic [WIDTH-1:0]        m_axis_tdata,
+  output logic                    m_axis_tvalid,
+  input  logic                    m_axis_tready,
+  output logic                    m_axis_tlast,
+  output logic [$clog2(N)-1:0]    m_axis_tuser
 );
   localparam int LOG2N = $clog2(N);
 
-  if (N < 2 || (1 << LOG2N) != N) begin : g_bad
-    $fatal(1, "fft_reorder: N=%0d must be a power of two", N);
+  if (N < 2 || (1 << LOG2N) != N) begin : g_bad_n
+    $fatal(1, "%m: N=%0d must be a power of two", N);
   end
 
   logic [WIDTH-1:0] mem_q [2*N];
@@ -48,7 +48,7 @@ module fft_reorder #(
 
   // Free bank, or the slot of the bank under read has already been read.
   assign wr_ok   = !full_q[wb_q] || (rb_q == wb_q && wr_addr < rd_ptr_q);
-  assign pop     = full_q[rb_q] && (!m_valid_q || m_ready);
+  assign pop     = full_q[rb_q] && (!m_valid_q || m_axis_tready);
   assign rd_last = rd_ptr_q == LOG2N'(N - 1);
   assign wr_last = wr_pos == LOG2N'(N - 1);
 
@@ -81,16 +81,16 @@ module fft_reorder #(
         rd_ptr_q <= rd_last ? '0 : rd_ptr_q + 1'b1;
         if (rd_last) rb_q <= ~rb_q;
         m_valid_q <= 1'b1;
-      end else if (m_ready) begin
+      end else if (m_axis_tready) begin
         m_valid_q <= 1'b0;
       end
     end
   end
 
-  assign m_data  = m_data_q;
-  assign m_user  = m_user_q;
-  assign m_last  = m_last_q;
-  assign m_valid = m_valid_q;
+  assign m_axis_tdata  = m_data_q;
+  assign m_axis_tuser  = m_user_q;
+  assign m_axis_tlast  = m_last_q;
+  assign m_axis_tvalid = m_valid_q;
 endmodule
 
 `default_nettype wire

@@ -36,7 +36,6 @@ module fft_sdf_bf #(
   output logic [LOG2N-1:0]      out_pos,
   output logic                  out_ov
 );
-  import fft_pkg::*;
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int MW = DW + LOG2N + 1;         // delay line word: data, index, overflow
@@ -44,10 +43,10 @@ module fft_sdf_bf #(
   localparam int PW = (D > 1) ? $clog2(D) : 1;
 
   if (D < 1 || (1 << DB) != D || DB >= LOG2N) begin : g_bad_d
-    $fatal(1, "fft_sdf_bf: D=%0d must be a power of two below 2^LOG2N", D);
+    $fatal(1, "%m: D=%0d must be a power of two below 2^LOG2N", D);
   end
-  if (ROTATE && DB + 1 >= LOG2N) begin : g_bad_rot
-    $fatal(1, "fft_sdf_bf: ROTATE needs D <= 2^(LOG2N-2) (D=%0d)", D);
+  if (ROTATE && DB + 1 >= LOG2N) begin : g_bad_rotate
+    $fatal(1, "%m: ROTATE needs D <= 2^(LOG2N-2) (D=%0d)", D);
   end
 
   // ---------------------------------------------------------------- delay line (FIFO of D)
@@ -106,16 +105,16 @@ module fft_sdf_bf #(
           {xr, xi} = {xi, -xr};
         end
       end
-      sr = round_conv(ar + xr, SCALE ? 1 : 0);
-      si = round_conv(ai + xi, SCALE ? 1 : 0);
-      dr = round_conv(ar - xr, SCALE ? 1 : 0);
-      di = round_conv(ai - xi, SCALE ? 1 : 0);
-      sum_ov = sum_ov | sat_ov(sr, W) | sat_ov(si, W);
-      dif_ov = dif_ov | sat_ov(dr, W) | sat_ov(di, W);
-      sum_data[ch*2*W +: W]     = W'(sat_val(sr, W));
-      sum_data[ch*2*W + W +: W] = W'(sat_val(si, W));
-      dif_data[ch*2*W +: W]     = W'(sat_val(dr, W));
-      dif_data[ch*2*W + W +: W] = W'(sat_val(di, W));
+      sr = fft_pkg::round_conv(ar + xr, SCALE ? 1 : 0);
+      si = fft_pkg::round_conv(ai + xi, SCALE ? 1 : 0);
+      dr = fft_pkg::round_conv(ar - xr, SCALE ? 1 : 0);
+      di = fft_pkg::round_conv(ai - xi, SCALE ? 1 : 0);
+      sum_ov = sum_ov | fft_pkg::sat_ov(sr, W) | fft_pkg::sat_ov(si, W);
+      dif_ov = dif_ov | fft_pkg::sat_ov(dr, W) | fft_pkg::sat_ov(di, W);
+      sum_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(sr, W));
+      sum_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(si, W));
+      dif_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(dr, W));
+      dif_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(di, W));
     end
   end
 

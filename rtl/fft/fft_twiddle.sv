@@ -31,14 +31,17 @@ module fft_twiddle #(
   output logic [LOG2N-1:0]      out_pos,
   output logic                  out_ov
 );
-  import fft_pkg::*;
-  import fft_rom_pkg::*;
+  // coefficient ROM geometry (rtl/fft/fft_rom_pkg.sv, generated)
+  localparam int ROM_LOG2 = fft_rom_pkg::ROM_LOG2;
+  localparam int ROM_SIZE = fft_rom_pkg::ROM_SIZE;
+  localparam int COEF_W = fft_rom_pkg::COEF_W;
+  localparam int COEF_FRAC = fft_rom_pkg::COEF_FRAC;
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int PRW = W + COEF_W;   // product width
 
-  if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad
-    $fatal(1, "fft_twiddle: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
+  if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad_log2m
+    $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
   end
 
   // ---------------------------------------------------------------- ROM index from the tag
@@ -75,8 +78,8 @@ module fft_twiddle #(
       d1_q   <= in_data;
       pos1_q <= in_pos;
       ov1_q  <= in_ov;
-      c1_q   <= signed'(COS[rom_idx]);
-      s1_q   <= signed'(COS[sin_idx]);
+      c1_q   <= signed'(fft_rom_pkg::COS(rom_idx));
+      s1_q   <= signed'(fft_rom_pkg::COS(sin_idx));
       for (int ch = 0; ch < NUM_CH; ch++) begin
         prc_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(c1_q);
         prs_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(s1_q);
@@ -103,11 +106,11 @@ module fft_twiddle #(
         yr = 64'(prc_r_q[ch]) + 64'(prs_i_q[ch]);
         yi = 64'(prc_i_q[ch]) - 64'(prs_r_q[ch]);
       end
-      yr = round_conv(yr, COEF_FRAC);
-      yi = round_conv(yi, COEF_FRAC);
-      y_ov = y_ov | sat_ov(yr, W) | sat_ov(yi, W);
-      y_d[ch*2*W +: W]     = W'(sat_val(yr, W));
-      y_d[ch*2*W + W +: W] = W'(sat_val(yi, W));
+      yr = fft_pkg::round_conv(yr, COEF_FRAC);
+      yi = fft_pkg::round_conv(yi, COEF_FRAC);
+      y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
+      y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
+      y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));
     end
   end
 

@@ -31,13 +31,15 @@ module fft_window #(
   output logic                       out_vld,
   output logic [LOG2N-1:0]           out_pos
 );
-  import fft_pkg::*;
-  import fft_rom_pkg::*;
+  // coefficient ROM geometry (rtl/fft/fft_rom_pkg.sv, generated)
+  localparam int ROM_LOG2 = fft_rom_pkg::ROM_LOG2;
+  localparam int COEF_W = fft_rom_pkg::COEF_W;
+  localparam int COEF_FRAC = fft_rom_pkg::COEF_FRAC;
 
   localparam int DW = NUM_CH * 2 * W;
 
-  if (W < DATA_W + GUARD_W || GUARD_W > COEF_FRAC || LOG2N > ROM_LOG2) begin : g_bad
-    $fatal(1, "fft_window: need W >= DATA_W+GUARD_W, GUARD_W <= 16 (GUARD_W=%0d)", GUARD_W);
+  if (W < DATA_W + GUARD_W || GUARD_W > COEF_FRAC || LOG2N > ROM_LOG2) begin : g_bad_guard_w
+    $fatal(1, "%m: need W >= DATA_W+GUARD_W, GUARD_W <= 16 (GUARD_W=%0d)", GUARD_W);
   end
 
   if (WINDOW) begin : g_win
@@ -56,14 +58,14 @@ module fft_window #(
       for (int c = 0; c < 2 * NUM_CH; c++) begin
         p = 64'(signed'(d1_q[c*DATA_W +: DATA_W])) * 64'(w1_q);
         // |x * w| <= |x| so the result always fits: no saturation needed.
-        y_d[c*W +: W] = W'(round_conv(p, COEF_FRAC - GUARD_W));
+        y_d[c*W +: W] = W'(fft_pkg::round_conv(p, COEF_FRAC - GUARD_W));
       end
     end
 
     always_ff @(posedge clk) begin
       if (en) begin
         d1_q   <= in_data;
-        w1_q   <= signed'(HANN[rom_idx]);
+        w1_q   <= signed'(fft_rom_pkg::HANN(rom_idx));
         pos1_q <= in_pos;
         y2_q   <= y_d;
         pos2_q <= pos1_q;

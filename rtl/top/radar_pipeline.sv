@@ -132,21 +132,21 @@ module radar_pipeline #(
 
   // ---- parameter checks -----------------------------------------------------------------
   if (DATA_W != 16) begin : g_bad_data_w
-    $fatal(1, "radar_pipeline: DATA_W=%0d, the DMA format needs 16", DATA_W);
+    $fatal(1, "%m: DATA_W=%0d, the DMA format needs 16", DATA_W);
   end
   if (NUM_RX < 1 || NUM_RX > 16) begin : g_bad_num_rx
-    $fatal(1, "radar_pipeline: NUM_RX=%0d not in 1..16", NUM_RX);
+    $fatal(1, "%m: NUM_RX=%0d not in 1..16", NUM_RX);
   end
   if (NUM_TX < 1 || NUM_TX > 16 || (NUM_TX & (NUM_TX - 1)) != 0) begin : g_bad_num_tx
-    $fatal(1, "radar_pipeline: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
   end
   if (N_RANGE < 16 || N_RANGE > 4096 || (N_RANGE & (N_RANGE - 1)) != 0)
   begin : g_bad_n_range
-    $fatal(1, "radar_pipeline: N_RANGE=%0d must be a power of two in 16..4096", N_RANGE);
+    $fatal(1, "%m: N_RANGE=%0d must be a power of two in 16..4096", N_RANGE);
   end
   if (N_DOPPLER < 16 || N_DOPPLER > 4096 || (N_DOPPLER & (N_DOPPLER - 1)) != 0)
   begin : g_bad_n_doppler
-    $fatal(1, "radar_pipeline: N_DOPPLER=%0d must be a power of two in 16..4096", N_DOPPLER);
+    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 16..4096", N_DOPPLER);
   end
 
   // ---- ADC chirp ping-pong ----------------------------------------------------------------
@@ -312,48 +312,33 @@ module radar_pipeline #(
   // fills the next, so at most DMG_DEPTH-1 marks wait here.
   localparam int DMG_DEPTH = 4;
   localparam int FWORD_W   = $clog2(FRAME_WORDS + 1);
-  logic [DMG_DEPTH-1:0]       dmg_q;        // marks, oldest in bit 0
-  logic [$clog2(DMG_DEPTH):0] dmg_cnt_q;
   logic [FWORD_W-1:0]         df_word_q;    // Doppler output word within its frame
-  logic                       df_beat, df_frame_end, dmg_push, dmg_pop, df_damaged;
+  logic                       df_beat, df_frame_end, df_damaged;
+  logic                       dmg_empty, dmg_full, dmg_overflow, dmg_underflow;
+  logic [$clog2(DMG_DEPTH):0] dmg_count;
   assign df_beat      = df_tvalid && df_tready;
   assign df_frame_end = df_beat && (df_word_q == FWORD_W'(FRAME_WORDS - 1));
-  assign dmg_push     = fa_frame_done;
-  assign dmg_pop      = df_frame_end && (dmg_cnt_q != '0);
-  assign df_damaged   = (dmg_cnt_q != '0) && dmg_q[0];
 
   always_ff @(posedge clk) begin
-    if (rst) begin
-      dmg_q     <= '0;
-      dmg_cnt_q <= '0;
-      df_word_q <= '0;
-    end else begin
-      if (df_beat) df_word_q <= df_frame_end ? '0 : df_word_q + 1'b1;
-      unique case ({dmg_push, dmg_pop})
-        2'b10: begin
-          dmg_q[dmg_cnt_q[$clog2(DMG_DEPTH)-1:0]] <= fa_frame_damaged;
-          dmg_cnt_q <= dmg_cnt_q + 1'b1;
-        end
-        2'b01: begin
-          dmg_q     <= dmg_q >> 1;
-          dmg_cnt_q <= dmg_cnt_q - 1'b1;
-        end
-        2'b11: begin
-          dmg_q                                          <= dmg_q >> 1;
-          dmg_q[dmg_cnt_q[$clog2(DMG_DEPTH)-1:0] - 1'b1] <= fa_frame_damaged;
-        end
-        default: ;
-      endcase
-    end
+    if (rst) df_word_q <= '0;
+    else if (df_beat) df_word_q <= df_frame_end ? '0 : df_word_q + 1'b1;
   end
+
+  mark_fifo #(.DEPTH(DMG_DEPTH), .WIDTH(1)) u_damage_marks (
+    .clk, .rst,
+    .push(fa_frame_done), .push_data(fa_frame_damaged),
+    .pop(df_frame_end), .head(df_damaged),
+    .empty(dmg_empty), .full(dmg_full), .count(dmg_count),
+    .overflow(dmg_overflow), .underflow(dmg_underflow)
+  );
 
 `ifndef SYNTHESIS
   always_ff @(posedge clk) begin
     if (!rst) begin
-      assert (!(dmg_push && !dmg_pop && dmg_cnt_q == ($clog2(DMG_DEPTH) + 1)'(DMG_DEPTH)))
-        else $error("radar_pipeline: damage-mark FIFO overflow");
-      assert (!(df_beat && dmg_cnt_q == '0))
-        else $error("radar_pipeline: Doppler output of a frame frame_align never sent");
+      assert (!(fa_frame_done && dmg_full && !df_frame_end))
+        else $error("%m: damage-mark FIFO overflow");
+      assert (!(df_beat && dmg_empty))
+        else $error("%m: Doppler output of a frame frame_align never sent");
     end
   end
 `endif
@@ -417,7 +402,8 @@ module radar_pipeline #(
   // (chirps dropped are reported instead). Waiver: reduced into a deliberately unused bit.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
-  assign unused_ok = ^{rf_tuser, df_tuser, pp_tuser, ct_tuser, ct_frames_out, pp_drop_samples};
+  assign unused_ok = ^{rf_tuser, df_tuser, ct_tuser, ct_frames_out, pp_drop_samples,
+                       dmg_count, dmg_overflow, dmg_underflow};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

@@ -18,18 +18,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 import tempfile
 from collections import Counter
 from pathlib import Path
 
+from model import frame_store_axi as fs
+from model.config import get_preset
+from rtlsim.toolchain import rtl_sources, run_cocotb
+
 HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE.parent), str(HERE)]
-
-from sim import rtl_sources, run_cocotb  # noqa: E402
-
-from model import frame_store_axi as fs  # noqa: E402
-from model.config import get_preset  # noqa: E402
 
 CLOCK_HZ = 100e6
 """Pipeline (and AXI port) clock: the chain's 100 MHz."""
@@ -92,9 +89,10 @@ def rtl_params(full: bool) -> dict:
 def measure(params: dict, stall: float, frames: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.json"
-        run_cocotb("frame_store_axi", rtl_sources("buffers/*.sv"), "test_frame_store_axi", HERE,
-                   params, extra_env={"FS_BENCH_JSON": str(out), "FS_BENCH_STALL": str(stall),
-                                      "FS_BENCH_FRAMES": str(frames)}, testcase="bench")
+        run_cocotb("frame_store_axi", rtl_sources("common/*.sv", "buffers/*.sv"),
+                   "test_frame_store_axi", HERE, params,
+                   extra_env={"FS_BENCH_JSON": str(out), "FS_BENCH_STALL": str(stall),
+                              "FS_BENCH_FRAMES": str(frames)}, testcase="bench")
         return json.loads(out.read_text())
 
 

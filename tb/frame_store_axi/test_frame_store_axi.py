@@ -12,15 +12,15 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
 from cocotb.triggers import RisingEdge
 from cocotbext.axi import AxiBus, AxiStreamFrame
 from cocotbext.axi.axi_ram import AxiRamRead, AxiRamWrite
 from cocotbext.axi.memory import Memory
-from sim import param, rtl_sources, run_cocotb
 
 from model import frame_store_axi as fs
-from model.packetizer import words_to_bytes
+from model.axis_packetizer import words_to_bytes
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class FaultRamWrite(AxiRamWrite):
@@ -72,8 +72,6 @@ class FaultAxiRam(Memory):
 class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut)
-        for comp in (self.source, self.sink):
-            comp.log.setLevel(logging.WARNING)
         self.g = fs.StoreGeometry(
             num_tx=param("NUM_TX"), num_rx=param("NUM_RX"), n_range=param("N_RANGE"),
             n_doppler=param("N_DOPPLER"), data_w=param("DATA_W"), tile_r=param("TILE_R"),
@@ -81,7 +79,6 @@ class TB(AxisTB):
             mem_base=param("MEM_BASE"))
         self.ram = FaultAxiRam(AxiBus.from_prefix(dut, "m_axi_mem"), dut.clk, dut.rst,
                                size=self.g.mem_base + self.g.memory_bytes)
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
         self.aw: list[tuple[int, int]] = []
         self.ar: list[tuple[int, int]] = []
         self.events: list[tuple[int, int, int, str]] = []   # (clock, addr, beats, W|R)
@@ -360,7 +357,8 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items() if k not in ("MEM_BASE",)))
 def test_frame_store_axi(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("frame_store_axi", rtl_sources("buffers/*.sv"), "test_frame_store_axi", here,
+    run_cocotb("frame_store_axi", rtl_sources("common/*.sv", "buffers/*.sv"),
+               "test_frame_store_axi", here,
                parameters={"DATA_W": 16, "AXI_ADDR_W": 32, "AXI_ID_W": 1, **parameters})
 
 

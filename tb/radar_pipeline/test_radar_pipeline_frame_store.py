@@ -17,29 +17,24 @@ import numpy as np
 import pytest
 from cocotb.triggers import SimTimeoutError, Timer
 from cocotbext.axi import AxiBus, AxiRam
-from sim import rtl_sources, run_cocotb
-from test_radar_pipeline import (
-    SMALL4,
-    assert_packets_equal,
-    chirp_bursts,
-    decode,
-    random_pause,
-)
+from test_radar_pipeline import SMALL4, assert_packets_equal, chirp_bursts, decode
 from test_radar_pipeline import adc_frames as scene_frames
 
-from host.rtlsim.driver import PipelineTB
-from host.rtlsim.pipeline_rtl import PIPELINE_SOURCES, hdl_parameters
+from model.axis_packetizer import parse_header
 from model.frame_store_axi import StoreGeometry
-from model.packetizer import parse_header
-from model.pipeline import PipelineParams, dma_packets, run_chain
+from model.radar_pipeline import PipelineParams, dma_packets, run_chain
+from rtlsim.axis import random_pause
+from rtlsim.pipeline import PipelineTB
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES
+from rtlsim.toolchain import rtl_sources, run_cocotb
 
 CHAIN = PipelineParams(packet_words=256, frame_store=True, axi_data_w=128, fs_tile_r=8)
 MEM_BASE = 0x10000
 
 
 def store_params(chain: PipelineParams) -> dict[str, int]:
-    return {"FRAME_STORE": 1, "AXI_DATA_W": chain.axi_data_w, "AXI_ADDR_W": 32,
-            "AXI_ID_W": 1, "MEM_BASE": MEM_BASE, "FS_TILE_R": chain.fs_tile_r}
+    return {**chain.hdl_parameters(SMALL4), "AXI_ADDR_W": 32, "AXI_ID_W": 1,
+            "MEM_BASE": MEM_BASE}
 
 
 def attach_ram(tb: PipelineTB) -> AxiRam:
@@ -65,8 +60,8 @@ async def external_store_bit_exact_with_axi_stalls(dut) -> None:
     for i, ch in enumerate(channels(ram)):
         ch.set_pause_generator(random_pause(0.3, 20 + i))
     frames = scene_frames("small4", SMALL4, 3)
-    tb.set_adc_gaps(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
-    tb.set_dma_stalls(random_pause(0.3, 2))
+    tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
+    tb.set_backpressure_generator(random_pause(0.3, 2))
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)
@@ -94,7 +89,7 @@ async def slow_memory_drops_whole_chirps(dut) -> None:
     n_frames = 6
     frames = scene_frames("small4", SMALL4, n_frames, seed=7)
     await tb.reset()
-    tb.set_adc_gaps(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
+    tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
     for adc in frames:
         await tb.send_frame(adc)
     frame_clocks = 2 * SMALL4.n_chirps * SMALL4.n_range
@@ -125,4 +120,4 @@ async def slow_memory_drops_whole_chirps(dut) -> None:
 def test_radar_pipeline_frame_store(name: str) -> None:
     run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES),
                "test_radar_pipeline_frame_store", Path(__file__).parent,
-               {**hdl_parameters(SMALL4, CHAIN), **store_params(CHAIN)})
+               store_params(CHAIN))

@@ -52,13 +52,13 @@ module frame_align #(
   localparam int CHP_W  = (FRAME_CHIRPS > 1) ? $clog2(FRAME_CHIRPS) : 1;
 
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
-    $fatal(1, "frame_align: NUM_RX=%0d not in 1..64", NUM_RX);
+    $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
   if (N_RANGE < 2 || N_RANGE > 65536) begin : g_bad_n_range
-    $fatal(1, "frame_align: N_RANGE=%0d not in 2..65536", N_RANGE);
+    $fatal(1, "%m: N_RANGE=%0d not in 2..65536", N_RANGE);
   end
   if (FRAME_CHIRPS < 1 || FRAME_CHIRPS > (1 << 24)) begin : g_bad_frame_chirps
-    $fatal(1, "frame_align: FRAME_CHIRPS=%0d not in 1..2^24", FRAME_CHIRPS);
+    $fatal(1, "%m: FRAME_CHIRPS=%0d not in 1..2^24", FRAME_CHIRPS);
   end
 
   typedef enum logic [1:0] {PASS, FILL, DISCARD} state_t;
@@ -158,20 +158,13 @@ module frame_align #(
   assign chirps_filled    = fill_cnt_q;
   assign chirps_discarded = disc_cnt_q;
 
-`ifndef SYNTHESIS
-  // AXI4-Stream: TVALID held and data stable while stalled (output side)
-  logic             v_q;
-  logic [WORD_W:0]  d_q;
-  always_ff @(posedge clk) begin
-    v_q <= m_axis_tvalid && !m_axis_tready && !rst;
-    d_q <= {m_axis_tlast, m_axis_tdata};
-    if (v_q && !rst) begin  // the AXI rules do not hold across a reset
-      assert (m_axis_tvalid) else $error("frame_align: TVALID dropped while stalled");
-      assert ({m_axis_tlast, m_axis_tdata} == d_q)
-        else $error("frame_align: data changed while stalled");
-    end
-  end
-`endif
+  // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(WORD_W + 3), .ASSUME(1'b1)) u_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
+    .payload({s_axis_tuser, s_axis_tlast, s_axis_tdata}));
+  axis_checker #(.PAYLOAD_W(WORD_W + 1)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tlast, m_axis_tdata}));
 
 endmodule
 

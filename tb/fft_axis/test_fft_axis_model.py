@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model import fft_fixed as ff
+from model import fft_axis as ff
 from model.fft_rom import PKG_PATH, cos_table, hann_table, render_rom_pkg, sin_table
 
 
 def test_rom_package_up_to_date() -> None:
     """rtl/fft/fft_rom_pkg.sv is exactly what model/fft_rom.py generates."""
-    assert PKG_PATH.read_text() == render_rom_pkg(), "run `python -m model.fft_rom`"
+    assert PKG_PATH.read_text() == render_rom_pkg(), "stale: run `make gen`"
 
 
 def test_rom_values() -> None:
