@@ -22,7 +22,7 @@ help:
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
-	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
@@ -75,6 +75,7 @@ bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
 	$(RUN) python tb/radar_pipeline/bench_harness.py
+	$(RUN) python tb/frame_store_axi/bench_frame_store_axi.py
 
 # not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
 SOAK_FRAMES ?= 1000

@@ -21,10 +21,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.axis_packetizer import check_geometry, cube_to_payload, packetize
+from model.axis_packetizer import (
+    check_geometry,
+    cube_to_payload,
+    pack_iq,
+    packetize,
+    unpack_iq,
+)
 from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
 from model.fft_axis import fft_fixed_planar, fft_fixed_reference, from_planar, to_planar
+from model.frame_store_axi import StoreGeometry, store_frames
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -37,7 +44,9 @@ class PipelineParams:
     """HDL parameters of ``radar_pipeline`` beyond the radar configuration.
 
     ``packet_words``: PACKET_WORDS; ``window``: WINDOW (periodic Hann before both FFTs);
-    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER.
+    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER;
+    ``frame_store``: FRAME_STORE (corner turn in external memory over AXI4, same payload),
+    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R.
     """
 
     packet_words: int = 1024
@@ -45,6 +54,15 @@ class PipelineParams:
     range_scale_sch: int = RANGE_SCALE_SCH
     doppler_scale_sch: int = DOPPLER_SCALE_SCH
     header: bool = True
+    frame_store: bool = False
+    axi_data_w: int = 128
+    fs_tile_r: int = 16
+
+    def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
+        """The external frame store's geometry (FRAME_STORE = 1)."""
+        return StoreGeometry(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+                             n_doppler=cfg.n_doppler, tile_r=self.fs_tile_r,
+                             axi_data_w=self.axi_data_w)
 
     def frame_words(self, cfg: RadarConfig) -> int:
         """Payload words per frame, num_tx * n_range * n_doppler."""
@@ -53,10 +71,13 @@ class PipelineParams:
     def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
         (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
-        schedules and HEADER)."""
+        schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``)."""
+        store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w, "FS_TILE_R": self.fs_tile_r}
+                 if self.frame_store else {})
         return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
                               RANGE_SCALE_SCH=self.range_scale_sch,
-                              DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header))
+                              DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),
+                              **store)
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a combination the RTL refuses at elaboration."""
@@ -107,7 +128,7 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
         rng = fft_fixed_reference(np.transpose(adc, (0, 2, 1)), window=params.window,
                                   scale_sch=params.range_scale_sch)
         words = rng.y.reshape(-1, cfg.num_rx)                   # chirp-major input order
-        turned = corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+        turned = _turn(words, cfg, params)
         dop = fft_fixed_reference(turned.reshape(-1, cfg.n_doppler, cfg.num_rx),
                                   window=params.window, scale_sch=params.doppler_scale_sch)
         payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
@@ -116,12 +137,26 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
     planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_range, rx, 2)
     rng_p, rng_ov = fft_fixed_planar(planar, window=params.window,
                                      scale_sch=params.range_scale_sch)
-    turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
-                         cfg.n_doppler)
+    if params.frame_store:     # through the external layout's bursts and strip buffer
+        words = from_planar(rng_p).reshape(-1, cfg.num_rx)
+        turned = to_planar(_turn(words, cfg, params)).astype(rng_p.dtype)
+    else:
+        turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
+                             cfg.n_doppler)
     dop_p, dop_ov = fft_fixed_planar(turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2),
                                      window=params.window, scale_sch=params.doppler_scale_sch)
     payload = from_planar(dop_p).reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
     return ChainOutput(payload, int(rng_ov.sum()), int(dop_ov.sum()))
+
+
+def _turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndarray:
+    """Range-FFT words complex (num_tx * n_doppler * n_range, num_rx), chirp-major input
+    order -> Doppler-vector order (tx, r, d), through the on-chip corner turn or, with
+    ``params.frame_store``, through the external store's bursts and strip buffer (the same
+    payload: tests/test_frame_store_chain.py)."""
+    if params.frame_store:
+        return unpack_iq(store_frames([pack_iq(words)], params.store_geometry(cfg))[0])
+    return corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
 
 
 def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None

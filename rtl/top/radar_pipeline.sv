@@ -36,7 +36,22 @@ module radar_pipeline #(
   // 1: a header word before each packet's payload (frame id, sequence, flags); 0: none.
   parameter bit HEADER = 1'b1,
   // Packet banks of the output buffer, power of two, 2..16 (2 = the paper's double buffer).
-  parameter int OUT_BANKS = 4
+  parameter int OUT_BANKS = 4,
+  // Corner turn: 0 = on-chip memory (corner_turn, m_axi_mem idle); 1 = external memory
+  // through m_axi_mem (frame_store_axi, docs/frame_store.md). The DMA output is identical.
+  parameter bit FRAME_STORE = 1'b0,
+  // m_axi_mem data width in bits: 128, 256 or 512 (FRAME_STORE = 1).
+  parameter int AXI_DATA_W = 128,
+  // m_axi_mem address width in bits, 32..40.
+  parameter int AXI_ADDR_W = 32,
+  // m_axi_mem ID width in bits, 1..8.
+  parameter int AXI_ID_W = 1,
+  // Byte address of the two frame areas in external memory, 4 KiB aligned (FRAME_STORE = 1).
+  /* verilator lint_off WIDTHEXPAND */
+  parameter longint unsigned MEM_BASE = 0,
+  /* verilator lint_on WIDTHEXPAND */
+  // Range bins per strip of the external layout (frame_store_axi TILE_R).
+  parameter int FS_TILE_R = 16
 ) (
   input  wire logic                       clk,
   input  wire logic                       rst,
@@ -70,7 +85,45 @@ module radar_pipeline #(
   output logic      [31:0]                chirps_discarded,      // chirps thrown away to realign
   output logic      [31:0]                frames_turned,         // frames through the corner turn
   output logic      [31:0]                frames_out,            // frames packetized
-  output logic      [31:0]                packets_out
+  output logic      [31:0]                packets_out,
+  // External frame store (FRAME_STORE = 1; outputs constant 0 when FRAME_STORE = 0)
+  output logic                            status_mem_error,      // sticky: SLVERR/DECERR
+  output logic      [31:0]                mem_error_count,
+  output logic      [AXI_ID_W-1:0]        m_axi_mem_awid,
+  output logic      [AXI_ADDR_W-1:0]      m_axi_mem_awaddr,
+  output logic      [7:0]                 m_axi_mem_awlen,
+  output logic      [2:0]                 m_axi_mem_awsize,
+  output logic      [1:0]                 m_axi_mem_awburst,
+  output logic                            m_axi_mem_awlock,
+  output logic      [3:0]                 m_axi_mem_awcache,
+  output logic      [2:0]                 m_axi_mem_awprot,
+  output logic                            m_axi_mem_awvalid,
+  input  wire logic                       m_axi_mem_awready,
+  output logic      [AXI_DATA_W-1:0]      m_axi_mem_wdata,
+  output logic      [AXI_DATA_W/8-1:0]    m_axi_mem_wstrb,
+  output logic                            m_axi_mem_wlast,
+  output logic                            m_axi_mem_wvalid,
+  input  wire logic                       m_axi_mem_wready,
+  input  wire logic [AXI_ID_W-1:0]        m_axi_mem_bid,
+  input  wire logic [1:0]                 m_axi_mem_bresp,
+  input  wire logic                       m_axi_mem_bvalid,
+  output logic                            m_axi_mem_bready,
+  output logic      [AXI_ID_W-1:0]        m_axi_mem_arid,
+  output logic      [AXI_ADDR_W-1:0]      m_axi_mem_araddr,
+  output logic      [7:0]                 m_axi_mem_arlen,
+  output logic      [2:0]                 m_axi_mem_arsize,
+  output logic      [1:0]                 m_axi_mem_arburst,
+  output logic                            m_axi_mem_arlock,
+  output logic      [3:0]                 m_axi_mem_arcache,
+  output logic      [2:0]                 m_axi_mem_arprot,
+  output logic                            m_axi_mem_arvalid,
+  input  wire logic                       m_axi_mem_arready,
+  input  wire logic [AXI_ID_W-1:0]        m_axi_mem_rid,
+  input  wire logic [AXI_DATA_W-1:0]      m_axi_mem_rdata,
+  input  wire logic [1:0]                 m_axi_mem_rresp,
+  input  wire logic                       m_axi_mem_rlast,
+  input  wire logic                       m_axi_mem_rvalid,
+  output logic                            m_axi_mem_rready
 );
 
   localparam int LANE_W      = 2 * DATA_W;
@@ -163,18 +216,77 @@ module radar_pipeline #(
   logic              ct_framing;
   logic [31:0]       ct_framing_count, ct_frames_out;
 
-  corner_turn #(
-    .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
-    .DATA_W(DATA_W)
-  ) u_corner_turn (
-    .clk, .rst,
-    .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
-    .s_axis_tlast(rf_tlast),
-    .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
-    .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
-    .status_framing_error(ct_framing), .framing_error_count(ct_framing_count),
-    .frames_in(frames_turned), .frames_out(ct_frames_out)
-  );
+  if (!FRAME_STORE) begin : g_ct_onchip
+    corner_turn #(
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+      .DATA_W(DATA_W)
+    ) u_corner_turn (
+      .clk, .rst,
+      .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
+      .s_axis_tlast(rf_tlast),
+      .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
+      .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
+      .status_framing_error(ct_framing), .framing_error_count(ct_framing_count),
+      .frames_in(frames_turned), .frames_out(ct_frames_out)
+    );
+    // the external memory port is idle
+    assign status_mem_error  = 1'b0;
+    assign mem_error_count   = '0;
+    assign m_axi_mem_awid    = '0;
+    assign m_axi_mem_awaddr  = '0;
+    assign m_axi_mem_awlen   = '0;
+    assign m_axi_mem_awsize  = '0;
+    assign m_axi_mem_awburst = '0;
+    assign m_axi_mem_awlock  = 1'b0;
+    assign m_axi_mem_awcache = '0;
+    assign m_axi_mem_awprot  = '0;
+    assign m_axi_mem_awvalid = 1'b0;
+    assign m_axi_mem_wdata   = '0;
+    assign m_axi_mem_wstrb   = '0;
+    assign m_axi_mem_wlast   = 1'b0;
+    assign m_axi_mem_wvalid  = 1'b0;
+    assign m_axi_mem_bready  = 1'b0;
+    assign m_axi_mem_arid    = '0;
+    assign m_axi_mem_araddr  = '0;
+    assign m_axi_mem_arlen   = '0;
+    assign m_axi_mem_arsize  = '0;
+    assign m_axi_mem_arburst = '0;
+    assign m_axi_mem_arlock  = 1'b0;
+    assign m_axi_mem_arcache = '0;
+    assign m_axi_mem_arprot  = '0;
+    assign m_axi_mem_arvalid = 1'b0;
+    assign m_axi_mem_rready  = 1'b0;
+    /* verilator lint_off UNUSEDSIGNAL */
+    logic unused_axi;
+    assign unused_axi = ^{m_axi_mem_awready, m_axi_mem_wready, m_axi_mem_bid, m_axi_mem_bresp,
+                          m_axi_mem_bvalid, m_axi_mem_arready, m_axi_mem_rid, m_axi_mem_rdata,
+                          m_axi_mem_rresp, m_axi_mem_rlast, m_axi_mem_rvalid};
+    /* verilator lint_on UNUSEDSIGNAL */
+  end else begin : g_ct_external
+    frame_store_axi #(
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+      .DATA_W(DATA_W), .TILE_R(FS_TILE_R), .AXI_DATA_W(AXI_DATA_W), .AXI_ADDR_W(AXI_ADDR_W),
+      .AXI_ID_W(AXI_ID_W), .MEM_BASE(MEM_BASE)
+    ) u_frame_store (
+      .clk, .rst,
+      .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
+      .s_axis_tlast(rf_tlast),
+      .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
+      .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
+      .m_axi_mem_awid, .m_axi_mem_awaddr, .m_axi_mem_awlen, .m_axi_mem_awsize,
+      .m_axi_mem_awburst, .m_axi_mem_awlock, .m_axi_mem_awcache, .m_axi_mem_awprot,
+      .m_axi_mem_awvalid, .m_axi_mem_awready, .m_axi_mem_wdata, .m_axi_mem_wstrb,
+      .m_axi_mem_wlast, .m_axi_mem_wvalid, .m_axi_mem_wready, .m_axi_mem_bid,
+      .m_axi_mem_bresp, .m_axi_mem_bvalid, .m_axi_mem_bready, .m_axi_mem_arid,
+      .m_axi_mem_araddr, .m_axi_mem_arlen, .m_axi_mem_arsize, .m_axi_mem_arburst,
+      .m_axi_mem_arlock, .m_axi_mem_arcache, .m_axi_mem_arprot, .m_axi_mem_arvalid,
+      .m_axi_mem_arready, .m_axi_mem_rid, .m_axi_mem_rdata, .m_axi_mem_rresp,
+      .m_axi_mem_rlast, .m_axi_mem_rvalid, .m_axi_mem_rready,
+      .status_framing_error(ct_framing), .framing_error_count(ct_framing_count),
+      .status_mem_error, .mem_error_count,
+      .frames_in(frames_turned), .frames_out(ct_frames_out)
+    );
+  end
 
   // ---- Doppler FFT --------------------------------------------------------------------------
   logic [WORD_W-1:0]            df_tdata;
