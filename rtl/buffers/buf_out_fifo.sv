@@ -100,7 +100,10 @@ module buf_out_fifo #(
     .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready), .payload(m_axis_tdata));
 `endif
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   always_ff @(posedge clk) begin
     if (!rst) begin
       assert (!(issue && !can_issue)) else $error("buf_out_fifo: read issued without credit");

@@ -225,7 +225,10 @@ module chirp_pingpong #(
     .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
     .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   // block invariant: with ADC_BACKPRESSURE nothing is ever dropped
   always_ff @(posedge clk) begin
     if (!rst && ADC_BACKPRESSURE && beat) assert (keep || skip_q)

@@ -268,7 +268,10 @@ module corner_turn #(
   end
 `endif
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   // block invariant (in place): never write a slot of the frame being read before reading it
   always_ff @(posedge clk) begin
     if (!rst && wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)

@@ -128,12 +128,16 @@ module fft_reorder #(
     assume (wr_pos == f_wpos);
   end
 `endif
-  always_comb if (f_past && !rst) begin
+  always_comb begin
+    f_written = 1'b0;
+    f_unread  = 1'b0;
+    if (f_past && !rst) begin
     if (wr_en) assert (!f_pend[{wb_q, wr_addr}] || (pop && {rb_q, rd_ptr_q} == {wb_q, wr_addr}));
     if (pop) assert (f_pend[{rb_q, rd_ptr_q}]);
     // bank order invariants
     if (wb_q != rb_q) assert (!full_q[wb_q]);
-    if (!full_q[rb_q]) assert (!full_q[!rb_q] && rd_ptr_q == '0);
+    if (wb_q == rb_q) assert (full_q[0] == full_q[1]);
+    if (!full_q[rb_q]) assert (!full_q[!rb_q] && rd_ptr_q == '0 && wb_q == rb_q);
     if (m_axis_tvalid) assert (m_axis_tlast == (m_axis_tuser == LOG2N'(N - 1)));
     // inductive form of the bank reuse rule: which slots hold unread samples
     for (int b = 0; b < 2; b++) begin
@@ -144,6 +148,7 @@ module fft_reorder #(
         if (f_written && full_q[b]) assert (b == int'(rb_q) && LOG2N'(i) < rd_ptr_q);
       end
     end
+  end
   end
   always_comb if (f_past && !rst) begin
     cover (full_q == 2'b11);
