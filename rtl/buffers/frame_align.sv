@@ -183,7 +183,7 @@ module frame_align #(
     end
   end
   always_comb if (f_past && !rst) begin
-    assume (f_fill_chirps != '1 && f_disc_chirps != '1);  // counters far from saturation
+    assume (f_fill_chirps != '1 && f_disc_chirps != '1 && f_dmg_frames != '1);  // no saturation
     assert (state_q == PASS || state_q == FILL || state_q == DISCARD);
     assert (smp_q <= SMP_W'(N_RANGE - 1));
     assert (chirp_q <= CHP_W'(FRAME_CHIRPS - 1));
