@@ -243,9 +243,9 @@ module corner_turn #(
     if (wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q);
     assert (!(pending_q && rd_active_q));
     if (!rd_active_q) assert (rd_cnt_q == '0);
-    if (rd_active_q) assert (rd_shift_q == wr_shift_q);
+    if (rd_active_q) assert (rd_shift_q == wr_shift_q && wr_cnt_q <= rd_cnt_q);
     if (pending_q) assert (wr_cnt_q == '0);
-    assert (wr_shift_q < SH_W'(B) && rd_shift_q < SH_W'(B));
+    assert ({1'b0, wr_shift_q} < (SH_W+1)'(B) && {1'b0, rd_shift_q} < (SH_W+1)'(B));
     for (int j = 0; j < (1 << B); j++) begin
       assert (f_pend[rotl(B'(j), wr_shift_q)] ==
               (pending_q || (rd_active_q && B'(j) >= rd_cnt_q) || B'(j) < wr_cnt_q));
