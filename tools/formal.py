@@ -79,7 +79,7 @@ def run_task(sby: Path, task: str, timeout: float) -> tuple[str, float]:
     (WORK / f"{sby.stem}_{task}.log").write_text(out)
     m = re.search(r"DONE \((\w+), rc=\d+\)", out)
     word = m.group(1) if m else "ERROR"
-    if word == "PASS" and task == "prove":
+    if word == "PASS" and task.startswith("prove"):
         word = "PROVEN"
     return word, seconds
 

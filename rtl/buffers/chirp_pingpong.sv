@@ -266,7 +266,8 @@ module chirp_pingpong #(
     assert (8'(f_commits - 8'(chirps_out_q)) == 8'(full_q[0]) + 8'(full_q[1]));
     if (ADC_BACKPRESSURE) begin
       if (beat) assert (keep || skip_q);
-      assert (!discard_q && drop_cnt_q == '0 && !ovf_q);
+      assert (drop_cnt_q == '0 && !ovf_q);
+      if (pos_q != '0 && !skip_q) assert (!discard_q);
     end
 `ifdef F_OUTPUT_FRAMING
     if (m_axis_tvalid) begin
