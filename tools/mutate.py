@@ -45,28 +45,40 @@ RTL = REPO / "rtl"
 OUT = REPO / "out" / "mutate"
 COPY_DIRS = ("rtl", "tb", "host", "model")
 
-# module -> pytest arguments of the testbenches that exercise it (most specific first)
-TESTS: dict[str, list[str]] = {
-    "frame_align": ["tb/frame_align"],
-    "chirp_pingpong": ["tb/chirp_pingpong"],
-    "corner_turn": ["tb/corner_turn"],
-    "axis_packetizer": ["tb/axis_packetizer"],
-    "buf_out_fifo": ["tb/chirp_pingpong", "tb/corner_turn", "tb/axis_packetizer"],
-    "buf_sdp_ram": ["tb/chirp_pingpong", "tb/corner_turn"],
-    "mark_fifo": ["tb/radar_pipeline"],
-    "radar_pipeline": ["tb/radar_pipeline"],
-    "fft_axis": ["tb/fft_axis/test_fft_axis.py"],
-    "fft_reorder": ["tb/fft_axis/test_fft_axis.py"],
-    "fft_sdf_bf": ["tb/fft_axis/test_fft_axis.py"],
-    "fft_twiddle": ["tb/fft_axis/test_fft_axis.py"],
-    "fft_window": ["tb/fft_axis/test_fft_axis.py"],
+# module -> pytest stages, cheapest first: a mutant is killed by the first stage that fails
+# (stage 1 is the smallest parameter set of the most specific testbench), and survives only
+# if every stage passes.
+_Q_FA = "tb/frame_align/test_frame_align.py::test_frame_align[rx2_n4]"
+_Q_CP = ("tb/chirp_pingpong/test_chirp_pingpong.py::"
+         "test_chirp_pingpong[NUM_RX1_N_RANGE8_ADC_BACKPRESSURE0]")
+_Q_CT = "tb/corner_turn/test_corner_turn.py::test_corner_turn[NUM_TX1_NUM_RX1_N_RANGE4_N_DOPPLER8]"
+_Q_PK = ("tb/axis_packetizer/test_axis_packetizer.py::test_axis_packetizer[NUM_RX1_PACKET_WORDS8_"
+         "FRAME_WORDS52_NUM_BANKS4_HEADER1_INPUT_BACKPRESSURE0_TLAST_PERIOD13]")
+_Q_FFT = ("tb/fft_axis/test_fft_axis.py::"
+          "test_fft_axis[N16_NUM_CH2_DATA_W12_GUARD_W2_WINDOW1_SCALE_SCH10]")
+_FFT = [[_Q_FFT], ["tb/fft_axis/test_fft_axis.py"]]
+TESTS: dict[str, list[list[str]]] = {
+    "frame_align": [[_Q_FA], ["tb/frame_align"]],
+    "chirp_pingpong": [[_Q_CP], ["tb/chirp_pingpong", "-k", "test_chirp_pingpong"]],
+    "corner_turn": [[_Q_CT], ["tb/corner_turn", "-k", "test_corner_turn"]],
+    "axis_packetizer": [[_Q_PK], ["tb/axis_packetizer", "-k", "test_axis_packetizer"]],
+    "buf_out_fifo": [[_Q_CP, _Q_CT], ["tb/chirp_pingpong", "tb/corner_turn",
+                                      "tb/axis_packetizer"]],
+    "buf_sdp_ram": [[_Q_CP, _Q_CT], ["tb/chirp_pingpong", "tb/corner_turn"]],
+    "mark_fifo": [["tb/radar_pipeline"]],
+    "radar_pipeline": [["tb/radar_pipeline"]],
+    "fft_axis": _FFT,
+    "fft_reorder": _FFT,
+    "fft_sdf_bf": _FFT,
+    "fft_twiddle": _FFT,
+    "fft_window": _FFT,
 }
 
 # The fixed CI subset (tests/test_mutate_ci.py): realistic one-line bugs in the cheapest
 # testbenches; every one must be killed.
 CI_MUTANTS = (
-    ("frame_align", "sticky", 0),
-    ("chirp_pingpong", "const", 0),
+    ("frame_align", "const", 0),      # chirp end one sample early
+    ("chirp_pingpong", "sticky", 2),  # overflow flag not sticky
 )
 
 
@@ -162,8 +174,7 @@ _REL_RE = re.compile(r"==|!=|<=|>=|(?<![<>])<(?![<=])|(?<![<>-])>(?![>=])")
 
 def _ops_in(code: str, spans, regex: re.Pattern[str]) -> Iterator[re.Match[str]]:
     for a, b in spans:
-        for m in regex.finditer(code, a, b):
-            yield m
+        yield from regex.finditer(code, a, b)
 
 
 def candidates(module: str) -> list[Mutant]:
@@ -290,7 +301,8 @@ def compiles(mutant: Mutant, root: Path) -> bool:
     return subprocess.run(cmd, cwd=root, capture_output=True).returncode == 0
 
 
-def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None) -> tuple[str, float]:
+def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
+               quick: bool = False) -> tuple[str, float]:
     """Run the covering testbenches on a copy of the tree holding ``mutant``.
     Returns ("killed" | "survived" | "timeout" | "invalid", seconds); a timeout counts as
     killed, a mutant that does not compile is "invalid" and not counted."""
@@ -306,16 +318,60 @@ def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None) -
             return "invalid", time.monotonic() - t0
         env = dict(os.environ)
         env["PYTHONPATH"] = f"{root}{os.pathsep}{env.get('PYTHONPATH', '')}"
-        cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p", "no:cacheprovider",
-               *(tests or TESTS[mutant.module])]
-        try:
-            proc = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True,
-                                  timeout=timeout)
-        except subprocess.TimeoutExpired:
-            return "timeout", time.monotonic() - t0
-        verdict = "survived" if proc.returncode == 0 else "killed"
-        if proc.returncode not in (0, 1):  # collection/build error still means the bug shows
-            verdict = "killed"
+        stages = [tests] if tests else TESTS[mutant.module]
+        if quick:
+            stages = stages[:1]
+        verdict = "survived"
+        for stage in stages:
+            left = timeout - (time.monotonic() - t0)
+            cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
+                   "no:cacheprovider", *stage]
+            try:
+                proc = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True,
+                                      timeout=max(left, 1.0))
+            except subprocess.TimeoutExpired:
+                return "timeout", time.monotonic() - t0
+            if proc.returncode != 0:
+                verdict = "killed"
+                break
+    return verdict, time.monotonic() - t0
+
+
+def run_mutant_formal(mutant: Mutant, timeout: float) -> tuple[str, float]:
+    """MCY-style: run the module's proof (formal/<module>.sby, tasks prove and bmc) on a
+    copy holding ``mutant``. A failed assertion kills it; "unknown" = the induction step
+    fails but no base-case counterexample was found within the depth."""
+    t0 = time.monotonic()
+    sby = REPO / "formal" / f"{mutant.module}.sby"
+    if not sby.exists():
+        return "invalid", 0.0
+    sys.path.insert(0, str(REPO / "tools"))
+    from formal import sby_command, sby_tasks
+    _, tasks, _ = sby_tasks(sby)
+    with tempfile.TemporaryDirectory(prefix="mutant_") as tmp:
+        root = Path(tmp)
+        for d in ("rtl", "formal"):
+            shutil.copytree(REPO / d, root / d)
+        apply(mutant, root)
+        env = dict(os.environ)
+        env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
+        verdict = "survived"
+        for task in [t for t in tasks if t != "cover"]:
+            try:
+                proc = subprocess.run([*sby_command(), "-d", str(root / f"w_{task}"),
+                                       str(root / "formal" / sby.name), task],
+                                      cwd=root / "formal", env=env, capture_output=True,
+                                      text=True, timeout=timeout)
+            except subprocess.TimeoutExpired:
+                return "timeout", time.monotonic() - t0
+            m = re.search(r"DONE \((\w+), rc=\d+\)", proc.stdout)
+            word = m.group(1) if m else "ERROR"
+            if word == "FAIL":
+                return "killed", time.monotonic() - t0
+            if word == "ERROR":
+                return "invalid", time.monotonic() - t0
+            if word != "PASS":
+                verdict = "unknown"
     return verdict, time.monotonic() - t0
 
 
@@ -339,7 +395,7 @@ def report(results: list[tuple[Mutant, str, float]]) -> str:
     """Markdown summary: score per module, then every surviving diff."""
     rows: dict[str, list[int]] = {}
     for m, verdict, _ in results:
-        if verdict == "invalid":
+        if verdict in ("invalid", "unknown"):
             continue
         r = rows.setdefault(m.module, [0, 0])
         r[0 if verdict != "survived" else 1] += 1
@@ -366,10 +422,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--list", action="store_true", help="print the candidates and stop")
     ap.add_argument("--ci", action="store_true", help="run the fixed CI subset")
     ap.add_argument("--id", action="append", help="run these mutants (module:op:index)")
+    ap.add_argument("--quick", action="store_true",
+                    help="first (cheapest) test stage only: survivors are not final")
+    ap.add_argument("--formal", action="store_true",
+                    help="kill mutants with the module's SymbiYosys proof instead of its tests")
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds per mutant")
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
     args = ap.parse_args(argv)
     modules = args.modules or list(TESTS)
+    if args.formal and not args.modules:
+        modules = [m for m in TESTS if (REPO / "formal" / f"{m}.sby").exists()]
     unknown = [m for m in modules if m not in TESTS]
     if unknown:
         print(f"error: no testbench mapping for {unknown} (see TESTS)", file=sys.stderr)
@@ -392,7 +454,8 @@ def main(argv: list[str] | None = None) -> int:
         chosen = sample(modules, args.n, args.seed)
     results: list[tuple[Mutant, str, float]] = []
     for m in chosen:
-        verdict, secs = run_mutant(m, args.timeout)
+        verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
+                         else run_mutant(m, args.timeout, quick=args.quick))
         results.append((m, verdict, secs))
         print(f"{m.ident:28s} {verdict:8s} {secs:6.0f} s  {m.path}:{m.line}: "
               f"{m.after.strip()[:60]}", flush=True)

@@ -321,6 +321,7 @@ module axis_packetizer #(
   logic [LEN_W:0]        f_out_pos = '0;
   logic [BANK_W:0]       f_nfull;
   logic [BANK_W-1:0]     f_b, f_nb;
+  desc_t                 f_d, f_dn;
   initial assume (rst);
   always_ff @(posedge clk) begin
     f_past <= 1'b1;
@@ -339,6 +340,8 @@ module axis_packetizer #(
   always_comb begin
     f_b  = '0;
     f_nb = '0;
+    f_d  = '0;
+    f_dn = '0;
     if (f_past && !rst) begin
       assume (frame_q != '1);
       assert (seq_q <= SEQ_W'(NPKT - 1));
@@ -352,19 +355,20 @@ module axis_packetizer #(
       for (int i = 0; i < NUM_BANKS; i++) begin
         f_b  = rd_bank_q + BANK_W'(i);
         f_nb = f_b + 1'b1;
+        f_d  = desc_q[f_b];
+        f_dn = desc_q[f_nb];
         if (full_q[f_b]) begin
-          assert (desc_q[f_b].seq <= SEQ_W'(NPKT - 1));
-          assert (desc_q[f_b].last == (desc_q[f_b].seq == SEQ_W'(NPKT - 1)));
-          assert (desc_q[f_b].len != '0 && desc_q[f_b].len <= LEN_W'(PACKET_WORDS));
+          assert (f_d.seq <= SEQ_W'(NPKT - 1));
+          assert (f_d.last == (f_d.seq == SEQ_W'(NPKT - 1)));
+          assert (f_d.len != '0 && f_d.len <= LEN_W'(PACKET_WORDS));
           if (INPUT_BACKPRESSURE) begin
-            assert (desc_q[f_b].drops == '0);
-            assert (desc_q[f_b].len == (desc_q[f_b].last ? LEN_W'(LAST_LEN) :
-                                                            LEN_W'(PACKET_WORDS)));
+            assert (f_d.drops == '0);
+            assert (f_d.len == (f_d.last ? LEN_W'(LAST_LEN) : LEN_W'(PACKET_WORDS)));
             // the next packet (stored or open) carries the next sequence number
             if (full_q[f_nb] && f_nb != rd_bank_q)
-              assert (desc_q[f_nb].seq == (desc_q[f_b].last ? '0 : desc_q[f_b].seq + 1'b1));
+              assert (f_dn.seq == (f_d.last ? '0 : f_d.seq + 1'b1));
             if (f_nb == wr_bank_q)
-              assert (seq_q == (desc_q[f_b].last ? '0 : desc_q[f_b].seq + 1'b1));
+              assert (seq_q == (f_d.last ? '0 : f_d.seq + 1'b1));
           end
         end
       end
