@@ -95,16 +95,19 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
                  timescale=("1ns", "1ps"), waves=waves, always=False)
     env = {f"PARAM_{k}": str(v) for k, v in parameters.items()}
     env.update(extra_env or {})
+    if cov:  # cocotb reads COVERAGE too (Python coverage of the testbench): not wanted here
+        env.setdefault("COCOTB_USER_COVERAGE", "0")
     try:
         return runner.test(test_module=test_module, hdl_toplevel=toplevel, build_dir=build_dir,
                            test_dir=build_dir, parameters=parameters, extra_env=env,
                            testcase=testcase, waves=waves,
                            plusargs=["+verilator+rand+reset+2"])
     finally:
-        if cov and (build_dir / "coverage.dat").exists():
-            keep = SIM_BUILD / "coverage" / f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
-            keep.parent.mkdir(parents=True, exist_ok=True)
-            (build_dir / "coverage.dat").replace(keep)
+        for dat in (build_dir / "coverage.dat", build_dir / "logs" / "coverage.dat"):
+            if cov and dat.exists():
+                keep = SIM_BUILD / "coverage" / f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
+                keep.parent.mkdir(parents=True, exist_ok=True)
+                dat.replace(keep)
 
 
 def param(name: str, default: int | None = None) -> int:
