@@ -124,7 +124,9 @@ module axis_packetizer #(
     logic             damaged;   // a word of the packet was marked damaged upstream
   } desc_t;
 
-  desc_t desc_q [NUM_BANKS];
+  // (plain vectors: Yosys mis-reads an unpacked array of packed structs, formal/README)
+  localparam int DESC_W = 2 * LEN_W + SEQ_W + 32 + 4;  // $bits(desc_t)
+  logic [DESC_W-1:0] desc_q [NUM_BANKS];
   logic [NUM_BANKS-1:0] full_q;            // bank holds a complete packet not yet fully read
 
   // ---------------------------------------------------------------------------------------
