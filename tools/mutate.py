@@ -77,8 +77,8 @@ TESTS: dict[str, list[list[str]]] = {
 # The fixed CI subset (tests/test_mutate_ci.py): realistic one-line bugs in the cheapest
 # testbenches; every one must be killed.
 CI_MUTANTS = (
-    ("frame_align", "const", 0),      # chirp end one sample early
-    ("chirp_pingpong", "sticky", 2),  # overflow flag not sticky
+    ("frame_align", "const", 0),   # chirp end one sample early (off-by-one at a wrap)
+    ("frame_align", "drop", 16),   # input beat counted without TREADY
 )
 
 
@@ -249,10 +249,13 @@ def candidates(module: str) -> list[Mutant]:
         m = re.match(r"^(\s*)if \((.*)\) (\w+) <= 1'b1;\s*$", code)
         if m:
             add("sticky", i, f"{m.group(1)}{m.group(3)} <= {m.group(2)};")
+        # multi-line form "if (c) begin / f <= 1'b1;": assign f <= c before the if (the
+        # inner assignment then repeats the same value: f follows c, it is not sticky)
         m = re.match(r"^(\s*)(\w+_q)\s*<= 1'b1;\s*$", code)
-        if m and i > 0 and re.match(r"^\s*if \((.*)\) begin", lines[i - 1]):
-            cond = re.match(r"^\s*if \((.*)\) begin", lines[i - 1]).group(1)
-            add("sticky", i, f"{m.group(1)}{m.group(2)} <= {cond};")
+        mi = re.match(r"^(\s*)if \((.*)\) begin(.*)$", lines[i - 1]) if i > 0 else None
+        if m and mi:
+            add("sticky", i - 1, f"{mi.group(1)}{m.group(2)} <= {mi.group(2)}; "
+                                 f"if ({mi.group(2)}) begin{mi.group(3)}")
         # swapped fields in a concatenation of plain names
         for m in re.finditer(r"\{(\s*[\w\[\]:.]+\s*),(\s*[\w\[\]:.]+\s*)([,}])", code):
             a, b = m.group(1), m.group(2)
@@ -414,6 +417,15 @@ def report(results: list[tuple[Mutant, str, float]]) -> str:
     return "\n".join(lines)
 
 
+def save(path: Path, m: Mutant, verdict: str, secs: float) -> None:
+    """Add (or replace) one verdict in the JSON results file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows = json.loads(path.read_text()) if path.exists() else []
+    rows = [r for r in rows if r["ident"] != m.ident]
+    rows.append({**asdict(m), "ident": m.ident, "verdict": verdict, "seconds": round(secs)})
+    path.write_text(json.dumps(rows, indent=1))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("modules", nargs="*", help="RTL module names (default: all in TESTS)")
@@ -426,7 +438,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="first (cheapest) test stage only: survivors are not final")
     ap.add_argument("--formal", action="store_true",
                     help="kill mutants with the module's SymbiYosys proof instead of its tests")
-    ap.add_argument("--timeout", type=float, default=900.0, help="seconds per mutant")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep the verdicts already in --json, run only the rest")
+    ap.add_argument("--timeout", type=float, default=300.0,
+                    help="seconds per mutant (a hang counts as killed)")
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
     args = ap.parse_args(argv)
     modules = args.modules or list(TESTS)
@@ -453,20 +468,18 @@ def main(argv: list[str] | None = None) -> int:
     else:
         chosen = sample(modules, args.n, args.seed)
     results: list[tuple[Mutant, str, float]] = []
+    if args.resume and args.json.exists():
+        done = {r["ident"]: r for r in json.loads(args.json.read_text())}
+        results = [(m, done[m.ident]["verdict"], done[m.ident]["seconds"]) for m in chosen
+                   if m.ident in done]
+        chosen = [m for m in chosen if m.ident not in done]
     for m in chosen:
         verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
                          else run_mutant(m, args.timeout, quick=args.quick))
         results.append((m, verdict, secs))
         print(f"{m.ident:28s} {verdict:8s} {secs:6.0f} s  {m.path}:{m.line}: "
               f"{m.after.strip()[:60]}", flush=True)
-    args.json.parent.mkdir(parents=True, exist_ok=True)
-    prev = json.loads(args.json.read_text()) if args.json.exists() else []
-    done = {r["ident"] for r in prev}
-    for m, v, s in results:
-        if m.ident in done:
-            prev = [r for r in prev if r["ident"] != m.ident]
-        prev.append({**asdict(m), "ident": m.ident, "verdict": v, "seconds": round(s)})
-    args.json.write_text(json.dumps(prev, indent=1))
+        save(args.json, m, verdict, secs)
     text = report(results)
     print()
     print(text)
