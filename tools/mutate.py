@@ -76,10 +76,22 @@ TESTS: dict[str, list[list[str]]] = {
 
 # The fixed CI subset (tests/test_mutate_ci.py): realistic one-line bugs in the cheapest
 # testbenches; every one must be killed.
+# (module, operator, text of the mutated line): robust to line moves.
 CI_MUTANTS = (
-    ("frame_align", "const", 0),   # chirp end one sample early (off-by-one at a wrap)
-    ("frame_align", "drop", 16),   # input beat counted without TREADY
+    ("frame_align", "const", "smp_q == SMP_W'(N_RANGE - 2)"),  # chirp end one sample early
+    ("frame_align", "drop", "in_beat  = s_axis_tvalid;"),      # input beat without TREADY
 )
+
+
+def ci_mutants() -> list[Mutant]:
+    """The fixed CI subset as mutants (fails loudly if the RTL no longer has one)."""
+    out = []
+    for module, op, text in CI_MUTANTS:
+        found = [m for m in candidates(module) if m.op == op and text in m.after]
+        if not found:
+            raise SystemExit(f"error: CI mutant {module}/{op} '{text}' no longer exists")
+        out.append(found[0])
+    return out
 
 
 @dataclass(frozen=True)
@@ -456,8 +468,10 @@ def main(argv: list[str] | None = None) -> int:
             for m in candidates(mod):
                 print(f"{m.ident:28s} {m.path}:{m.line}: {m.after.strip()}")
         return 0
-    if args.ci or args.id:
-        wanted = list(args.id or [f"{m}:{o}:{k}" for m, o, k in CI_MUTANTS])
+    if args.ci:
+        chosen = ci_mutants()
+    elif args.id:
+        wanted = list(args.id)
         pool = {m.ident: m for mod in {w.split(":")[0] for w in wanted}
                 for m in candidates(mod)}
         missing = [w for w in wanted if w not in pool]
@@ -475,7 +489,7 @@ def main(argv: list[str] | None = None) -> int:
         chosen = [m for m in chosen if m.ident not in done]
     for m in chosen:
         verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
-                         else run_mutant(m, args.timeout, quick=args.quick))
+                         else run_mutant(m, args.timeout, quick=args.quick or args.ci))
         results.append((m, verdict, secs))
         print(f"{m.ident:28s} {verdict:8s} {secs:6.0f} s  {m.path}:{m.line}: "
               f"{m.after.strip()[:60]}", flush=True)
