@@ -92,6 +92,9 @@ module mark_fifo #(
     assert (cnt_q == CW'(f_pushes - f_pops));
     for (int i = 0; i < DEPTH; i++) if (CW'(i) >= cnt_q) assert (q[i] == '0);
   end
+  always_ff @(posedge clk) if (f_past && $past(rst)) begin
+    assert (cnt_q == '0 && !ovf_q && !unf_q);  // reset clears the queue and both flags
+  end
   always_ff @(posedge clk) if (f_past && !$past(rst) && !rst) begin
     // sticky flags, and set only by a refused operation
     if ($past(ovf_q)) assert (ovf_q);
