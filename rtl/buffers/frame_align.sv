@@ -196,6 +196,12 @@ module frame_align #(
     if (state_q == PASS) assert (smp_q == f_in_pos);
     if (state_q == FILL) assert (in_first_q);
     if (state_q == DISCARD) assert (smp_q == '0 && chirp_q == '0);
+    // a clean frame start where no frame has begun is forwarded: no fill, no discard
+    if (state_q == PASS && at_first && sof && !gap && !frame_begun)
+      assert (!need_fill && !need_discard);
+    // a clean chirp inside a begun frame is forwarded too
+    if (state_q == PASS && at_first && !sof && !gap && frame_begun)
+      assert (!need_fill && !need_discard);
     assert (fill_cnt_q == f_fill_chirps);
     assert (dmg_cnt_q == f_dmg_frames);
     assert (disc_cnt_q == f_disc_chirps);
