@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl gnn-dataset gnn-train gnn-eval \
-        clean help formal coverage mutate
+        clean help formal coverage mutate view bench-view
 all: test
 
 help:
@@ -28,17 +28,21 @@ help:
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
 	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
+	@echo "make view            live browser view of the Table I replay at http://127.0.0.1:8050/"
+	@echo "make bench-view      browser display updates/s and memory of radar view (table)"
 	@echo "make formal          SymbiYosys proofs of formal/*.sby (k-induction, bmc, cover), table"
 	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
 	@echo "make mutate          mutation testing of rtl/ (MUTANTS=40 SEED=1), score per module"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
+	@tools/install-chromium.sh
 
 $(STAMP): pyproject.toml
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(VENV)/bin/python -m pip install --quiet -e '.[dev]'
+	tools/install-chromium.sh
 	touch $@
 
 demo: $(STAMP)
@@ -57,12 +61,12 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
-	$(RUN) ruff check model host gnn tb tests tools synth
+	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth
 
 # Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
 gen: $(STAMP)
 	$(RUN) python -m model.fft_rom
-	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_fixed_model.py -k up_to_date
+	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
@@ -91,18 +95,31 @@ mutate: $(STAMP)
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 
 gnn-dataset: $(STAMP)
-	$(RUN) python -m gnn.cli dataset --train 700 --val 500 --test 200 --workers 2
+	$(RUN) radar gnn dataset --train 700 --val 500 --test 200 --workers 2
 
 gnn-train: $(STAMP)
-	$(RUN) python -m gnn.cli train --epochs 50 --hidden 64 --layers 3 \
+	$(RUN) radar gnn train --epochs 50 --hidden 64 --layers 3 \
 	  --data $(GNN_CACHE)/train.npz $(GNN_CACHE)/val.npz
 
 gnn-eval: $(STAMP)
 	mkdir -p $(OUT)
-	$(RUN) python -m gnn.cli eval --json $(OUT)/gnn_eval.json
+	$(RUN) radar gnn eval --json $(OUT)/gnn_eval.json
 	$(RUN) python -m gnn.bench_infer
 
 clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache
 	find . -name __pycache__ -not -path './$(VENV)/*' -prune -exec rm -rf {} +
 	find . -name '*.result.xml' -not -path './$(VENV)/*' -delete
+
+# ---- radar view (live browser view) --------------------------------------------------------
+VIEW_CAPTURE ?= $(OUT)/table1_paper-fpga.dmacap
+
+$(VIEW_CAPTURE): | $(STAMP)
+	mkdir -p $(dir $@)
+	$(RUN) radar capture --scene table1 --preset paper-fpga --frames 8 --out $@
+
+view: $(STAMP) $(VIEW_CAPTURE)
+	$(RUN) radar view --replay $(VIEW_CAPTURE) --gnn --ego-speed 27.78
+
+bench-view: $(STAMP)
+	$(RUN) python -m radar.view.bench_view

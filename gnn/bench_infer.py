@@ -14,8 +14,7 @@ import numpy as np
 import torch
 
 from gnn.baseline import baseline_detect
-from gnn.cli import DEFAULT_CACHE
-from gnn.dataset import generate, load_frames, split_path
+from gnn.dataset import DEFAULT_CACHE, generate, load_frames, split_path
 from gnn.frame import Frame
 from gnn.infer import GnnDetector
 

@@ -36,7 +36,11 @@ def load_checkpoint(path: Path | None = None) -> tuple[RadarGnn, GraphConfig, di
         model = RadarGnn(ModelConfig(**ck["model"]))
         model.load_state_dict(ck["state_dict"])
         graph = GraphConfig(**ck["graph"])
-    except (KeyError, TypeError, RuntimeError, OSError) as exc:
-        raise ValueError(f"checkpoint: {path} is not a gnn checkpoint ({exc})") from None
+    except Exception as exc:  # noqa: BLE001 - any failure means "not a checkpoint"
+        # torch's own message may advise weights_only=False (executing arbitrary pickled
+        # code from the file): never pass that on, name only the kind of failure
+        raise ValueError(f"checkpoint: {path} is not a readable gnn checkpoint "
+                         f"({type(exc).__name__}); use a file written by `radar gnn train` "
+                         f"(loaded with weights_only=True only)") from None
     model.eval()
     return model, graph, dict(ck.get("meta", {}))

@@ -10,6 +10,7 @@ a progress bar.
 from __future__ import annotations
 
 import multiprocessing as mp
+import os
 from dataclasses import fields
 from pathlib import Path
 
@@ -22,6 +23,8 @@ from gnn.render import render_points, resolve_backend
 from gnn.synth_scenes import random_scene
 from host.pointcloud import PointCloud
 
+DEFAULT_CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "radar-gnn"
+"""Default dataset cache folder (``$XDG_CACHE_HOME/radar-gnn``)."""
 SPLIT_SEED_BASE = {"train": 0, "val": 500_000, "test": 1_000_000}
 """First scene seed of each split."""
 FORMAT_VERSION = 1

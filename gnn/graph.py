@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 from torch_geometric.data import Data
 
 from host.pointcloud import PointCloud
+from model.scene import check_ego_speed
 
 NODE_FEATURES = ("rcs_dbsm/10", "snr_db/20", "vr_comp/5", "vx_comp/5", "vy_comp/5",
                  "cos_az", "sin_az", "degree/k")
@@ -77,6 +78,7 @@ def build_graph(cloud: PointCloud, ego_speed_mps: float = 0.0,
     (n, 2) in m, ``edge_index`` int64 (2, E), ``edge_attr`` float32 (E, 4)
     (:data:`EDGE_FEATURES`)."""
     cfg = cfg or GraphConfig()
+    check_ego_speed(ego_speed_mps)
     xy = np.stack([cloud.x_m, cloud.y_m], axis=1).astype(float)
     if not np.all(np.isfinite(xy)):
         raise ValueError("cloud: x_m/y_m contain NaN or infinity")

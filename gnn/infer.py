@@ -13,6 +13,7 @@ from gnn.detection import Detection, decode
 from gnn.graph import GraphConfig, build_graph
 from gnn.model import RadarGnn
 from host.pointcloud import PointCloud
+from model.scene import check_ego_speed
 
 
 class GnnDetector:
@@ -55,6 +56,7 @@ def detect_objects(cloud: PointCloud, ego_speed_mps: float = 0.0,
     indices into the cloud). ``ego_speed_mps``: ego speed along +x (m/s, 0 for a static
     radar). Uses the shipped checkpoint unless ``checkpoint`` names another."""
     global _DEFAULT
+    check_ego_speed(ego_speed_mps)  # before loading torch weights: fail fast
     if checkpoint is not None:
         det = GnnDetector.from_checkpoint(checkpoint)
     else:

@@ -16,6 +16,7 @@ import numpy as np
 
 from host.pointcloud import PointCloud
 from model.config import RadarConfig
+from model.reference import signed_bin
 from model.scene import Scatterers, Scene
 from model.simulate import simulate_scene, snr_per_sample_db
 
@@ -71,8 +72,8 @@ def stand_in_points(cfg: RadarConfig, sc: Scatterers, beamforming: bool,
     rbin = np.rint([cfg.range_bin_of(r, v) for r, v in
                     zip(sc.range_m, sc.radial_velocity_mps, strict=True)]).astype(int)
     half = cfg.n_doppler // 2
-    dbin = (np.rint(sc.radial_velocity_mps / cfg.velocity_bin_mps).astype(int) + half) \
-        % cfg.n_doppler - half
+    dbin = signed_bin(np.rint(sc.radial_velocity_mps / cfg.velocity_bin_mps).astype(int)
+                      % cfg.n_doppler, cfg.n_doppler)
     sin_az = np.sin(np.radians(sc.azimuth_deg))
     abin = np.rint(sin_az * cfg.n_virtual / 2).astype(int)
     ok = (rbin >= 0) & (rbin < cfg.n_range)

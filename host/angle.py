@@ -22,7 +22,10 @@ class AngleParams:
     """Angle estimator settings.
 
     ``n_fft``: zero-padded angle FFT length. ``max_targets``: components per cell.
-    ``min_snr_db``: a component's coherent SNR (angle-domain peak over noise) must reach this.
+    ``min_snr_db``: the coherent SNR (angle-domain peak over noise) a second or further
+    component must reach; the first component of a detected cell is always kept (the
+    detector decided the cell, so a second gate here would lower the false-alarm rate below
+    the configured Pfa and hide weak targets the CFAR found).
     ``dynamic_range_db``: further components at most this far below the strongest (model
     errors of a strong target leave residue below that). ``refine_iterations``: RELAX passes
     re-estimating each component with the others removed.
@@ -85,8 +88,8 @@ def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
     """Components (targets) in one cell's TDM-compensated channel vector x, complex (n,).
 
     ``noise_per_channel``: noise power per channel in the same units as |x|^2. Components are
-    found strongest first; each new one is accepted while its coherent SNR reaches
-    ``min_snr_db`` and it is within ``dynamic_range_db`` of the first.
+    found strongest first; the first is always returned, each further one while its
+    coherent SNR reaches ``min_snr_db`` and it is within ``dynamic_range_db`` of the first.
     """
     n = x.shape[0]
     noise = max(noise_per_channel, 1e-30)
@@ -98,7 +101,7 @@ def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
         a = complex(np.vdot(steering(n, s), residual) / n)
         power = abs(a) ** 2
         snr_db = 10 * np.log10(power * n / noise)
-        if snr_db < params.min_snr_db:
+        if comps and snr_db < params.min_snr_db:
             break
         if first_power is not None and 10 * np.log10(first_power / power) > \
                 params.dynamic_range_db:

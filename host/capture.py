@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import RadarConfig
-from model.packetizer import cube_to_payload, packetize, words_to_bytes
 from model.reference import cube_to_dma_order
 
 MAGIC = b"RDMACAP1"
@@ -42,6 +42,15 @@ class CaptureInfo:
     def matches(self, cfg: RadarConfig) -> bool:
         return (self.num_rx, self.num_tx, self.n_range, self.n_doppler) == (
             cfg.num_rx, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+
+    def config(self, configs: Iterable[RadarConfig]) -> RadarConfig:
+        """The configuration among ``configs`` with this capture's geometry (ValueError if
+        none): the capture header carries what ``radar receive`` would otherwise need."""
+        for cfg in configs:
+            if self.matches(cfg):
+                return cfg
+        raise ValueError(f"capture geometry {self.num_tx} TX x {self.num_rx} RX, "
+                         f"{self.n_range} x {self.n_doppler} matches no preset")
 
 
 def frame_packets(cube: np.ndarray, cfg: RadarConfig, packet_words: int, frame_id: int

@@ -1,9 +1,13 @@
 """Detection on range-Doppler maps: the paper's threshold, 2-D CA-CFAR and OS-CFAR, peak
 grouping.
 
-Maps are float (n_range, n_doppler) powers with the Doppler axis in natural FFT order. The
-Doppler axis is circular (wraps around); the range axis is not: near its ends the training
-window is cut off and the threshold factor is recomputed for the cells that remain.
+Maps are float (n_range, n_doppler) powers with the Doppler axis in natural FFT order. Both
+axes are circular: the Doppler FFT's, and the range FFT's too because the IF is sampled
+complex (bin N-k is the negative beat frequency -k fs/N, ``model.config``). CFAR windows and
+peak grouping therefore wrap around at the range edges instead of being cut: a strong near
+target's window sidelobes that wrap into the top bins meet a training window that holds the
+target itself, exactly as its sidelobes on the other side do. Which bins may be *reported*
+is a separate rule, ``RadarConfig.detection_bins`` (applied by :func:`detection_mask`).
 
 Thresholds for a configured false-alarm probability are derived, not tuned. A cell of a
 map that integrates ``n_channels`` independent channels non-coherently is Gamma(L, theta)
@@ -30,6 +34,10 @@ from scipy.signal import fftconvolve
 # |sum w^2 e^{-j2pi i n/N}|^2 / (sum w^2)^2 -> 1, 4/9, 1/36 for i = 0, 1, 2; 0 beyond.
 HANN_POWER_CORRELATION = (1.0, 4.0 / 9.0, 1.0 / 36.0)
 RECT_POWER_CORRELATION = (1.0,)
+OS_MAX_ELEMENTS = 2 * 10**8
+"""OS-CFAR holds (cells x training cells) values at once: bound on that product."""
+MAX_WINDOW_CELLS = 2048
+"""Largest guard or training extent per side (half the largest FFT the core supports)."""
 
 
 @dataclass(frozen=True)
@@ -48,12 +56,16 @@ class CfarParams:
     os_rank: float = 0.75
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.pfa < 0.5:
-            raise ValueError(f"pfa: must be in (0, 0.5), got {self.pfa}")
+        if isinstance(self.pfa, bool) or not isinstance(self.pfa, int | float) or \
+                not 1e-15 <= self.pfa < 0.5:
+            raise ValueError(f"pfa: must be in [1e-15, 0.5), got {self.pfa}")
         if self.kind not in ("ca", "os"):
             raise ValueError(f"kind: must be 'ca' or 'os', got {self.kind!r}")
-        if any(g < 0 for g in self.guard) or any(t < 1 for t in self.train):
-            raise ValueError("guard must be >= 0 and train >= 1 cells per side")
+        for name, cells, lo in (("guard", self.guard, 0), ("train", self.train, 1)):
+            if len(cells) != 2 or any(isinstance(c, bool) or not isinstance(c, int | np.integer)
+                                      or not lo <= c <= MAX_WINDOW_CELLS for c in cells):
+                raise ValueError(f"{name}: must be two integers (range, Doppler) in "
+                                 f"{lo}..{MAX_WINDOW_CELLS} cells per side, got {cells}")
         if not 0.0 < self.os_rank < 1.0:
             raise ValueError(f"os_rank: must be in (0, 1), got {self.os_rank}")
 
@@ -68,13 +80,25 @@ def _kernel(params: CfarParams) -> np.ndarray:
 
 def _correlation_sum(kernel: np.ndarray, rho_r: tuple[float, ...],
                      rho_d: tuple[float, ...]) -> float:
-    """sum over training-cell pairs of their power correlation (separable windows)."""
-    idx = np.argwhere(kernel > 0)
-    dr = np.abs(idx[:, None, 0] - idx[None, :, 0])
-    dd = np.abs(idx[:, None, 1] - idx[None, :, 1])
-    rr = np.array(rho_r + (0.0,) * (kernel.shape[0] + 1))[dr]
-    rd = np.array(rho_d + (0.0,) * (kernel.shape[1] + 1))[dd]
-    return float(np.sum(rr * rd))
+    """sum over training-cell pairs of their power correlation (separable windows).
+
+    Only offsets where rho != 0 contribute, so the pair count per offset (the kernel's
+    autocorrelation there) is taken by shifting the mask: O(cells), not O(cells^2)."""
+    total = 0.0
+    nr, nd = kernel.shape
+    for dr, cr in enumerate(rho_r):
+        for dd, cd in enumerate(rho_d):
+            if dr >= nr or dd >= nd:
+                continue
+            pairs = float(np.sum(kernel[dr:, dd:] * kernel[:nr - dr, :nd - dd]))
+            if dd and dr:  # (+dr, +dd) and (+dr, -dd), each counted for both orders
+                pairs += float(np.sum(kernel[dr:, :nd - dd] * kernel[:nr - dr, dd:]))
+                total += 2 * cr * cd * pairs
+            elif dd or dr:
+                total += 2 * cr * cd * pairs
+            else:
+                total += pairs
+    return total
 
 
 def effective_cells(params: CfarParams, windowed: tuple[bool, bool] = (True, True)) -> float:
@@ -108,13 +132,31 @@ def os_factor(pfa: float, n_channels: int, n_train: int, k: int) -> float:
                                  xtol=1e-6))
 
 
+def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
+    """ValueError when the CFAR window (guard + training cells, both sides, plus the cell
+    under test) does not fit the (n_range, n_doppler) map ``shape``: on a circular axis the
+    window would then count cells twice."""
+    for axis, name in enumerate(("range", "Doppler")):
+        span = 2 * (params.guard[axis] + params.train[axis]) + 1
+        if span > shape[axis]:
+            raise ValueError(f"CFAR window: 2 x (guard {params.guard[axis]} + train "
+                             f"{params.train[axis]}) + 1 = {span} {name} cells does not fit "
+                             f"the map's {shape[axis]} {name} bins")
+    n_train = int(_kernel(params).sum())
+    if params.kind == "os" and n_train * shape[0] * shape[1] > OS_MAX_ELEMENTS:
+        raise ValueError(f"CFAR window: OS-CFAR sorts {n_train} training cells for each of "
+                         f"{shape[0] * shape[1]} cells, more than this host allows "
+                         f"({OS_MAX_ELEMENTS:.0e} values); use fewer training cells or CA")
+
+
 def _pad(power: np.ndarray, params: CfarParams) -> tuple[np.ndarray, np.ndarray]:
-    """Map padded with wrap in Doppler and zeros in range, and the matching validity mask."""
+    """Map padded circularly on both axes, and the matching validity mask (all ones: kept so
+    a cut window could be expressed again)."""
     (gr, gd), (tr, td) = params.guard, params.train
     pr, pd = gr + tr, gd + td
-    valid = np.ones_like(power)
-    padded = np.pad(np.pad(power, ((0, 0), (pd, pd)), mode="wrap"), ((pr, pr), (0, 0)))
-    vpad = np.pad(np.pad(valid, ((0, 0), (pd, pd)), mode="wrap"), ((pr, pr), (0, 0)))
+    check_window(params, power.shape)
+    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
+    vpad = np.ones_like(padded)
     return padded, vpad
 
 
@@ -161,9 +203,17 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3)
                 ) -> np.ndarray:
     """Peak grouping: cells of ``mask`` that are the maximum of their (range, Doppler)
-    neighbourhood (Doppler circular). Returns int (n, 2) of (range_bin, doppler_bin)."""
-    mx = maximum_filter(power, size=size, mode=("nearest", "wrap"))
+    neighbourhood (both axes circular). Returns int (n, 2) of (range_bin, doppler_bin)."""
+    mx = maximum_filter(power, size=size, mode="wrap")
     return np.argwhere(mask & (power >= mx))
+
+
+def detection_mask(n_range: int, n_doppler: int, bins: tuple[int, int]) -> np.ndarray:
+    """bool (n_range, n_doppler): True in the range bins ``bins[0] <= r < bins[1]`` a
+    detector may report (``RadarConfig.detection_bins``: DC guard and negative-beat guard)."""
+    mask = np.zeros((n_range, n_doppler), bool)
+    mask[bins[0]:bins[1]] = True
+    return mask
 
 
 def paper_threshold(cube: np.ndarray, threshold_db: float) -> tuple[np.ndarray, np.ndarray]:
@@ -176,3 +226,42 @@ def paper_threshold(cube: np.ndarray, threshold_db: float) -> tuple[np.ndarray, 
     p0 = np.abs(cube[0]) ** 2
     floor = np.median(p0)
     return p0 > floor * 10.0 ** (threshold_db / 10.0), p0
+
+
+MAIN_LOBE_BINS = 2
+"""Half width of the periodic Hann main lobe, bins: sidelobe masking starts beyond it."""
+
+
+@lru_cache(maxsize=16)
+def sidelobe_envelope(n: int, windowed: bool) -> np.ndarray:
+    """Power envelope of a windowed tone's response, float (n,): for circular offset k,
+    the largest |W(k + delta)|^2 / |W(0)|^2 over fractional offsets |delta| <= 0.5 of the
+    tone from the bin centre; 0 within the main lobe (|k| <= MAIN_LOBE_BINS)."""
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n) if windowed else np.ones(n)
+    k = np.arange(n)
+    k = np.where(k > n // 2, k - n, k)
+    delta = np.linspace(-0.5, 0.5, 21)
+    # response at k + delta for every k: the DFT of w * exp(-j 2 pi delta t / n), one FFT
+    # per fractional offset
+    shifted = w[None, :] * np.exp(-2j * np.pi * np.outer(delta, np.arange(n)) / n)
+    resp = np.abs(np.fft.fft(shifted, axis=1)) / w.sum()                  # (delta, k)
+    env = np.max(resp**2, axis=0)
+    env[np.abs(k) <= MAIN_LOBE_BINS] = 0.0
+    return env
+
+
+def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
+                    margin_db: float) -> np.ndarray:
+    """bool (n,): cells (int (n, 2) of (range, Doppler)) of ``power`` (float (n_range,
+    n_doppler)) that are not ``margin_db`` above the window sidelobes of some stronger cell
+    in the same Doppler column (range sidelobes, circular) or range row (Doppler
+    sidelobes). A target 95 dB above the noise has Hann sidelobes above the noise 30 bins
+    away, which a CFAR window a few cells wide cannot tell from targets."""
+    env_r = sidelobe_envelope(power.shape[0], windowed[0]) * 10 ** (margin_db / 10)
+    env_d = sidelobe_envelope(power.shape[1], windowed[1]) * 10 ** (margin_db / 10)
+    out = np.zeros(len(cells), bool)
+    for i, (r, d) in enumerate(cells):
+        col = power[:, d] * np.roll(env_r[::-1], r + 1)   # env_r[(r - r') mod n] per r'
+        row = power[r, :] * np.roll(env_d[::-1], d + 1)
+        out[i] = col.max() > power[r, d] or row.max() > power[r, d]
+    return out

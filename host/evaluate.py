@@ -2,7 +2,9 @@
 
 Targets are matched to points within gates in range (m), radial velocity (m/s, on the
 unfolded velocity or, for an aliased target, on the velocity it aliases to) and azimuth
-(deg); the strongest point in the gate wins.
+(deg); the strongest point in the gate wins. Errors are always measured against the true
+velocity: a point that reports the alias of a target's velocity has an error of about
+2 vmax, and the table says so (the error against the alias is shown beside it, labelled).
 """
 
 from __future__ import annotations
@@ -32,9 +34,10 @@ class Match:
     target: PointTarget
     index: int
     range_err_m: float
-    velocity_err_mps: float
+    velocity_err_mps: float  # estimate - true velocity (never against the alias)
     azimuth_err_deg: float
     aliased: bool  # matched at the aliased velocity (not unfolded)
+    alias_velocity_err_mps: float = float("nan")  # estimate - alias (aliased matches only)
 
 
 def match_targets(cloud: PointCloud, targets: tuple[PointTarget, ...], cfg: RadarConfig,
@@ -60,10 +63,11 @@ def match_targets(cloud: PointCloud, targets: tuple[PointTarget, ...], cfg: Rada
             out.append(Match(t, -1, np.nan, np.nan, np.nan, False))
             continue
         used[best] = True
-        want_v = alias_velocity(t.radial_velocity_mps, cfg) if aliased else t.radial_velocity_mps
+        v = float(cloud.radial_velocity_mps[best])
+        alias_err = v - alias_velocity(t.radial_velocity_mps, cfg) if aliased else float("nan")
         out.append(Match(t, best, float(cloud.range_m[best] - t.range_m),
-                         float(cloud.radial_velocity_mps[best] - want_v),
-                         float(cloud.azimuth_deg[best] - t.azimuth_deg), aliased))
+                         v - t.radial_velocity_mps,
+                         float(cloud.azimuth_deg[best] - t.azimuth_deg), aliased, alias_err))
     # other points of a matched target's cell (same range/Doppler bins) are not false alarms
     for m in out:
         if m.index >= 0:
@@ -76,7 +80,9 @@ def match_targets(cloud: PointCloud, targets: tuple[PointTarget, ...], cfg: Rada
 def table3(matches: list[Match], cloud: PointCloud, cfg: RadarConfig,
            with_paper: bool = True) -> str:
     """The paper's Table III (actual vs estimated range and closing speed, plus azimuth)
-    with our absolute errors and, beside them, the paper's hardware errors."""
+    with our absolute errors and, beside them, the paper's hardware errors. An aliased
+    speed is marked ``*`` and its error is against the true speed (flags give the error
+    against the alias)."""
     paper_col = f" {'paper':>6}" if with_paper else ""
     head = (f"{'veh':>3} | {'range m':>7} {'est':>7} {'err':>6}{paper_col} | "
             f"{'speed m/s':>9} {'est':>7} {'err':>6}{paper_col} | "
@@ -95,8 +101,12 @@ def table3(matches: list[Match], cloud: PointCloud, cfg: RadarConfig,
             continue
         j = m.index
         flags = []
+        mark = " "
         if m.aliased:
-            flags.append(f"aliased (true {closing:.2f} beyond +-{cfg.max_velocity_mps:.2f})")
+            mark = "*"
+            flags.append(f"ALIASED: speed {-cloud.radial_velocity_mps[j]:.2f} is the alias of "
+                         f"{closing:.2f} (beyond +-{cfg.max_velocity_mps:.2f}); error vs "
+                         f"the alias {abs(m.alias_velocity_err_mps):.2f}")
         elif abs(t.radial_velocity_mps) > cfg.max_velocity_mps:
             flags.append("unfolded by TDM phase test")
         if cloud.ambiguous[j]:
@@ -104,7 +114,27 @@ def table3(matches: list[Match], cloud: PointCloud, cfg: RadarConfig,
         lines.append(
             f"{i + 1:>3} | {t.range_m:>7.2f} {cloud.range_m[j]:>7.2f} "
             f"{abs(m.range_err_m):>6.2f}{pr} | {closing:>9.2f} "
-            f"{-cloud.radial_velocity_mps[j]:>7.2f} {abs(m.velocity_err_mps):>6.2f}{pv} | "
+            f"{-cloud.radial_velocity_mps[j]:>6.2f}{mark} {abs(m.velocity_err_mps):>6.2f}{pv} | "
             f"{t.azimuth_deg:>6.1f} {cloud.azimuth_deg[j]:>7.2f} {abs(m.azimuth_err_deg):>6.2f}"
             f" | {', '.join(flags)}")
     return "\n".join(lines)
+
+
+def alias_note(targets: tuple[PointTarget, ...], cfg: RadarConfig, prefix: str = "V"
+               ) -> str | None:
+    """A sentence for figures explaining the targets whose velocity is beyond +-vmax
+    (labels ``prefix`` + 1-based index), or None when there are none."""
+    vmax = cfg.max_velocity_mps
+    fast = [(i, t) for i, t in enumerate(targets) if not -vmax <= t.radial_velocity_mps < vmax]
+    if not fast:
+        return None
+    names = ", ".join(f"{prefix}{i + 1} ({t.radial_velocity_mps:+.1f} m/s, shows at "
+                      f"{alias_velocity(t.radial_velocity_mps, cfg):+.2f})" for i, t in fast)
+    if cfg.num_tx > 1:
+        return (f"{names}: beyond the unambiguous +-{vmax:.2f} m/s. This map compensates the "
+                f"TDM slot delay with the aliased Doppler, which mis-phases the {cfg.num_tx} "
+                f"TX slots and smears the target across azimuth; the point cloud tests the "
+                f"unfolded hypotheses and places it correctly.")
+    return (f"{names}: beyond the unambiguous +-{vmax:.2f} m/s. With one TX there is no TDM "
+            f"phase to correct (azimuth is right) and nothing to unfold with: its velocity "
+            f"is reported aliased and flagged ambiguous.")

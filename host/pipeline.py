@@ -4,16 +4,25 @@ Steps (DESIGN.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel
-   0; peak grouping keeps local maxima.
+   0; peak grouping keeps local maxima; only ``RadarConfig.detection_bins`` are reported
+   (the top range bins are negative beat frequencies), and cells within
+   ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
 2. Range and Doppler refined by log-parabolic (Gaussian) interpolation around each peak.
-3. TDM Doppler phase compensation per TX slot, with velocity unfolding: the Doppler of a
-   target beyond +-vmax is aliased, and the compensation for the true (unfolded) Doppler
-   gives a sharper angle spectrum than the aliased one. Hypotheses m in {-1, 0, +1} (velocity
-   + 2 m vmax) are compared when num_tx > 1 and the cell is strong enough to decide; the
-   winner is used and ``ambiguous`` is set whenever the measured Doppler was aliased
-   (unfolded) or the test could not decide.
+3. TDM Doppler phase compensation per TX slot, with velocity unfolding. The measured
+   Doppler fixes the velocity only modulo the alias period 2 vmax: the hypotheses are
+   v + 2 m vmax for every integer m with |v + 2 m vmax| <= ``max_speed_mps`` (the fastest
+   radial speed the application expects, default 100 m/s). With num_tx > 1 the TDM phase
+   test separates hypotheses whose m differ modulo num_tx (compensation for the wrong one
+   blurs the angle spectrum); hypotheses m and m + num_tx are indistinguishable. A point is
+   ``ambiguous`` when more than one hypothesis survives (always with one TX once
+   ``max_speed_mps`` > vmax: paper-fpga can never unfold) or when the reported velocity is
+   an unfolded one (it rests on the TDM test). The velocity reported is the surviving
+   hypothesis of smallest magnitude.
 4. Angle: zero-padded angle FFT with interpolated peaks, RELAX-style so several targets in
-   a cell give several points (``host.angle``).
+   a cell give several points (``host.angle``). The CFAR already decided that the cell holds
+   a target, so its strongest component always gives a point (no second, hidden SNR gate:
+   the point cloud's false-alarm rate is the CFAR's Pfa); further components must pass
+   ``AngleParams.min_snr_db``.
 5. Point cloud: range corrected for range-Doppler coupling, x/y, vx/vy, power, coherent
    SNR and an RCS estimate from the radar equation (``host.pointcloud``).
 """
@@ -25,7 +34,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from host.angle import AngleParams, estimate_angles, peak_power
-from host.cfar import CfarParams, cfar_threshold, local_peaks, paper_threshold
+from host.cfar import (
+    CfarParams,
+    cfar_threshold,
+    check_window,
+    detection_mask,
+    local_peaks,
+    paper_threshold,
+    sidelobe_masked,
+)
 from host.pointcloud import PointCloud
 from model.config import RadarConfig, dbm_to_w
 from model.reference import (
@@ -38,6 +55,9 @@ from model.reference import (
 from model.simulate import rx_gain, tx_gain
 
 DETECTORS = ("ca", "os", "paper")
+MAX_RADIAL_SPEED_MPS = 100.0
+"""Default fastest radial speed the application expects, m/s (360 km/h: two cars at
+180 km/h head-on). Velocities are unfolded and flagged ``ambiguous`` against it."""
 
 
 @dataclass(frozen=True)
@@ -50,8 +70,13 @@ class DetectionParams:
     CFAR cell correlation, scalloping and RCS corrections). ``tx_beamforming``: TX gain
     model used for the RCS estimate. ``unfold_velocity``: TDM Doppler hypothesis test.
     ``unfold_min_snr_db`` / ``unfold_margin_db``: a hypothesis other than the aliased one
-    wins only in cells at least this strong and by at least this margin.
-    ``min_range_bin``: bins below it are ignored (DC / TX leakage).
+    wins only in cells at least this strong and by at least this margin; the aliased one
+    excludes the others when it beats them by the margin. ``max_speed_mps``: fastest radial
+    speed considered when unfolding and flagging ``ambiguous`` (module docstring, step 3).
+    Reported range bins are ``RadarConfig.detection_bins`` (DC and negative-beat guards).
+    ``sidelobe_margin_db``: a detected cell must exceed the window sidelobes of every
+    stronger cell in its Doppler column and range row by this much (``host.cfar.
+    sidelobe_masked``; beyond the +-2-bin main lobe); None turns the masking off.
     """
 
     detector: str = "ca"
@@ -64,12 +89,27 @@ class DetectionParams:
     unfold_velocity: bool = True
     unfold_min_snr_db: float = 30.0
     unfold_margin_db: float = 0.45
-    min_range_bin: int = 1
+    max_speed_mps: float = MAX_RADIAL_SPEED_MPS
+    sidelobe_margin_db: float | None = 10.0
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
             raise ValueError(f"detector: must be one of {', '.join(DETECTORS)}, got "
                              f"{self.detector!r}")
+        if not isinstance(self.paper_threshold_db, int | float) or not \
+                0.0 <= self.paper_threshold_db <= 200.0:
+            raise ValueError(f"threshold_db: must be a number of dB in [0, 200], got "
+                             f"{self.paper_threshold_db!r}")
+        if not isinstance(self.max_speed_mps, int | float) or not \
+                0.0 < self.max_speed_mps <= 3.0e4:
+            raise ValueError(f"max_speed_mps: must be in (0, 30000] m/s, got "
+                             f"{self.max_speed_mps!r}")
+
+    def check(self, cfg: RadarConfig) -> None:
+        """ValueError when the settings do not fit ``cfg`` (CFAR window larger than the
+        range-Doppler map)."""
+        if self.detector != "paper":
+            check_window(self.cfar, (cfg.n_range, cfg.n_doppler))
 
 
 def _window_response(n: int, offset: float, windowed: bool) -> float:
@@ -108,27 +148,55 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
         threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
         cells = local_peaks(nci, nci > threshold)
-    cells = cells[cells[:, 0] >= params.min_range_bin]
+    ok = detection_mask(cfg.n_range, cfg.n_doppler, cfg.detection_bins)
+    cells = cells[ok[cells[:, 0], cells[:, 1]]]
+    if params.sidelobe_margin_db is not None and len(cells):
+        cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
     return cells, noise_map[cells[:, 0], cells[:, 1]], nci
 
 
-def _choose_fold(x: np.ndarray, cfg: RadarConfig, d: int, snr_db: float,
+def _tdm_comp(cfg: RadarConfig, k: int) -> np.ndarray:
+    """TDM compensation phasors, complex (n_virtual,), for the *unfolded* signed Doppler bin
+    ``k`` (any integer). ``tdm_phase_compensation`` takes natural-order bins and maps
+    k >= n_doppler/2 back to k - n_doppler, which would undo an unfolding by +1; its phase
+    has period num_tx * n_doppler in k, so k is shifted by that period instead."""
+    if k >= cfg.n_doppler // 2:
+        k -= cfg.num_tx * cfg.n_doppler
+    return tdm_phase_compensation(cfg, k)
+
+
+def velocity_hypotheses(cfg: RadarConfig, velocity_mps: float, max_speed_mps: float
+                        ) -> list[int]:
+    """Alias orders m with |velocity + 2 m vmax| <= max_speed (m = 0 when none is)."""
+    period = 2.0 * cfg.max_velocity_mps
+    lo = int(np.ceil((-max_speed_mps - velocity_mps) / period))
+    hi = int(np.floor((max_speed_mps - velocity_mps) / period))
+    return list(range(lo, hi + 1)) or [0]
+
+
+def _choose_fold(x: np.ndarray, cfg: RadarConfig, d: int, velocity_mps: float, snr_db: float,
                  params: DetectionParams) -> tuple[int, bool]:
-    """TDM Doppler hypothesis m for a cell: (m, ambiguous)."""
-    if cfg.num_tx == 1 or not params.unfold_velocity:
-        return 0, False
-    n_fft = params.angle.n_fft
-    k = int(signed_bins(cfg.n_doppler)[d])
-    powers = {m: peak_power(x * tdm_phase_compensation(cfg, k + m * cfg.n_doppler), n_fft)
-              for m in (-1, 0, 1)}
-    best = max(powers, key=powers.__getitem__)
-    margin_db = 10 * np.log10(powers[best] / powers[0]) if best != 0 else 0.0
-    if best != 0 and snr_db >= params.unfold_min_snr_db and margin_db >= params.unfold_margin_db:
-        return best, True
-    # aliased hypothesis kept; ambiguous when another explains the cell (almost) as well
-    second = max(p for m, p in powers.items() if m != 0)
-    undecided = 10 * np.log10(powers[0] / second) < params.unfold_margin_db
-    return 0, bool(undecided and snr_db < params.unfold_min_snr_db)
+    """Alias order m of a cell's velocity and whether it is ambiguous (module docstring,
+    step 3). ``x``: the cell's channel vector; ``velocity_mps``: measured (aliased)."""
+    hyps = velocity_hypotheses(cfg, velocity_mps, params.max_speed_mps)
+    if cfg.num_tx > 1 and params.unfold_velocity and len(hyps) > 1:
+        n_fft = params.angle.n_fft
+        k = int(signed_bins(cfg.n_doppler)[d])
+        classes = sorted({m % cfg.num_tx for m in hyps})
+        power = {c: peak_power(x * _tdm_comp(cfg, k + c * cfg.n_doppler), n_fft)
+                 for c in classes}
+        best = max(classes, key=power.__getitem__)
+        margin = 10 ** (params.unfold_margin_db / 10)
+        others = [power[c] for c in classes if c != best]
+        beats_all = not others or power[best] >= margin * max(others)
+        if best != 0 and not (beats_all and snr_db >= params.unfold_min_snr_db):
+            best = 0 if 0 in power else best
+            beats_all = not others or power[best] >= margin * max(
+                power[c] for c in classes if c != best)
+        if beats_all:
+            hyps = [m for m in hyps if m % cfg.num_tx == best] or hyps
+    m = min(hyps, key=lambda h: abs(velocity_mps + 2.0 * h * cfg.max_velocity_mps))
+    return m, len(hyps) > 1 or m != 0
 
 
 def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.ndarray,
@@ -148,10 +216,7 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
                  frame: int = 0) -> PointCloud:
     """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
     params = params or DetectionParams()
-    expected = (cfg.n_virtual, cfg.n_range, cfg.n_doppler)
-    if cube.shape != expected:
-        raise ValueError(f"cube: expected shape {expected} for preset {cfg.name!r}, got "
-                         f"{cube.shape}")
+    cfg.check_cube(cube)
     cells, noise, nci = detect_cells(cube, cfg, params)
     logp = np.log(np.maximum(nci, 1e-30))
     nr, nd = cfg.n_range, cfg.n_doppler
@@ -167,9 +232,10 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
         noise_ch = noise_cell / cfg.n_virtual
         cell_snr_db = 10 * np.log10(max(nci[r, d] - noise_cell, 1e-30) / noise_cell) \
             + 10 * np.log10(cfg.n_virtual)
-        fold, ambiguous = _choose_fold(x, cfg, d, cell_snr_db, params)
+        fold, ambiguous = _choose_fold(x, cfg, d, (int(sbins[d]) + dd) * cfg.velocity_bin_mps,
+                                       cell_snr_db, params)
         k = int(sbins[d]) + fold * nd
-        comps = estimate_angles(x * tdm_phase_compensation(cfg, k), noise_ch, params.angle)
+        comps = estimate_angles(x * _tdm_comp(cfg, k), noise_ch, params.angle)
         velocity = (k + dd) * cfg.velocity_bin_mps
         # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
         coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
@@ -185,7 +251,7 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
             rows["amp_adc"].append(abs(c.amplitude) / (cg * scallop))
             rows["range_bin"].append(r)
             rows["doppler_bin"].append(k)
-            rows["ambiguous"].append(ambiguous or fold != 0)
+            rows["ambiguous"].append(ambiguous)
     a = {k: np.asarray(v) for k, v in rows.items()}
     if not len(a["range_m"]):
         return PointCloud.empty()

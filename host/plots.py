@@ -85,10 +85,11 @@ def plot_detection_mask(power: np.ndarray, mask: np.ndarray, cfg: RadarConfig, p
 
 
 def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
-                            cfg: RadarConfig, path: Path, max_range_m: float | None = None
-                            ) -> Path:
+                            cfg: RadarConfig, path: Path, max_range_m: float | None = None,
+                            note: str | None = None) -> Path:
     """Range-azimuth maps side by side on one colour scale (the paper's Fig. 5 with and
-    without TX beamforming). maps: (float (n_range, n_fft) power, title)."""
+    without TX beamforming). maps: (float (n_range, n_fft) power, title). ``note``: text
+    under the maps (e.g. why an aliased target is smeared in azimuth)."""
     rng = np.arange(cfg.n_range) * cfg.range_bin_m
     ok = np.isfinite(az)
     dbs = [10 * np.log10(np.maximum(m[:, ok], 1e-12)) for m, _ in maps]
@@ -96,6 +97,8 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
     vmin = min(np.median(d) for d in dbs)
     fig, axes = plt.subplots(1, len(maps), figsize=(5.5 * len(maps), 4.5), dpi=110,
                              sharey=True, squeeze=False)
+    if note:  # room for the note under the axes, before the colour bar takes its share
+        fig.subplots_adjust(bottom=0.2)
     for ax, d, (_, title) in zip(axes[0], dbs, maps, strict=True):
         im = ax.pcolormesh(az[ok], rng, d, shading="nearest", cmap="viridis", vmin=vmin,
                            vmax=vmax)
@@ -105,35 +108,70 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
             ax.set_ylim(0, min(max_range_m, cfg.max_range_m))
     axes[0][0].set_ylabel("range (m)")
     fig.colorbar(im, ax=axes[0].tolist(), label="power (dB, LSB^2)")
+    if note:
+        fig.text(0.01, 0.01, note, fontsize=7, va="bottom", wrap=True)
     return _save(fig, path, tight=False)
 
 
 def plot_point_cloud(x: np.ndarray, y: np.ndarray, snr_db: np.ndarray, path: Path, title: str,
                      truth: list[tuple[float, float, str]] | None = None,
-                     boxes: list[dict] | None = None) -> Path:
+                     boxes: list[dict] | None = None, missed: list[str] | None = None,
+                     note: str | None = None) -> Path:
     """Bird's-eye view of a point cloud (x forward up, y left to the left), coloured by SNR.
 
-    truth: (x_m, y_m, label) ground-truth markers; boxes: dicts with x, y, length, width,
-    heading_deg, label (detected objects) drawn as rotated rectangles.
+    truth: (x_m, y_m, label) ground-truth markers; ``missed``: labels of truth targets no
+    point matched (drawn as red crosses, "missed" in the legend); boxes: dicts with x, y,
+    length, width, heading_deg, label (detected objects) drawn as rotated rectangles.
+    A legend names truth, radar points, GNN boxes and missed targets; axis limits include
+    every marker and label (nothing clipped). ``note``: text under the plot.
     """
-    fig, ax = plt.subplots(figsize=(6, 6.5), dpi=110)
-    sc = ax.scatter(-y, x, c=snr_db, cmap="plasma", s=28, zorder=3)
-    fig.colorbar(sc, ax=ax, label="SNR (dB)")
+    fig, ax = plt.subplots(figsize=(6.5, 7), dpi=110)
+    handles = []
+    sc = ax.scatter(-y, x, c=snr_db, cmap="plasma", s=28, zorder=3, label="radar points")
+    handles.append(sc)
+    fig.colorbar(sc, ax=ax, label="point SNR (dB)")
+    missed = set(missed or [])
+    xs, ys = [0.0, *(-np.asarray(y, float))], [0.0, *np.asarray(x, float)]
     for tx, ty, label in truth or []:
-        ax.plot(-ty, tx, "s", mfc="none", mec="g", ms=14, zorder=2)
-        ax.annotate(label, (-ty, tx), xytext=(8, -4), textcoords="offset points", color="g")
+        if label in missed:
+            h, = ax.plot(-ty, tx, "x", color="r", ms=14, mew=2.5, zorder=4,
+                         label="truth, missed")
+            ax.annotate(f"{label} missed", (-ty, tx), xytext=(8, -4),
+                        textcoords="offset points", color="r", annotation_clip=False)
+        else:
+            h, = ax.plot(-ty, tx, "s", mfc="none", mec="g", ms=14, zorder=2, label="truth")
+            ax.annotate(label, (-ty, tx), xytext=(8, -4), textcoords="offset points",
+                        color="g", annotation_clip=False)
+        if h.get_label() not in [k.get_label() for k in handles]:
+            handles.append(h)
+        xs.append(-ty)
+        ys.append(tx)
     for b in boxes or []:
         h = np.radians(b["heading_deg"])
         u = np.array([np.cos(h), np.sin(h)]) * b["length"] / 2
         w = np.array([-np.sin(h), np.cos(h)]) * b["width"] / 2
         c = np.array([b["x"], b["y"]])
         pts = np.array([c + u + w, c + u - w, c - u - w, c - u + w, c + u + w])
-        ax.plot(-pts[:, 1], pts[:, 0], "-", color="tab:blue")
-        ax.annotate(b.get("label", ""), (-b["y"], b["x"]), color="tab:blue")
-    ax.plot(0, 0, "k^", ms=10)
+        line, = ax.plot(-pts[:, 1], pts[:, 0], "-", color="tab:blue", label="GNN boxes")
+        if "GNN boxes" not in [k.get_label() for k in handles]:
+            handles.append(line)
+        ax.annotate(b.get("label", ""), (-b["y"], b["x"]), xytext=(4, 4),
+                    textcoords="offset points", color="tab:blue", annotation_clip=False)
+        xs.extend(-pts[:, 1])
+        ys.extend(pts[:, 0])
+    radar, = ax.plot(0, 0, "k^", ms=10, label="radar")
+    handles.append(radar)
+    # limits with room for the labels (about 15 % of the span to the right and top)
+    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+    span = max(x1 - x0, y1 - y0, 10.0)
+    ax.set_xlim(x0 - 0.08 * span, x1 + 0.2 * span)
+    ax.set_ylim(y0 - 0.08 * span, y1 + 0.12 * span)
     ax.set_xlabel("-y (m, right)")
     ax.set_ylabel("x (m, forward)")
-    ax.set_aspect("equal")
+    ax.set_aspect("equal", adjustable="box")
     ax.grid(alpha=0.3)
+    ax.legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.9)
     ax.set_title(title)
+    if note:
+        fig.text(0.01, 0.005, note, fontsize=7, va="bottom", wrap=True)
     return _save(fig, path)

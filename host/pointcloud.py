@@ -7,12 +7,13 @@ A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per p
 - ``vx_mps``/``vy_mps``: the radial velocity projected on the line of sight (m/s)
 - ``power_db``: cell power after angle FFT, dB re 1 LSB^2; ``snr_db``: over the local noise
 - ``rcs_dbsm``: RCS estimate from the radar equation, dB re 1 m^2
-- ``range_bin``, ``doppler_bin`` (signed), ``ambiguous`` (bool: the velocity may be aliased,
-  i.e. it lies within one velocity bin of +-vmax or the detection is otherwise flagged)
+- ``range_bin``, ``doppler_bin`` (signed, unfolded), ``ambiguous`` (bool: another velocity
+  within the assumed maximum speed explains the measurement, or the velocity was unfolded by
+  the TDM test; ``host.pipeline`` step 3)
 
-JSON (``to_json_dict``) follows DESIGN.md section 4: ``{"preset", "frames", "points": [...]}``
-with the required fields range_m, azimuth_deg, radial_velocity_mps, x_m, y_m, power_db,
-snr_db plus the extra ones.
+JSON (``to_json_dict``, read back by ``from_json_dict``) follows DESIGN.md section 4:
+``{"preset", "frames", "points": [...]}`` with the required fields range_m, azimuth_deg,
+radial_velocity_mps, x_m, y_m, power_db, snr_db plus the extra ones.
 """
 
 from __future__ import annotations
@@ -108,3 +109,24 @@ class PointCloud:
     def to_json_dict(self, preset: str, frames: int) -> dict[str, Any]:
         """The DESIGN.md section 4 point cloud JSON object."""
         return {"preset": preset, "frames": int(frames), "points": self.records()}
+
+    @classmethod
+    def from_json_dict(cls, doc: dict[str, Any]) -> PointCloud:
+        """A cloud from the DESIGN.md section 4 JSON object (``{"points": [...]}``, as
+        written by :meth:`to_json_dict`). Each point needs range_m, azimuth_deg,
+        radial_velocity_mps, power_db and snr_db; rcs_dbsm, range_bin, doppler_bin, frame
+        and ambiguous default to 0/false; x, y, vx, vy are derived from the polar fields.
+        Raises ValueError naming the problem."""
+        try:
+            pts = doc["points"]
+            get = {k: [float(p[k]) for p in pts] for k in
+                   ("range_m", "azimuth_deg", "radial_velocity_mps", "power_db", "snr_db")}
+            rcs = [float(p.get("rcs_dbsm", 0.0)) for p in pts]
+            rb = [int(p.get("range_bin", 0)) for p in pts]
+            db = [int(p.get("doppler_bin", 0)) for p in pts]
+            frame = np.array([int(p.get("frame", 0)) for p in pts], dtype=int)
+            amb = [bool(p.get("ambiguous", False)) for p in pts]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"not a point cloud JSON object ({exc!r})") from None
+        return cls.from_polar(rcs_dbsm=rcs, range_bin=rb, doppler_bin=db, ambiguous=amb,
+                              frame=frame, **get)

@@ -1,8 +1,8 @@
 """Incremental decoding of the FPGA's DMA stream into radar cubes.
 
 The packet format (header word layout, payload order) is defined once, in
-``model.packetizer`` (mirrored by ``rtl/buffers/axis_packetizer.sv``); this module groups
-arriving packets into frames and hands each frame to ``model.packetizer.depacketize``, which
+``model.axis_packetizer`` (mirrored by ``rtl/buffers/axis_packetizer.sv``); this module groups
+arriving packets into frames and hands each frame to ``model.axis_packetizer.depacketize``, which
 places every intact packet by its sequence number and reports what is wrong.
 
 Input comes either as packets (one UDP datagram = one TLAST-closed DMA packet, the paper's
@@ -17,34 +17,75 @@ damaged: lost, repeated, truncated, reordered or corrupt packets) or in the deco
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from model.config import RadarConfig
-from model.packetizer import (
+from model.axis_packetizer import (
     MAGIC,
     check_geometry,
     depacketize,
     packets_per_frame,
     parse_header,
 )
+from model.config import RadarConfig
 
 MAX_STREAM_PROBLEMS = 1000
 """Stream-level problem messages kept (counters keep counting past it)."""
 
 
+def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig]
+                         ) -> tuple[RadarConfig, int]:
+    """The radar configuration and PACKET_WORDS a DMA packet belongs to, from its header
+    alone: the datagram length and header lane 1 (payload words) give the word width, hence
+    num_rx; lane 3 gives the packets per frame, which with the payload length fixes
+    PACKET_WORDS for a preset's frame size. ValueError when no configuration fits."""
+    tried = []
+    for cfg in configs:
+        wb = 4 * cfg.num_rx
+        if len(data) < wb or len(data) % wb or cfg.num_rx < 4:
+            tried.append(cfg.name)
+            continue
+        words = np.frombuffer(data, dtype="<u4").reshape(-1, cfg.num_rx)
+        try:
+            hdr = parse_header(words[0])
+        except ValueError:
+            tried.append(cfg.name)
+            continue
+        frame_words = cfg.num_tx * cfg.n_range * cfg.n_doppler
+        if hdr.length != len(words) - 1 or not hdr.n_packets:
+            tried.append(cfg.name)
+            continue
+        n = hdr.n_packets
+        if hdr.seq < n - 1:
+            pw = hdr.length
+        elif n > 1 and (frame_words - hdr.length) % (n - 1) == 0:
+            pw = (frame_words - hdr.length) // (n - 1)
+        elif n == 1:
+            pw = max(hdr.length, 2)
+        else:
+            tried.append(cfg.name)
+            continue
+        if pw >= 2 and packets_per_frame(frame_words, pw) == n:
+            return cfg, pw
+        tried.append(cfg.name)
+    raise ValueError(f"packet of {len(data)} bytes fits none of the configurations "
+                     f"{', '.join(tried)} (word width, payload length and packets per frame "
+                     f"from its header)")
+
+
 def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
     """Frame payload, uint32 (frame_words, num_rx) in DMA order -> radar cube complex64
     (n_virtual, n_range, n_doppler). Same result as ``model.reference.dma_order_to_cube(
-    model.packetizer.payload_to_cube(...))`` but transposes the int16 I/Q pairs before
+    model.axis_packetizer.payload_to_cube(...))`` but transposes the int16 I/Q pairs before
     widening them (about 4x faster on a ``full`` frame)."""
     iq = np.ascontiguousarray(words, dtype="<u4").view("<i2").reshape(
         cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx, 2).transpose(0, 3, 1, 2, 4)
     cube = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.complex64)
     cube.real = iq[..., 0]  # I: low half of the word (little-endian)
     cube.imag = iq[..., 1]  # Q: high half
-    return cube.reshape(cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    return cube.reshape(cfg.cube_shape)
 
 
 @dataclass
@@ -77,6 +118,8 @@ class StreamStats:
     late_packets: int = 0
     frames_complete: int = 0
     frames_damaged: int = 0
+    reordered_packets: int = 0
+    duplicate_packets: int = 0
     hw_overflow_seen: bool = False
     hw_framing_seen: bool = False
 
@@ -179,8 +222,9 @@ class StreamDecoder:
         entry = self._open.pop(fid)
         self._closed.append(fid)
         del self._closed[:-4 * self.reorder_window]
-        # depacketize expects arrival order; it reports reordering, repeats and gaps
-        decoded = depacketize(entry.packets, self.frame_words, self.packet_words, self.num_rx)
+        packets = self._in_order(entry.packets)
+        # depacketize reports what is still wrong: gaps, conflicting repeats, bad lengths
+        decoded = depacketize(packets, self.frame_words, self.packet_words, self.num_rx)
         if len(decoded) != 1:  # cannot happen: all packets carry the same frame id
             problems = [f"frame {fid}: packets split into {len(decoded)} groups"]
             words = np.zeros((self.frame_words, self.num_rx), np.uint32)
@@ -199,6 +243,25 @@ class StreamDecoder:
             if not frame.problems:
                 frame.problems.append(f"frame {fid}: {int((~valid).sum())} words missing")
         return frame
+
+    def _in_order(self, packets: list[np.ndarray]) -> list[np.ndarray]:
+        """A frame's packets sorted by sequence number with exact duplicates removed: a
+        link that only reordered or duplicated packets loses nothing (counted in
+        ``stats``). Differing packets with the same number stay, for depacketize to report."""
+        seqs = [parse_header(p[0]).seq for p in packets]
+        order = sorted(range(len(packets)), key=lambda i: (seqs[i], i))
+        if order != sorted(order):
+            self.stats.reordered_packets += sum(
+                1 for a, b in zip(seqs, seqs[1:], strict=False) if b < a)
+        out: list[np.ndarray] = []
+        last_seq = None
+        for i in order:
+            if seqs[i] == last_seq and np.array_equal(packets[i], out[-1]):
+                self.stats.duplicate_packets += 1
+                continue
+            out.append(packets[i])
+            last_seq = seqs[i]
+        return out
 
     def flush(self) -> list[Frame]:
         """Close every open frame (end of stream), oldest first."""

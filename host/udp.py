@@ -19,6 +19,29 @@ UDP_MAX_PAYLOAD = 65507
 """Largest UDP payload over IPv4, bytes."""
 
 
+def max_packet_words(num_rx: int) -> int:
+    """Largest PACKET_WORDS whose packet (header word + payload, 4 * num_rx bytes a word)
+    fits one UDP datagram: 1022 for 16 lanes, 4093 for 4 (capped at the header's 65535)."""
+    return min(UDP_MAX_PAYLOAD // (4 * num_rx) - 1, 65535)
+
+
+def check_port(port: int, allow_zero: bool = True) -> int:
+    """ValueError unless ``port`` is a UDP port number (0 = any free port, if allowed)."""
+    lo = 0 if allow_zero else 1
+    if isinstance(port, bool) or not isinstance(port, int) or not lo <= port <= 65535:
+        raise ValueError(f"port: must be an integer in {lo}..65535, got {port!r}")
+    return port
+
+
+def check_seconds(value: float | None, name: str, allow_none: bool = False) -> None:
+    """ValueError unless ``value`` is a finite positive number of seconds (<= 1 day)."""
+    if value is None and allow_none:
+        return
+    if isinstance(value, bool) or not isinstance(value, int | float) or not \
+            0.0 < value <= 86400.0:
+        raise ValueError(f"{name}: must be a number of seconds in (0, 86400], got {value!r}")
+
+
 @dataclass(frozen=True)
 class Impairments:
     """Link faults injected by the sender: per-packet probabilities and a seed."""
@@ -51,8 +74,10 @@ class UdpSender:
 
     def __init__(self, host: str, port: int, rate_bps: float | None = None,
                  impairments: Impairments | None = None) -> None:
-        if rate_bps is not None and rate_bps <= 0:
-            raise ValueError(f"rate_bps: must be positive, got {rate_bps}")
+        if rate_bps is not None and not 0 < rate_bps <= 1e12:
+            raise ValueError(f"rate: must be positive and at most 1e6 Mbit/s, got "
+                             f"{rate_bps / 1e6:g} Mbit/s")
+        check_port(port, allow_zero=False)
         self.addr = (host, port)
         self.rate_bps = rate_bps
         self.imp = impairments or Impairments()
@@ -109,6 +134,11 @@ class UdpReceiver:
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0,
                  rcvbuf_bytes: int = 16 << 20) -> None:
+        check_port(port)
+        self.interrupted = False
+        self.decoder: StreamDecoder | None = None
+        self.datagrams = 0
+        self.unusable: list[str] = []  # datagrams no decoder could be built from
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf_bytes)
         self.sock.bind((host, port))
@@ -126,15 +156,25 @@ class UdpReceiver:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def receive(self, decoder: StreamDecoder, max_frames: int | None = None,
+    def receive(self, decoder: StreamDecoder | None, max_frames: int | None = None,
                 idle_timeout_s: float = 1.0, total_timeout_s: float = 60.0,
-                on_frame: Callable[[Frame], None] | None = None) -> list[Frame]:
+                on_frame: Callable[[Frame], None] | None = None,
+                make_decoder: Callable[[bytes], StreamDecoder] | None = None) -> list[Frame]:
         """Decode datagrams until ``max_frames`` frames are out, the link has been idle for
-        ``idle_timeout_s``, or ``total_timeout_s`` has passed; then close open frames.
-        Bounded in time by construction."""
+        ``idle_timeout_s`` *after the first datagram*, or ``total_timeout_s`` has passed
+        (which also bounds the wait for the first one); then close open frames. Ctrl-C
+        (KeyboardInterrupt) stops the same way and sets :attr:`interrupted`, so what was
+        received is returned, not lost. ``decoder`` None: ``make_decoder(first datagram)``
+        builds it (geometry learnt from the stream); it is kept in :attr:`decoder`."""
+        check_seconds(idle_timeout_s, "idle timeout")
+        check_seconds(total_timeout_s, "timeout")
+        if max_frames is not None and (isinstance(max_frames, bool) or max_frames < 1):
+            raise ValueError(f"frames: must be >= 1, got {max_frames!r}")
+        if decoder is None and make_decoder is None:
+            raise ValueError("receive: needs a decoder or make_decoder")
+        self.decoder = decoder
         frames: list[Frame] = []
         deadline = time.monotonic() + total_timeout_s
-        self.sock.settimeout(idle_timeout_s)
 
         def emit(new: list[Frame]) -> None:
             for f in new:
@@ -142,11 +182,29 @@ class UdpReceiver:
                 if on_frame:
                     on_frame(f)
 
-        while time.monotonic() < deadline and (max_frames is None or len(frames) < max_frames):
-            try:
-                data, _ = self.sock.recvfrom(UDP_MAX_PAYLOAD + 1)
-            except TimeoutError:
-                break
-            emit(decoder.push_packet(data))
-        emit(decoder.flush())
+        try:
+            while max_frames is None or len(frames) < max_frames:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    break
+                self.sock.settimeout(min(left, idle_timeout_s) if self.datagrams else left)
+                try:
+                    data, _ = self.sock.recvfrom(UDP_MAX_PAYLOAD + 1)
+                except TimeoutError:
+                    if self.datagrams:
+                        break
+                    continue
+                self.datagrams += 1
+                if self.decoder is None:
+                    assert make_decoder is not None
+                    try:
+                        self.decoder = make_decoder(data)
+                    except ValueError as exc:  # not a packet of any known geometry
+                        self.unusable.append(str(exc))
+                        continue
+                emit(self.decoder.push_packet(data))
+        except KeyboardInterrupt:
+            self.interrupted = True
+        if self.decoder is not None:
+            emit(self.decoder.flush())
         return frames

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from model.axis_packetizer import pack_iq
+
 
 @dataclass
 class ChirpAttempt:
@@ -110,8 +112,7 @@ def adc_frame_to_stream(adc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     adc = np.asarray(adc)
     n_chirps, num_rx, n_range = adc.shape
     s = adc.transpose(0, 2, 1).reshape(-1, num_rx)
-    words = ((np.imag(s).astype(np.int64) & 0xFFFF) << 16 | (np.real(s).astype(np.int64)
-                                                              & 0xFFFF)).astype(np.uint32)
+    words = pack_iq(s)
     n = n_chirps * n_range
     tlast = (np.arange(n) % n_range) == n_range - 1
     sof = np.zeros(n, bool)

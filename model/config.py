@@ -19,12 +19,23 @@ Where the paper's numbers disagree (DESIGN.md section 2):
 
 Sampling is complex (I/Q), so a beat frequency in [0, fs) maps to range bins 0..N-1 and the
 maximum range is ``n_range * range_bin_m``.
+
+Range bins and the range edge: the range FFT of a complex IF signal is circular. Bin N-k is
+the beat frequency -k fs/N just as much as (N-k) fs/N: a target at range <= 0 (one that has
+driven past the radar), and the window sidelobes of a strong near target, land in the top
+bins. The detectors therefore treat the range axis as circular (CFAR windows wrap, they are
+not cut) and never report the ``NEGATIVE_BEAT_GUARD_BINS`` top bins nor the
+``DC_GUARD_BINS`` lowest ones (DC offset / TX leakage); :meth:`RadarConfig.detection_bins` is
+that one rule, for the host CFAR and the FPGA detector alike, and
+:attr:`RadarConfig.max_detection_range_m` the largest range a detection can report.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+
+import numpy as np
 
 C0 = 299_792_458.0
 """Speed of light in vacuum, m/s."""
@@ -33,6 +44,14 @@ BOLTZMANN = 1.380649e-23
 
 FFT_MIN, FFT_MAX = 16, 4096
 """Transform lengths the open FFT core supports (DESIGN.md 3.1)."""
+
+DC_GUARD_BINS = 1
+"""Range bins 0..DC_GUARD_BINS-1 are never detections (DC offset, TX-RX leakage)."""
+NEGATIVE_BEAT_GUARD_BINS = 4
+"""Top range bins N-4..N-1 are never detections: with complex sampling they hold negative
+beat frequencies (range < 0), i.e. only the wrapped window sidelobes of near targets
+(periodic Hann main lobe +-2 bins, first sidelobes at +-2.5 bins) and targets that have
+passed the radar."""
 
 
 def db_to_lin(db: float) -> float:
@@ -193,6 +212,22 @@ class RadarConfig:
         """Largest unambiguous range, n_range * range_bin (beat frequency = fs), m."""
         return self.n_range * self.range_bin_m
 
+    @property
+    def detection_bins(self) -> tuple[int, int]:
+        """Range bins a detector may report: ``lo <= bin < hi`` (see the module docstring:
+        DC guard below, negative-beat guard at the top of the circular range axis)."""
+        return DC_GUARD_BINS, self.n_range - NEGATIVE_BEAT_GUARD_BINS
+
+    @property
+    def max_detection_range_m(self) -> float:
+        """Largest range a detection can report, the start of the top guard band, m."""
+        return self.detection_bins[1] * self.range_bin_m
+
+    @property
+    def min_detection_range_m(self) -> float:
+        """Smallest range a detection can report (end of the DC guard), m."""
+        return self.detection_bins[0] * self.range_bin_m
+
     def beat_frequency_hz(self, range_m: float, radial_velocity_mps: float = 0.0) -> float:
         """Beat frequency of a target, S * 2R / c plus its Doppler shift 2v / lambda, Hz."""
         return (self.slope_hz_per_s * 2.0 * range_m / C0
@@ -245,6 +280,31 @@ class RadarConfig:
         """Largest positive ADC code, 2**(adc_bits-1) - 1."""
         return 2 ** (self.adc_bits - 1) - 1
 
+    # ---- array shapes ---------------------------------------------------------------------
+    @property
+    def adc_shape(self) -> tuple[int, int, int]:
+        """Shape of one ADC frame: (n_chirps in transmit order, num_rx, n_range samples)."""
+        return (self.n_chirps, self.num_rx, self.n_range)
+
+    @property
+    def cube_shape(self) -> tuple[int, int, int]:
+        """Shape of one radar cube: (n_virtual, n_range, n_doppler)."""
+        return (self.n_virtual, self.n_range, self.n_doppler)
+
+    def check_adc(self, adc: np.ndarray, what: str = "adc") -> None:
+        """ValueError naming the expected and actual shape unless ``adc`` is one ADC frame
+        of this configuration, (n_chirps, num_rx, n_range)."""
+        if np.shape(adc) != self.adc_shape:
+            raise ValueError(f"{what}: expected shape {self.adc_shape} (chirps, rx, samples) "
+                             f"for preset {self.name!r}, got {np.shape(adc)}")
+
+    def check_cube(self, cube: np.ndarray, what: str = "cube") -> None:
+        """ValueError naming the expected and actual shape unless ``cube`` is one radar cube
+        of this configuration, (n_virtual, n_range, n_doppler)."""
+        if np.shape(cube) != self.cube_shape:
+            raise ValueError(f"{what}: expected shape {self.cube_shape} for preset "
+                             f"{self.name!r}, got {np.shape(cube)}")
+
     # ---- front end ------------------------------------------------------------------------
     @property
     def noise_power_w(self) -> float:
@@ -293,6 +353,20 @@ PRESETS: dict[str, RadarConfig] = {
         name="full", num_tx=4, num_rx=16, n_range=256, n_doppler=256,
         sample_rate_hz=32.5e6, chirp_period_s=8.76e-6, design_max_range_m=300.0),
 }
+
+
+DATA_W = 16
+"""Bits of I and of Q on every sample stream of the RTL (DESIGN.md section 3)."""
+
+
+def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
+    """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,
+    N_DOPPLER and DATA_W, then ``overrides`` (e.g. ``PACKET_WORDS=1024``) added or replacing.
+    The one place that maps a preset to HDL parameters (tests, RTL source, synthesis)."""
+    params = {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
+              "N_DOPPLER": cfg.n_doppler, "DATA_W": DATA_W}
+    params.update(overrides)
+    return params
 
 
 def get_preset(name: str) -> RadarConfig:

@@ -1,5 +1,5 @@
 """Single source of the FFT coefficient ROMs shared by the RTL (``rtl/fft/fft_rom_pkg.sv``)
-and the bit-accurate model (:mod:`model.fft_fixed`).
+and the bit-accurate model (:mod:`model.fft_axis`).
 
 Two tables of ``ROM_SIZE = 4096`` entries cover every transform length N = 16..4096:
 
@@ -11,7 +11,7 @@ Two tables of ``ROM_SIZE = 4096`` entries cover every transform length N = 16..4
 
 ``rint`` is numpy's round-half-to-even. ``make gen`` (``python -m model.fft_rom``) rewrites
 the SystemVerilog package (only when its contents change); the unit test
-``tb/fft_axis/test_fft_fixed_model.py`` and the FFT testbench fail when it is stale.
+``tb/fft_axis/test_fft_axis_model.py`` and the FFT testbench fail when it is stale.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+
+from model.reference import hann_periodic
 
 ROM_LOG2 = 12
 """log2 of the ROM length: the largest supported transform is 2**ROM_LOG2 points."""
@@ -46,8 +48,7 @@ def sin_table() -> np.ndarray:
 
 def hann_table() -> np.ndarray:
     """int64 (4096,): Q1.16 periodic Hann of length 4096 (values 0..65536)."""
-    k = np.arange(ROM_SIZE)
-    w = 0.5 - 0.5 * np.cos(2.0 * np.pi * k / ROM_SIZE)
+    w = hann_periodic(ROM_SIZE)
     return np.rint((1 << COEF_FRAC) * w).astype(np.int64)
 
 

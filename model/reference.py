@@ -31,17 +31,17 @@ def hann_periodic(n: int) -> np.ndarray:
     return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
 
 
-def signed_bins(n: int) -> np.ndarray:
-    """Signed bin index of each natural-order FFT bin: 0..n/2-1, -n/2..-1, int (n,)."""
-    k = np.arange(n)
+def signed_bin(k: np.ndarray | int, n: int) -> np.ndarray:
+    """Signed index of natural-order FFT bin ``k`` (0..n-1 -> 0..n/2-1, -n/2..-1), int, the
+    shape of ``k``. Values below n/2 pass unchanged and larger ones lose ``n`` (so an
+    already signed bin stays as it is)."""
+    k = np.asarray(k)
     return np.where(k < n // 2, k, k - n)
 
 
-def _check_adc(adc: np.ndarray, cfg: RadarConfig) -> None:
-    expected = (cfg.n_chirps, cfg.num_rx, cfg.n_range)
-    if adc.shape != expected:
-        raise ValueError(f"adc: expected shape {expected} (chirps, rx, samples) for preset "
-                         f"{cfg.name!r}, got {adc.shape}")
+def signed_bins(n: int) -> np.ndarray:
+    """Signed bin index of each natural-order FFT bin: 0..n/2-1, -n/2..-1, int (n,)."""
+    return signed_bin(np.arange(n), n)
 
 
 def range_fft(adc: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndarray:
@@ -49,7 +49,7 @@ def range_fft(adc: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndar
 
     adc: complex (n_chirps, num_rx, n_range) -> complex128 (n_chirps, num_rx, n_range).
     """
-    _check_adc(adc, cfg)
+    cfg.check_adc(adc)
     x = adc.astype(np.complex128)
     if window:
         x = x * hann_periodic(cfg.n_range)
@@ -83,7 +83,7 @@ def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     """
     turned = corner_turn(range_fft(adc, cfg, range_window), cfg)
     cube = doppler_fft(turned, cfg, doppler_window)
-    return cube.reshape(cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    return cube.reshape(cfg.cube_shape)
 
 
 def cube_to_dma_order(cube: np.ndarray, cfg: RadarConfig) -> np.ndarray:
@@ -95,7 +95,7 @@ def cube_to_dma_order(cube: np.ndarray, cfg: RadarConfig) -> np.ndarray:
 def dma_order_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
     """Inverse of :func:`cube_to_dma_order`: (num_tx, n_range, n_doppler, num_rx) ->
     (n_virtual, n_range, n_doppler)."""
-    return words.transpose(0, 3, 1, 2).reshape(cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+    return words.transpose(0, 3, 1, 2).reshape(cfg.cube_shape)
 
 
 def range_doppler_power(cube: np.ndarray) -> np.ndarray:
@@ -110,8 +110,7 @@ def tdm_phase_compensation(cfg: RadarConfig, doppler_bin: np.ndarray | int) -> n
     bin k picks up exp(j 2 pi k t / (n_doppler * num_tx)) on TX t's channels; multiply by the
     returned conjugate phasor. ``doppler_bin`` is the natural-order bin (converted to signed).
     """
-    d = np.asarray(doppler_bin)
-    k = np.where(d < cfg.n_doppler // 2, d, d - cfg.n_doppler)
+    k = signed_bin(doppler_bin, cfg.n_doppler)
     tx_of_v = np.arange(cfg.n_virtual) // cfg.num_rx
     return np.exp(-2j * np.pi * np.multiply.outer(k, tx_of_v) / (cfg.n_doppler * cfg.num_tx))
 

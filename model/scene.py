@@ -34,6 +34,28 @@ from model.config import PRESETS, RadarConfig, get_preset
 KMH = 1.0 / 3.6
 """m/s per km/h."""
 
+# Limits of what a scene may ask of the simulator (one-line ValueError beyond them).
+MAX_RANGE_M = 1.0e5
+"""Largest target range or object distance, m (far beyond every preset's IF band)."""
+MAX_SPEED_MPS = 1000.0
+"""Largest radial velocity or object speed, m/s (Mach 3: covers every road user)."""
+MAX_RCS_M2 = 1.0e6
+"""Largest RCS, m^2 (a large ship)."""
+MAX_SIZE_M = 1000.0
+"""Largest object length or width, m."""
+MAX_SCATTERERS_PER_OBJECT = 256
+"""Scatterers per extended object (memory and time of the simulator grow with it)."""
+MAX_SCATTERERS = 2048
+"""Scatterers per scene, all targets and objects together."""
+MAX_SEED = 2**63 - 1
+"""Largest scene seed."""
+
+_BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "radial_velocity_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
+           "rcs_m2": (0.0, MAX_RCS_M2), "x_m": (-MAX_RANGE_M, MAX_RANGE_M),
+           "y_m": (-MAX_RANGE_M, MAX_RANGE_M), "length_m": (0.0, MAX_SIZE_M),
+           "width_m": (0.0, MAX_SIZE_M), "vx_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
+           "vy_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS), "heading_deg": (-3600.0, 3600.0)}
+
 
 def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = None) -> float:
     if key not in d:
@@ -43,6 +65,10 @@ def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = 
     value = d[key]
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise ValueError(f"{where}.{key}: must be a finite number, got {value!r}")
+    lo, hi = _BOUNDS.get(key, (-math.inf, math.inf))
+    if not lo <= value <= hi:
+        raise ValueError(f"{where}.{key}: {value!r} is outside what the simulator accepts "
+                         f"[{lo:g}, {hi:g}]")
     return float(value)
 
 
@@ -149,8 +175,10 @@ class ExtendedObject:
             raise ValueError("length_m/width_m: must be positive")
         if self.rcs_m2 <= 0:
             raise ValueError(f"rcs_m2: must be positive, got {self.rcs_m2}")
-        if not isinstance(self.n_scatterers, int) or self.n_scatterers < 1:
-            raise ValueError(f"n_scatterers: must be a positive integer, got {self.n_scatterers}")
+        if not isinstance(self.n_scatterers, int) or not \
+                1 <= self.n_scatterers <= MAX_SCATTERERS_PER_OBJECT:
+            raise ValueError(f"n_scatterers: must be an integer in 1..{MAX_SCATTERERS_PER_OBJECT}"
+                             f", got {self.n_scatterers}")
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "object") -> ExtendedObject:
@@ -227,6 +255,13 @@ class Scene:
 
     def __post_init__(self) -> None:
         get_preset(self.preset)  # validates the name
+        n = len(self.targets) + sum(o.n_scatterers for o in self.objects)
+        if n > MAX_SCATTERERS:
+            raise ValueError(f"scene: {n} scatterers (targets + objects' n_scatterers), at "
+                             f"most {MAX_SCATTERERS}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not \
+                0 <= self.seed <= MAX_SEED:
+            raise ValueError(f"seed: must be an integer in 0..2**63-1, got {self.seed!r}")
 
     @property
     def config(self) -> RadarConfig:
@@ -298,8 +333,8 @@ class Scene:
 
 def _int(d: Mapping[str, Any], key: str, default: int) -> int:
     v = d.get(key, default)
-    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-        raise ValueError(f"{key}: must be a non-negative integer, got {v!r}")
+    if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= MAX_SEED:
+        raise ValueError(f"{key}: must be an integer in 0..2**63-1, got {v!r}")
     return v
 
 
@@ -321,6 +356,25 @@ TABLE1_VEHICLES: tuple[tuple[float, float, float, float], ...] = (
     (20.0, -80.0, -10.0, 40.0),
     (10.0, 25.0, -30.0, 20.0),
 )
+
+
+MAX_EGO_SPEED_MPS = 150.0
+"""Largest ego speed accepted for velocity compensation, m/s (540 km/h)."""
+
+
+def check_ego_speed(ego_speed_mps: float) -> float:
+    """ValueError unless ``ego_speed_mps`` is a finite speed within +-MAX_EGO_SPEED_MPS."""
+    if isinstance(ego_speed_mps, bool) or not isinstance(ego_speed_mps, int | float) or not \
+            -MAX_EGO_SPEED_MPS <= ego_speed_mps <= MAX_EGO_SPEED_MPS:
+        raise ValueError(f"ego speed: must be a finite number of m/s within "
+                         f"+-{MAX_EGO_SPEED_MPS:g}, got {ego_speed_mps!r}")
+    return float(ego_speed_mps)
+
+
+def default_ego_speed_mps(scene: Scene) -> float:
+    """Ego speed along +x a scene implies, m/s: the Table I scene's 100 km/h, else 0 (a
+    static radar). ``radar detect --gnn`` and ``radar gnn detect`` both default to it."""
+    return EGO_SPEED_KMH * KMH if scene.name == "table1" else 0.0
 
 
 def table1_scene(preset: str = "full", seed: int = 1, tx_beamforming: bool = True) -> Scene:

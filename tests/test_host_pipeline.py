@@ -119,9 +119,12 @@ def test_paper_fpga_end_to_end():
     found = [m for m in matches if m.index >= 0]
     assert len(found) >= 3  # vehicle 1 (100 m, 30 deg) is below the noise with 4 channels
     for m in found:
-        assert abs(m.range_err_m) <= 0.5 and abs(m.velocity_err_mps) <= 0.15
+        v_err = m.alias_velocity_err_mps if m.aliased else m.velocity_err_mps
+        assert abs(m.range_err_m) <= 0.5 and abs(v_err) <= 0.15
         assert abs(m.azimuth_err_deg) <= 3.0  # 4 elements: 28.6 deg resolution, coarse angle
     assert matches[2].aliased  # one TX cannot unfold: vehicle 3 shows at +5.56 m/s
+    assert cloud.ambiguous[matches[2].index]  # ... and says so
+    assert abs(matches[2].velocity_err_mps) > 50  # the error is against the true -50 m/s
     assert int((~used).sum()) <= 2
 
 

@@ -8,7 +8,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def test_rtl_lint_clean():
-    from host.rtlsim.toolchain import ensure_verilator_env
+    from rtlsim.toolchain import ensure_verilator_env
 
     ensure_verilator_env()
     r = subprocess.run(["bash", str(REPO / "tools" / "lint.sh")], cwd=REPO,
@@ -19,7 +19,8 @@ def test_rtl_lint_clean():
 
 def test_python_lint_clean():
     ruff = str(Path(sys.executable).parent / "ruff")  # pinned in the dev extras
-    folders = [f for f in ("model", "host", "gnn", "tb", "tests", "tools", "synth")
+    folders = [f for f in ("model", "rtlsim", "host", "gnn", "radar", "tb", "tests", "tools",
+                           "synth")
                if (REPO / f).is_dir()]
     r = subprocess.run([ruff, "check", *folders], cwd=REPO, capture_output=True, text=True)
     assert r.returncode == 0, r.stdout[-3000:]

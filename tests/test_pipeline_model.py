@@ -6,9 +6,9 @@ import pytest
 from host.evaluate import match_targets
 from host.pipeline import process_cube
 from host.stream import StreamDecoder
+from model.axis_packetizer import words_to_bytes
 from model.config import get_preset
-from model.packetizer import words_to_bytes
-from model.pipeline import PipelineParams, chain_gain, dma_packets, run_chain
+from model.radar_pipeline import PipelineParams, chain_gain, dma_packets, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene

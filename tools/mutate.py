@@ -43,7 +43,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
 OUT = REPO / "out" / "mutate"
-COPY_DIRS = ("rtl", "tb", "host", "model")
+COPY_DIRS = tuple(d for d in ("rtl", "tb", "host", "model", "rtlsim", "radar")
+                  if (REPO / d).is_dir())
 
 # module -> pytest stages, cheapest first: a mutant is killed by the first stage that fails
 # (stage 1 is the smallest parameter set of the most specific testbench), and survives only
@@ -306,7 +307,7 @@ def compiles(mutant: Mutant, root: Path) -> bool:
     """Verilator lint of the mutated module (a mutant that does not compile is invalid,
     not killed: it says nothing about the testbench)."""
     sys.path.insert(0, str(REPO))
-    from host.rtlsim.toolchain import ensure_verilator_env
+    from rtlsim.toolchain import ensure_verilator_env
     ensure_verilator_env()
     dirs = [a for d in sorted({p.parent for p in (root / "rtl").rglob("*.sv")})
             for a in ("-y", str(d))]

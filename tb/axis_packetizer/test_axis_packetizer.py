@@ -1,35 +1,22 @@
-"""cocotb testbench of ``rtl/buffers/axis_packetizer.sv`` against ``model/packetizer.py``."""
+"""cocotb testbench of ``rtl/buffers/axis_packetizer.sv`` against ``model/axis_packetizer.py``."""
 
 from __future__ import annotations
 
 import itertools
-import logging
-import os
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
-from model import packetizer as pk
-
-
-def words_to_frame(words: np.ndarray) -> AxiStreamFrame:
-    return AxiStreamFrame(pk.words_to_bytes(words))
-
-
-def frame_to_words(frame: AxiStreamFrame, num_rx: int) -> np.ndarray:
-    return pk.bytes_to_words(bytes(frame.tdata), num_rx)
+from model import axis_packetizer as pk
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut)
-        for comp in (self.source, self.sink):
-            comp.log.setLevel(logging.WARNING)
         self.num_rx = param("NUM_RX")
         self.packet_words = param("PACKET_WORDS")
         self.frame_words = param("FRAME_WORDS")
@@ -37,7 +24,6 @@ class TB(AxisTB):
         self.backpressure = bool(param("INPUT_BACKPRESSURE"))
         self.tlast_period = param("TLAST_PERIOD")
         self.n_packets = pk.packets_per_frame(self.frame_words, self.packet_words)
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
@@ -46,15 +32,12 @@ class TB(AxisTB):
         """Queue one frame, cut at the expected input TLAST positions."""
         chunk = self.tlast_period or len(words)
         for start in range(0, len(words), chunk):
-            await self.source.send(words_to_frame(words[start:start + chunk]))
+            await self.send_words(words[start:start + chunk])
 
     async def drain(self, quiet: int = 64) -> list[np.ndarray]:
         """Wait for the source to finish and the output to go quiet; return received packets."""
         await self.wait_quiet(quiet)
-        out = []
-        while not self.sink.empty():
-            out.append(frame_to_words(self.sink.recv_nowait(), self.num_rx))
-        return out
+        return [w for w, _ in self.drain_words(self.num_rx)]
 
     def status(self) -> dict[str, int]:
         d = self.dut
@@ -209,10 +192,10 @@ async def test_framing_error(dut):
     await tb.send_frame(frames[0])
     # frame 1 with one TLAST a word early (on word t-2): exactly one framing error
     t = tb.tlast_period
-    await tb.source.send(words_to_frame(frames[1][:t - 1]))
-    await tb.source.send(words_to_frame(frames[1][t - 1:t]))
+    await tb.send_words(frames[1][:t - 1])
+    await tb.send_words(frames[1][t - 1:t])
     for start in range(t, len(frames[1]), t):
-        await tb.source.send(words_to_frame(frames[1][start:start + t]))
+        await tb.send_words(frames[1][start:start + t])
     got = await tb.drain()
     st = tb.status()
     assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
@@ -268,7 +251,8 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_axis_packetizer(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("axis_packetizer", rtl_sources("common/*.sv", "buffers/*.sv"), "test_axis_packetizer", here,
+    run_cocotb("axis_packetizer", rtl_sources("common/*.sv", "buffers/*.sv"),
+               "test_axis_packetizer", here,
                parameters={"DATA_W": 16, **parameters})
 
 

@@ -3,32 +3,24 @@
 from __future__ import annotations
 
 import itertools
-import logging
-import os
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
 from model import chirp_pingpong as cp
-from model.packetizer import words_to_bytes
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut)
-        for comp in (self.source, self.sink):
-            comp.log.setLevel(logging.WARNING)
         self.num_rx = param("NUM_RX")
         self.n_range = param("N_RANGE")
         self.backpressure = bool(param("ADC_BACKPRESSURE"))
         assert param("DATA_W") == 16
-        self.bpw = self.num_rx * 4  # bytes per word
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
 
     def stream(self, n_chirps: int, chirps_per_frame: int = 16):
         """Random ADC stream of n_chirps good chirps: (words, tlast, sof)."""
@@ -46,28 +38,22 @@ class TB(AxisTB):
             ends.append(len(words))
         start = 0
         for end in ends:
-            user = [int(u) for u in sof[start:end] for _ in range(self.bpw)]
-            fr = AxiStreamFrame(words_to_bytes(words[start:end]), tuser=user)
-            await self.source.send(fr)
+            await self.send_words(words[start:end], tuser=sof[start:end])
             start = end
 
     async def drain(self, quiet: int = 64) -> list[cp.OutChirp]:
         await self.wait_quiet(quiet)
         out = []
-        while not self.sink.empty():
-            f = self.sink.recv_nowait(compact=False)
-            w = np.frombuffer(bytes(f.tdata), dtype="<u4").reshape(-1, self.num_rx)
-            user = [f.tuser[i * self.bpw] for i in range(len(w))]
+        for w, user in self.drain_words(self.num_rx):
             assert len(w) == self.n_range, f"chirp of {len(w)} samples"
             assert all(u == 0 for u in user[1:]), "TUSER set past the first sample"
             out.append(cp.OutChirp(-1, w, bool(user[0] & 1), bool(user[0] & 2)))
         return out
 
     def status(self) -> dict[str, int]:
-        d = self.dut
-        return {k: int(getattr(d, k).value) for k in (
+        return self.read_status((
             "status_overflow", "status_framing_error", "drop_count", "chirps_dropped",
-            "framing_error_count", "chirps_out")}
+            "framing_error_count", "chirps_out"))
 
     @staticmethod
     def compare(got: list[cp.OutChirp], exp: list[cp.OutChirp]) -> None:
@@ -214,5 +200,6 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_chirp_pingpong(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    run_cocotb("chirp_pingpong", rtl_sources("common/*.sv", "buffers/*.sv"), "test_chirp_pingpong", here,
+    run_cocotb("chirp_pingpong", rtl_sources("common/*.sv", "buffers/*.sv"),
+               "test_chirp_pingpong", here,
                parameters={"DATA_W": 16, **parameters})

@@ -2,33 +2,26 @@
 
 from __future__ import annotations
 
-import logging
-import os
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, no_pause, random_pause
-from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
 from model import corner_turn as ct
-from model.packetizer import words_to_bytes
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut)
-        for comp in (self.source, self.sink):
-            comp.log.setLevel(logging.WARNING)
         self.num_tx = param("NUM_TX")
         self.num_rx = param("NUM_RX")
         self.n_range = param("N_RANGE")
         self.n_doppler = param("N_DOPPLER")
         assert param("DATA_W") == 16
         self.frame_words = self.num_tx * self.n_range * self.n_doppler
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
@@ -37,7 +30,7 @@ class TB(AxisTB):
         """One frame as chirps (TLAST on the last range bin of each chirp)."""
         nr = self.n_range
         for c in range(len(words) // nr):
-            await self.source.send(AxiStreamFrame(words_to_bytes(words[c * nr:(c + 1) * nr])))
+            await self.send_words(words[c * nr:(c + 1) * nr])
 
     async def recv_frames(self, n: int) -> list[np.ndarray]:
         """Receive n frames of Doppler vectors, checking TLAST and TUSER (frame start)."""
@@ -45,20 +38,16 @@ class TB(AxisTB):
         for _ in range(n):
             vecs = []
             for v in range(self.num_tx * self.n_range):
-                f = await self.sink.recv(compact=False)
-                w = np.frombuffer(bytes(f.tdata), dtype="<u4").reshape(-1, self.num_rx)
+                w, sof = await self.recv_words_user(self.num_rx)
                 assert len(w) == self.n_doppler, f"vector of {len(w)} words"
-                lanes = self.num_rx * 4
-                sof = [f.tuser[i * lanes] for i in range(len(w))]
                 assert sof == [int(v == 0 and i == 0) for i in range(len(w))], sof[:4]
                 vecs.append(w)
             frames.append(np.vstack(vecs))
         return frames
 
     def status(self) -> dict[str, int]:
-        d = self.dut
-        return {k: int(getattr(d, k).value) for k in (
-            "status_framing_error", "framing_error_count", "frames_in", "frames_out")}
+        return self.read_status((
+            "status_framing_error", "framing_error_count", "frames_in", "frames_out"))
 
     def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
         for k, (g, f) in enumerate(zip(got, sent, strict=True)):
@@ -129,10 +118,10 @@ async def test_framing_error(dut):
     nr = tb.n_range
     rx = cocotb.start_soon(tb.recv_frames(1))
     # chirp 0 split as (nr-1) + 1 words: early TLAST at word nr-2 -> exactly one error
-    await tb.source.send(AxiStreamFrame(words_to_bytes(f[:nr - 1])))
-    await tb.source.send(AxiStreamFrame(words_to_bytes(f[nr - 1:nr])))
+    await tb.send_words(f[:nr - 1])
+    await tb.send_words(f[nr - 1:nr])
     for c in range(1, len(f) // nr):
-        await tb.source.send(AxiStreamFrame(words_to_bytes(f[c * nr:(c + 1) * nr])))
+        await tb.send_words(f[c * nr:(c + 1) * nr])
     got = await rx
     tb.check(got, [f])
     st = tb.status()

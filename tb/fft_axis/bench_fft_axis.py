@@ -2,8 +2,9 @@
 against the paper's Xilinx radix-4 burst figures.
 
 Runs the cocotb test ``test_throughput_latency`` of ``test_fft_axis.py`` (no stalls, four
-back-to-back frames) on Verilator for each configuration through ``sim.run_cocotb`` (builds
-are shared with the regression under ``sim_build/``) and prints a table.
+back-to-back frames) on Verilator for each configuration through
+``rtlsim.toolchain.run_cocotb`` (builds are shared with the regression under ``sim_build/``)
+and prints a table.
 
     tools/venv-run python tb/fft_axis/bench_fft_axis.py [--quick]
 """
@@ -19,10 +20,11 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE.parent), str(HERE)]
+sys.path[:0] = [str(HERE.parents[1]), str(HERE)]
 
-from sim import ensure_verilator_env  # noqa: E402
 from test_fft_axis import run  # noqa: E402
+
+from rtlsim.toolchain import ensure_verilator_env  # noqa: E402
 
 # Xilinx FFT IP, radix-4 burst I/O, cycles per transform as quoted in the paper.
 PAPER_CYCLES = {64: 231, 256: 837}

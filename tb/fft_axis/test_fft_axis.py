@@ -1,4 +1,4 @@
-"""cocotb testbench of ``rtl/fft/fft_axis.sv`` against the bit-accurate ``model/fft_fixed.py``.
+"""cocotb testbench of ``rtl/fft/fft_axis.sv`` against the bit-accurate ``model/fft_axis.py``.
 
 Every output sample is compared bit-exact with the model (data, tuser, tlast and the
 overflow event of each beat), and the transform is compared with float64 numpy (SQNR, dB,
@@ -16,13 +16,14 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, random_pause
 from cocotb.triggers import FallingEdge, with_timeout
 from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
-from model import fft_fixed as ff
+from model import fft_axis as ff
+from model.axis_packetizer import bytes_to_words, words_to_bytes
 from model.fft_rom import PKG_PATH, render_rom_pkg
+from rtlsim.axis import AxisTB, bursty_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
@@ -30,9 +31,7 @@ class TB(AxisTB):
     handshakes and event pulses, and the model configured from the HDL parameters."""
 
     def __init__(self, dut) -> None:
-        super().__init__(dut)
-        for comp in (self.source, self.sink):  # the reset test flushes a frame on purpose
-            comp.log.setLevel(logging.ERROR)
+        super().__init__(dut, log_level=logging.ERROR)  # the reset test flushes a frame
         self.n = param("N")
         self.ch = param("NUM_CH")
         self.dw = param("DATA_W", 16)
@@ -41,7 +40,6 @@ class TB(AxisTB):
         self.window = bool(param("WINDOW", 0))
         self.scale_sch = param("SCALE_SCH", 0xFFF) & ((1 << (self.n.bit_length() - 1)) - 1)
         self.default_scale = self.scale_sch == ff.default_scale_sch(self.n)
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
         self.clear_monitor()
         cocotb.start_soon(self._monitor())
 
@@ -86,7 +84,7 @@ class TB(AxisTB):
         im = np.imag(x).astype(np.int64) & mask
         lane = (im << dw) | re
         if dw == 16:
-            return AxiStreamFrame(lane.astype("<u4").tobytes())
+            return AxiStreamFrame(words_to_bytes(lane))
         nbytes = 2 * dw * self.ch // 8
         out = bytearray()
         for beat in lane:
@@ -100,7 +98,7 @@ class TB(AxisTB):
         nbytes = 2 * dw * ch // 8
         raw = bytes(frame.tdata)
         if dw == 16:
-            lane = np.frombuffer(raw, dtype="<u4").reshape(-1, ch).astype(np.int64)
+            lane = bytes_to_words(raw, ch).astype(np.int64)
         else:
             words = [int.from_bytes(raw[i:i + nbytes], "little")
                      for i in range(0, len(raw), nbytes)]

@@ -8,32 +8,24 @@ per-frame damaged marks and the counters are compared with the model.
 
 from __future__ import annotations
 
-import logging
-import os
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
-from axis_tb import AxisTB, bursty_pause, random_pause
 from cocotb.triggers import RisingEdge
-from cocotbext.axi import AxiStreamFrame
-from sim import param, rtl_sources, run_cocotb
 
 from model.frame_align import frame_align
-from model.packetizer import words_to_bytes
+from rtlsim.axis import AxisTB, bursty_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
 class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut)
-        for comp in (self.source, self.sink):
-            comp.log.setLevel(logging.WARNING)
         self.num_rx = param("NUM_RX")
         self.n_range = param("N_RANGE")
         self.frame_chirps = param("FRAME_CHIRPS")
-        self.bpw = 4 * self.num_rx
-        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
         self.done: list[bool] = []
         cocotb.start_soon(self._watch_frames())
 
@@ -64,14 +56,12 @@ class TB(AxisTB):
 
     async def send(self, chirps, sof, gap) -> None:
         for ch, s, g in zip(chirps, sof, gap, strict=True):
-            user = [int(s) | (int(g) << 1)] * self.bpw + [0] * (self.bpw * (self.n_range - 1))
-            await self.source.send(AxiStreamFrame(words_to_bytes(ch), tuser=user))
+            await self.send_words(ch, tuser=[int(s) | (int(g) << 1)] + [0] * (len(ch) - 1))
 
     async def collect(self, n_chirps: int) -> list[np.ndarray]:
         out = []
         for _ in range(n_chirps):
-            f = await self.sink.recv()
-            out.append(np.frombuffer(bytes(f.tdata), dtype="<u4").reshape(-1, self.num_rx))
+            out.append(await self.recv_words(self.num_rx))
         return out
 
     def counters(self) -> tuple[int, int, int]:
@@ -179,5 +169,6 @@ PARAMS = [dict(NUM_RX=2, DATA_W=16, N_RANGE=4, FRAME_CHIRPS=6),
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: f"rx{p['NUM_RX']}_n{p['N_RANGE']}")
 def test_frame_align(parameters: dict) -> None:
-    run_cocotb("frame_align", rtl_sources("common/*.sv", "buffers/frame_align.sv"), "test_frame_align",
+    run_cocotb("frame_align", rtl_sources("common/*.sv", "buffers/frame_align.sv"),
+               "test_frame_align",
                Path(__file__).parent, parameters)

@@ -19,15 +19,15 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE.parent), str(HERE)]
+sys.path[:0] = [str(HERE.parents[1]), str(HERE)]
 
-from sim import rtl_sources, run_cocotb  # noqa: E402
 from test_radar_pipeline import CONFIGS  # noqa: E402
 
-from host.rtlsim.pipeline_rtl import PIPELINE_SOURCES, hdl_parameters  # noqa: E402
+from model.axis_packetizer import packets_per_frame  # noqa: E402
 from model.config import get_preset  # noqa: E402
-from model.packetizer import packets_per_frame  # noqa: E402
-from model.pipeline import PipelineParams  # noqa: E402
+from model.radar_pipeline import PipelineParams  # noqa: E402
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES  # noqa: E402
+from rtlsim.toolchain import rtl_sources, run_cocotb  # noqa: E402
 
 CLOCK_HZ = 100e6
 PAPER_FPS = 3.79
@@ -39,7 +39,7 @@ def measure(name: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.json"
         run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES), "test_radar_pipeline",
-                   HERE, hdl_parameters(cfg, chain),
+                   HERE, chain.hdl_parameters(cfg),
                    extra_env={"RP_BENCH_JSON": str(out)}, testcase="throughput_latency")
         return json.loads(out.read_text())
 

@@ -1,4 +1,4 @@
-"""End-to-end cocotb regression of ``rtl/top/radar_pipeline.sv`` against ``model.pipeline``.
+"""End-to-end cocotb regression of ``rtl/top/radar_pipeline.sv`` against ``model.radar_pipeline``.
 
 ADC frames from ``model.simulate`` go through the RTL; the DMA stream is decoded by the host
 decoder (``host.stream``) and compared packet by packet, bit for bit, with the model;
@@ -11,24 +11,32 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
 from cocotb.triggers import RisingEdge, SimTimeoutError, Timer
-from sim import rtl_sources, run_cocotb
 
-from host.backends import cube_from_adc
 from host.pipeline import process_cube
-from host.rtlsim.driver import PipelineTB
-from host.rtlsim.pipeline_rtl import PIPELINE_SOURCES, hdl_parameters
 from host.stream import StreamDecoder
+from model.axis_packetizer import parse_header, words_to_bytes
 from model.config import RadarConfig, get_preset
-from model.packetizer import parse_header, words_to_bytes
-from model.pipeline import PipelineParams, chain_gain, dma_packets, run_chain
+from model.radar_pipeline import (
+    PipelineParams,
+    chain_gain,
+    dma_packets,
+    run_chain,
+    scaled_cube,
+)
 from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_frame, simulate_scene
+from rtlsim.axis import random_pause
+from rtlsim.pipeline import PipelineTB
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES
+from rtlsim.toolchain import rtl_sources, run_cocotb
 
 SMALL4 = RadarConfig(name="small4", num_tx=4, num_rx=4, n_range=32, n_doppler=32,
                      sample_rate_hz=10e6, chirp_period_s=4e-6, design_max_range_m=50.0)
@@ -53,12 +61,6 @@ def adc_frames(name: str, cfg: RadarConfig, n: int, seed: int = 1) -> list[np.nd
     sc = Scene(preset="full", targets=SMALL4_TARGETS).scatterers()
     return [simulate_frame(cfg, sc, rng=np.random.default_rng([seed, k]), frame_index=k)
             .samples for k in range(n)]
-
-
-def random_pause(probability: float, seed: int):
-    rng = np.random.default_rng(seed)
-    while True:
-        yield bool(rng.random() < probability)
 
 
 def chirp_bursts(active: int, idle: int):
@@ -95,8 +97,8 @@ async def frames_back_to_back_with_dma_stalls(dut) -> None:
     tb = PipelineTB(dut)
     name, cfg, chain = config_of(tb)
     frames = adc_frames(name, cfg, 3)
-    tb.set_adc_gaps(chirp_bursts(cfg.n_range, cfg.n_range))
-    tb.set_dma_stalls(random_pause(0.3, 2))
+    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
+    tb.set_backpressure_generator(random_pause(0.3, 2))
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)
@@ -112,7 +114,7 @@ async def frames_back_to_back_with_dma_stalls(dut) -> None:
     gain = chain_gain(cfg, chain)
     for f, adc in zip(decoded, frames, strict=True):
         rtl_cloud = process_cube(f.cube / gain, cfg)
-        model_cloud = process_cube(cube_from_adc(adc, cfg, "model", chain), cfg)
+        model_cloud = process_cube(scaled_cube(adc, cfg, chain), cfg)
         assert len(rtl_cloud) == len(model_cloud) >= (3 if name == "paper-fpga" else 2)
         for field in ("range_m", "azimuth_deg", "radial_velocity_mps", "snr_db"):
             assert np.array_equal(getattr(rtl_cloud, field), getattr(model_cloud, field))
@@ -128,8 +130,8 @@ async def adc_gaps_at_the_real_sample_rate(dut) -> None:
     if name != "small4":
         return
     frames = adc_frames(name, cfg, 2, seed=5)
-    tb.set_adc_gaps(random_pause(0.8, 3))
-    tb.set_dma_stalls(random_pause(0.5, 4))
+    tb.set_idle_generator(random_pause(0.8, 3))
+    tb.set_backpressure_generator(random_pause(0.5, 4))
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)
@@ -151,8 +153,8 @@ async def dma_overload_then_recovery(dut) -> None:
     frames = adc_frames(name, cfg, n_frames, seed=7)
     await tb.reset()
     stall = {"on": False}
-    tb.set_dma_stalls(iter(lambda: stall["on"], None))
-    tb.set_adc_gaps(chirp_bursts(cfg.n_range, cfg.n_range))
+    tb.set_backpressure_generator(iter(lambda: stall["on"], None))
+    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
     for adc in frames:
         await tb.send_frame(adc)
     frame_clocks = 2 * cfg.n_chirps * cfg.n_range
@@ -195,7 +197,7 @@ async def reset_mid_stream(dut) -> None:
         return
     frames = adc_frames(name, cfg, 3, seed=11)
     await tb.reset()
-    tb.set_adc_gaps(chirp_bursts(cfg.n_range, cfg.n_range))
+    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
     for adc in frames:
         await tb.send_frame(adc)
     for _ in range(cfg.n_chirps * cfg.n_range):  # half way through frame 0
@@ -272,21 +274,20 @@ async def throughput_latency(dut) -> None:
 def test_radar_pipeline(name: str, tmp_path: Path) -> None:
     cfg, chain = CONFIGS[name]
     run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES), "test_radar_pipeline",
-               Path(__file__).parent, hdl_parameters(cfg, chain),
+               Path(__file__).parent, chain.hdl_parameters(cfg),
                extra_env={"SEED": os.environ.get("SEED", "1")})
     if name == "paper-fpga":
         # `radar detect --backend rtl` (same build folder, so run here, after the build)
-        # gives the same point cloud JSON as the bit-accurate model backend
-        from host.cli import main
-
+        # gives the same point cloud JSON as the bit-accurate model backend; run as a
+        # command, as a user does (the testbenches do not import the application)
         assert chain == PipelineParams()  # the CLI's chain settings
         docs = {}
         for backend in ("rtl", "model"):
             out = tmp_path / f"{backend}.json"
-            assert main(["detect", "--scene", "table1", "--preset", "paper-fpga", "--frames",
-                         "2", "--backend", backend, "--json", str(out)]) == 0
+            subprocess.run([sys.executable, "-m", "radar.cli", "detect", "--scene", "table1",
+                            "--preset", "paper-fpga", "--frames", "2", "--backend", backend,
+                            "--json", str(out)], check=True)
             docs[backend] = json.loads(out.read_text())
             docs[backend].pop("backend")
         assert docs["rtl"] == docs["model"]
         assert len(docs["rtl"]["points"]) >= 6
-

@@ -1,7 +1,8 @@
-"""cocotb test run by :func:`host.rtlsim.pipeline_rtl.run_pipeline_rtl`: stream ADC frames
+"""cocotb test run by :func:`rtlsim.pipeline_rtl.run_pipeline_rtl`: stream ADC frames
 (``RADAR_RTL_ADC``: .npy of shape (frames, n_chirps, num_rx, n_range)) through
-``radar_pipeline`` back to back, write the DMA packets to ``RADAR_RTL_DMA`` (.dmacap) and
-the status to ``RADAR_RTL_STATUS`` (JSON)."""
+``radar_pipeline`` back to back, write the DMA packets to ``RADAR_RTL_DMA`` (.npz: ``words``
+uint32 (total words, num_rx) and ``lengths``, words per packet) and the status to
+``RADAR_RTL_STATUS`` (JSON)."""
 
 from __future__ import annotations
 
@@ -12,8 +13,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 
-from host.capture import CaptureInfo, write_capture
-from host.rtlsim.driver import PipelineTB
+from rtlsim.pipeline import PipelineTB
 
 
 @cocotb.test()
@@ -24,7 +24,6 @@ async def stream_frames(dut) -> None:
     for adc in frames:
         await tb.send_frame(adc)
     packets = await tb.recv_frames(len(frames), tb.frame_timeout_cycles())
-    info = CaptureInfo(tb.num_rx, tb.packet_words, tb.num_tx, tb.n_range, tb.n_doppler)
-    write_capture(Path(os.environ["RADAR_RTL_DMA"]), info,
-                  [np.ascontiguousarray(p, dtype="<u4").tobytes() for p in packets])
+    np.savez(os.environ["RADAR_RTL_DMA"], words=np.concatenate(packets).astype(np.uint32),
+             lengths=np.array([len(p) for p in packets], dtype=np.int64))
     Path(os.environ["RADAR_RTL_STATUS"]).write_text(json.dumps(tb.status()))

@@ -1,5 +1,7 @@
-"""Shared cocotb-side testbench helpers: clock, reset, AXI4-Stream source/sink, idle and
-backpressure generators. Every block's ``TB`` class builds on :class:`AxisTB`.
+"""Shared cocotb-side testbench base: clock, reset, AXI4-Stream source/sink with words in and
+out, status reads, idle and backpressure generators. Every block's ``TB`` class (and
+:class:`rtlsim.pipeline.PipelineTB`) builds on :class:`AxisTB`. Imported only inside a cocotb
+simulation.
 """
 
 from __future__ import annotations
@@ -7,12 +9,16 @@ from __future__ import annotations
 import itertools
 import logging
 import random
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Sequence
 
 import cocotb
+import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import RisingEdge
-from cocotbext.axi import AxiStreamBus, AxiStreamSink, AxiStreamSource
+from cocotb.triggers import RisingEdge, with_timeout
+from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
+
+from model.axis_packetizer import bytes_to_words, words_to_bytes
+from rtlsim.toolchain import seed
 
 CLK_PERIOD_NS = 10  # 100 MHz, the paper's FPGA clock
 
@@ -39,20 +45,38 @@ def bursty_pause(seed: int, max_run: int = 200, busy_fraction: float = 0.3) -> I
             yield paused
 
 
+def unpack_frame(frame: AxiStreamFrame, lanes: int) -> tuple[np.ndarray, list[int]]:
+    """A received AXI-Stream frame -> (uint32 words (beats, lanes), TUSER of each beat)."""
+    words = bytes_to_words(bytes(frame.tdata), lanes)
+    n, tuser = len(words), frame.tuser
+    if not tuser:  # no TUSER port (None or empty)
+        return words, [0] * n
+    if isinstance(tuser, int):
+        return words, [tuser] * n
+    stride = len(tuser) // max(n, 1)  # one entry per byte (or per beat)
+    return words, [int(tuser[i * stride]) for i in range(n)]
+
+
 class AxisTB:
     """Clock, synchronous active-high reset, and one AXI4-Stream source and sink.
 
-    ``source_prefix`` / ``sink_prefix`` name the DUT's port prefixes (``s_axis``/``m_axis``).
+    ``source_prefix`` / ``sink_prefix`` name the DUT's port prefixes (``s_axis``/``m_axis``);
+    the cocotbext-axi components log at ``log_level`` (warnings by default: a testbench that
+    flushes a frame on purpose passes ``logging.ERROR``). ``rng`` is seeded from ``SEED``.
     """
 
-    def __init__(self, dut, source_prefix: str = "s_axis", sink_prefix: str = "m_axis") -> None:
+    def __init__(self, dut, source_prefix: str = "s_axis", sink_prefix: str = "m_axis",
+                 log_level: int = logging.WARNING) -> None:
         self.dut = dut
         self.log = logging.getLogger(f"cocotb.tb.{dut._name}")
         self.log.setLevel(logging.INFO)
+        self.rng = np.random.default_rng(seed())
         cocotb.start_soon(Clock(dut.clk, CLK_PERIOD_NS, unit="ns").start())
         self.source = AxiStreamSource(AxiStreamBus.from_prefix(dut, source_prefix), dut.clk,
                                       dut.rst)
         self.sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, sink_prefix), dut.clk, dut.rst)
+        for comp in (self.source, self.sink):
+            comp.log.setLevel(log_level)
         self._in_prefix, self._out_prefix = source_prefix, sink_prefix
         self.cycle = 0
         self.reset_meter()
@@ -102,6 +126,45 @@ class AxisTB:
         while idle < quiet:
             await RisingEdge(self.dut.clk)
             idle = 0 if (m_valid.value == 1 or s_valid.value == 1) else idle + 1
+
+    # ---- words in and out ------------------------------------------------------------------
+    async def send_words(self, words: np.ndarray, tuser: Sequence[int] | None = None) -> None:
+        """Queue one AXI-Stream frame (TLAST on its last beat): ``words`` uint32 (beats,
+        lanes), lane 0 in the low 32 bits; ``tuser`` one value per beat (None: no TUSER)."""
+        words = np.asarray(words)
+        if words.ndim == 1:
+            words = words[:, None]
+        user = None
+        if tuser is not None:
+            user = np.repeat(np.asarray(tuser, dtype=int), 4 * words.shape[1]).tolist()
+        await self.source.send(AxiStreamFrame(words_to_bytes(words), tuser=user))
+
+    async def recv_words_user(self, lanes: int, timeout_cycles: int | None = None
+                              ) -> tuple[np.ndarray, list[int]]:
+        """Next TLAST-closed frame from the sink: (uint32 words (beats, lanes), TUSER of each
+        beat). ``timeout_cycles`` bounds the wait (raises ``SimTimeoutError``)."""
+        recv = self.sink.recv(compact=False)
+        if timeout_cycles is not None:
+            frame = await with_timeout(recv, timeout_cycles * CLK_PERIOD_NS, "ns")
+        else:
+            frame = await recv
+        return unpack_frame(frame, lanes)
+
+    async def recv_words(self, lanes: int, timeout_cycles: int | None = None) -> np.ndarray:
+        """Next TLAST-closed frame from the sink: uint32 words (beats, lanes)."""
+        words, _ = await self.recv_words_user(lanes, timeout_cycles)
+        return words
+
+    def drain_words(self, lanes: int) -> list[tuple[np.ndarray, list[int]]]:
+        """Every frame already in the sink's queue, as (words, TUSER per beat)."""
+        out = []
+        while not self.sink.empty():
+            out.append(unpack_frame(self.sink.recv_nowait(compact=False), lanes))
+        return out
+
+    def read_status(self, names: Iterable[str]) -> dict[str, int]:
+        """Current values of the DUT's status/counter ports ``names``."""
+        return {name: int(getattr(self.dut, name).value) for name in names}
 
     async def cycles(self, n: int) -> None:
         for _ in range(n):

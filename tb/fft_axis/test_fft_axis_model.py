@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from model import fft_fixed as ff
+from model import fft_axis as ff
 from model.fft_rom import PKG_PATH, cos_table, hann_table, render_rom_pkg, sin_table
 
 

@@ -1,4 +1,5 @@
-"""``radar detect --backend rtl``: ADC frames through the Verilated ``radar_pipeline``.
+"""ADC frames through the Verilated ``radar_pipeline`` from ordinary Python (the RTL frame
+source of ``radar detect --backend rtl``).
 
 The model is built once per parameter set under ``sim_build/radar_pipeline/`` (the first
 run compiles for a minute or two), then the frames stream through it back to back at one
@@ -13,20 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from host.capture import read_capture
-from host.rtlsim.toolchain import build_and_test, rtl_sources
+from model.axis_packetizer import words_to_bytes
 from model.config import RadarConfig
-from model.pipeline import PipelineParams
+from model.radar_pipeline import PipelineParams
+from rtlsim.toolchain import build_and_test, rtl_sources
 
 PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "top/*.sv")
-
-
-def hdl_parameters(cfg: RadarConfig, chain: PipelineParams) -> dict[str, int]:
-    """``radar_pipeline`` HDL parameters for a radar configuration and chain settings."""
-    return {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
-            "N_DOPPLER": cfg.n_doppler, "DATA_W": 16, "PACKET_WORDS": chain.packet_words,
-            "WINDOW": int(chain.window), "RANGE_SCALE_SCH": chain.range_scale_sch,
-            "DOPPLER_SCALE_SCH": chain.doppler_scale_sch, "HEADER": int(chain.header)}
 
 
 def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
@@ -40,12 +33,14 @@ def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
         d = Path(tmp)
         np.save(d / "adc.npy", np.stack(adc_frames).astype(np.complex64))
         build_and_test("radar_pipeline", rtl_sources(*PIPELINE_SOURCES),
-                       "host.rtlsim.pipeline_test", hdl_parameters(cfg, chain),
+                       "rtlsim.pipeline_test", chain.hdl_parameters(cfg),
                        extra_env={"RADAR_RTL_ADC": str(d / "adc.npy"),
-                                  "RADAR_RTL_DMA": str(d / "dma.dmacap"),
+                                  "RADAR_RTL_DMA": str(d / "dma.npz"),
                                   "RADAR_RTL_STATUS": str(d / "status.json")},
                        testcase="stream_frames")
-        if not (d / "dma.dmacap").exists():
+        if not (d / "dma.npz").exists():
             raise RuntimeError("the RTL simulation produced no DMA stream (see its log)")
-        _, packets = read_capture(d / "dma.dmacap")
-        return list(packets), json.loads((d / "status.json").read_text())
+        with np.load(d / "dma.npz") as dma:
+            ends = np.cumsum(dma["lengths"])
+            packets = [words_to_bytes(p) for p in np.split(dma["words"], ends[:-1])]
+        return packets, json.loads((d / "status.json").read_text())

@@ -1,0 +1,1 @@
+"""One module per ``radar`` command group; each has ``add_parsers(sub, presets)``."""

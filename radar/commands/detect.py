@@ -1,0 +1,117 @@
+"""``radar detect``: frames of a scene through a frame source (model, float, rtl) and the
+host processing to the point cloud JSON of DESIGN.md section 4, optionally GNN objects and
+figures."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from host.pipeline import process_cube
+from host.pointcloud import PointCloud
+from model.observability import scene_report
+from model.simulate import simulate_scene
+from radar.common import (
+    CliError,
+    add_detection_options,
+    count,
+    detection_params,
+    ego_speed_mps,
+    out_file,
+    progress,
+    scene_of,
+    warn,
+)
+from radar.figures import detect_plots
+from radar.objects import describe, gnn_objects, object_boxes
+from radar.sources import SOURCES, SourceError, get_source
+
+MAX_DETECT_FRAMES = 10_000
+"""Largest --frames (90 s of radar time; the command keeps every cloud in memory)."""
+
+
+def cmd_detect(args: argparse.Namespace) -> int:
+    scene = scene_of(args)
+    out = out_file(args.json, ".json", "--json")
+    count(args.frames, "--frames", MAX_DETECT_FRAMES)
+    cfg = scene.config
+    params = detection_params(args, scene.tx_beamforming, cfg)
+    clouds, per_frame, objects = [], [], []
+    last_cube = None
+    ego = ego_speed_mps(args, scene)
+    report, warnings = scene_report(scene, range(args.frames), params.max_speed_mps)
+    warn(warnings, "detect")
+    t0 = time.perf_counter()
+    saturated: list[int] = []
+
+    def adc_frames() -> Iterator[np.ndarray]:
+        for k in progress(range(args.frames), "frames"):
+            adc = simulate_scene(scene, frame_index=k)
+            saturated.append(adc.saturated)
+            yield adc.samples
+
+    try:
+        for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
+            cloud = process_cube(cube, cfg, params, frame=k)
+            clouds.append(cloud)
+            per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": saturated[k]})
+            if args.gnn:
+                objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
+            last_cube = cube
+    except SourceError as exc:
+        raise CliError(f"--backend {args.backend}: {exc}") from None
+    except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
+        raise CliError(str(exc)) from None
+    clipped = [k for k, n in enumerate(saturated) if n]
+    if clipped:
+        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
+              f"harmonics of the clipped echo can appear as false points"], "detect")
+    cloud = PointCloud.concat(clouds)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
+    doc.update({"backend": args.backend, "detector": args.detector, "scene": scene.name,
+                "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
+                "frame_info": per_frame, **report})
+    if args.gnn:
+        doc["objects"] = objects
+    out.write_text(json.dumps(doc, indent=1))
+    print(f"{len(cloud)} points in {args.frames} frame(s) ({time.perf_counter() - t0:.2f} s) "
+          f"-> {out}")
+    if args.gnn:
+        print(f"GNN: {len(objects)} object(s): " + describe(objects))
+    if args.plots and last_cube is not None:
+        last = [o for o in objects if o["frame"] == args.frames - 1]
+        detect_plots(Path(args.plots), cfg, scene, last_cube, clouds[-1], object_boxes(last))
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
+    d = sub.add_parser(
+        "detect", help="scene -> point cloud JSON",
+        description="Simulate frames of a scene, run them through the FPGA chain (a model "
+                    "of it or the RTL) and the host processing, and write the point cloud "
+                    "JSON of DESIGN.md section 4.")
+    d.add_argument("--scene", required=True, help="scene JSON file or built-in name (table1)")
+    d.add_argument("--json", required=True, help="output point cloud .json")
+    d.add_argument("--backend", choices=list(SOURCES), default="model",
+                   help="; ".join(f"{name}: {src.help}" for name, src in SOURCES.items()))
+    d.add_argument("--plots", default=None, help="folder for a range-Doppler map and the "
+                                                 "x-y point cloud of the last frame")
+    d.add_argument("--frames", type=int, default=1,
+                   help=f"frames to process, 1..{MAX_DETECT_FRAMES} (default 1)")
+    d.add_argument("--preset", choices=presets, default=None,
+                   help="override the scene's radar preset")
+    d.add_argument("--gnn", action="store_true",
+                   help="also classify objects with the GNN (shipped checkpoint): adds "
+                        "\"objects\" (class, score, rotated box, point indices) to the JSON")
+    d.add_argument("--ego-speed", type=float, default=None,
+                   help="ego speed along +x for the GNN's velocity compensation, m/s "
+                        "(default: 27.78 for table1, else 0; written to the JSON, where "
+                        "`radar gnn detect --points` picks it up)")
+    add_detection_options(d)
+    d.set_defaults(func=cmd_detect)

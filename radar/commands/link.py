@@ -1,0 +1,224 @@
+"""The link commands: ``radar capture`` (DMA packets of simulated frames to a .dmacap file),
+``radar replay`` (send a capture over UDP as the board would) and ``radar receive`` (decode
+UDP packets -> point cloud JSON)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from host.capture import CaptureInfo, read_capture, write_capture
+from host.pipeline import process_cube
+from host.pointcloud import PointCloud
+from model.axis_packetizer import words_to_bytes
+from model.config import PRESETS, get_preset
+from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
+from model.simulate import simulate_scene
+from radar.common import (
+    CliError,
+    add_detection_options,
+    check,
+    count,
+    detection_params,
+    out_file,
+    progress,
+    scene_of,
+    warn,
+)
+
+MAX_CAPTURE_FRAMES = 1000
+"""Largest --frames of a capture (17 GB on full: more is a mistake)."""
+MAX_RECEIVE_FRAMES = 1_000_000
+"""Largest --frames of radar receive."""
+
+
+def cmd_capture(args: argparse.Namespace) -> int:
+    from host.udp import max_packet_words
+
+    scene = scene_of(args)
+    cfg = scene.config
+    out = out_file(args.out, ".dmacap", "--out")
+    count(args.frames, "--frames", MAX_CAPTURE_FRAMES)
+    fit = max_packet_words(cfg.num_rx)
+    pw = fit if args.packet_words is None else args.packet_words
+    chain = PipelineParams(packet_words=pw)
+    try:
+        chain.check(cfg)
+    except ValueError as exc:
+        raise CliError(f"--packet-words: {exc}") from None
+    if pw > fit:
+        raise CliError(f"--packet-words: {pw} words + header = {(pw + 1) * 4 * cfg.num_rx} "
+                       f"bytes per packet does not fit a UDP datagram (at most {fit} for "
+                       f"{cfg.num_rx} lanes), so radar replay could not send it")
+    packets: list[bytes] = []
+    for k in progress(range(args.frames), "frames"):
+        adc = simulate_scene(scene, frame_index=k).samples
+        packets.extend(words_to_bytes(p) for p in dma_packets([adc], cfg, chain, k))
+    info = CaptureInfo(cfg.num_rx, pw, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+    n = write_capture(out, info, packets)
+    print(f"wrote {out}: {args.frames} frame(s), {n} packets of {pw} payload words (preset "
+          f"{cfg.name}; bit-accurate model of the FPGA chain, cube gain "
+          f"{chain_gain(cfg, chain):g} over 1/N per FFT)")
+    return 0
+
+
+def cmd_replay(args: argparse.Namespace) -> int:
+    from host.udp import Impairments, UdpSender
+
+    check(args.seed, "--seed", 0 <= args.seed < 2**63, "an integer in 0..2**63-1")
+    rate = args.rate_mbps
+    check(rate, "--rate-mbps", rate == 0 or 0 < rate <= 1e6,
+          "0 (unpaced) or a rate in (0, 1e6] Mbit/s")
+    try:
+        info, packets = read_capture(Path(args.capture))
+        cfg = info.config(PRESETS.values())
+        imp = Impairments(loss=args.loss, duplicate=args.duplicate, reorder=args.reorder,
+                          seed=args.seed)
+        with UdpSender(args.host, args.port, rate * 1e6 if rate else None, imp) as tx:
+            log = tx.send(packets)
+    except (ValueError, OSError) as exc:
+        raise CliError(str(exc)) from None
+    print(f"sent {log.sent} datagrams ({cfg.name}, {info.packet_words} payload words each) to "
+          f"{args.host}:{args.port} ({len(log.dropped)} dropped, {len(log.duplicated)} "
+          f"duplicated, {len(log.reordered)} reordered on purpose)")
+    return 0
+
+
+def cmd_receive(args: argparse.Namespace) -> int:
+    from host.stream import StreamDecoder, geometry_from_packet
+    from host.udp import UdpReceiver, check_seconds
+
+    out = out_file(args.json, ".json", "--json")
+    count(args.frames, "--frames", MAX_RECEIVE_FRAMES)
+    try:
+        check_seconds(args.idle_timeout, "--idle-timeout")
+        check_seconds(args.timeout, "--timeout")
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    fixed = get_preset(args.preset) if args.preset else None
+    params = detection_params(args, cfg=fixed)
+
+    def make_decoder(first: bytes) -> StreamDecoder:
+        """Geometry from the options if given, else learnt from the first datagram."""
+        configs = [fixed] if fixed else list(PRESETS.values())
+        cfg, pw = geometry_from_packet(first, configs)
+        return StreamDecoder(cfg, args.packet_words or pw)
+
+    try:
+        if fixed and args.packet_words:
+            StreamDecoder(fixed, args.packet_words)  # check the geometry before listening
+        rx = UdpReceiver(args.host, args.port)
+    except (ValueError, OSError) as exc:
+        raise CliError(str(exc)) from None
+    print(f"listening on {args.host}:{rx.port}", flush=True)
+    with rx:
+        frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
+                            total_timeout_s=args.timeout, make_decoder=make_decoder)
+    decoder = rx.decoder
+    cfg = decoder.cfg if decoder else fixed
+    if decoder:
+        params = detection_params(args, cfg=decoder.cfg)  # CFAR window vs the learnt map
+    clouds, frames_doc = [], []
+    try:
+        for f in frames:
+            entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
+                                     "problems": f.problems}
+            if decoder and (f.complete or args.use_damaged):
+                gain = chain_gain(decoder.cfg, PipelineParams(packet_words=decoder.packet_words))
+                cloud = process_cube(f.cube / gain, decoder.cfg, params, frame=f.frame_id)
+                clouds.append(cloud)
+                entry["points"] = len(cloud)
+            frames_doc.append(entry)
+    except KeyboardInterrupt:
+        rx.interrupted = True
+    cloud = PointCloud.concat(clouds)
+    doc = cloud.to_json_dict(cfg.name if cfg else "unknown", len(frames))
+    doc.update({"backend": "udp", "packet_words": decoder.packet_words if decoder else None,
+                "datagrams": rx.datagrams, "interrupted": rx.interrupted,
+                "frame_info": frames_doc,
+                "stream_problems": (decoder.stream_problems if decoder else []) + rx.unusable,
+                "stats": vars(decoder.stats) if decoder else {}})
+    out.write_text(json.dumps(doc, indent=1))
+    damaged = sum(not f.complete for f in frames)
+    print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
+          + (f" (preset {cfg.name}, {decoder.packet_words} payload words per packet learnt "
+             f"from the stream)" if decoder and not args.preset else ""))
+    for f in frames:
+        for p in f.problems[:5]:
+            print(f"  {p}")
+    if rx.interrupted:
+        warn(["interrupted: wrote what was received"], "receive")
+        return 130
+    if not clouds:
+        why = ("no datagram arrived" if not rx.datagrams else
+               "no datagram was a DMA packet of a known preset" if not decoder else
+               "every frame was damaged (see --use-damaged)")
+        print(f"radar receive: error: no usable frame: {why} within {args.timeout:g} s",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
+    c = sub.add_parser(
+        "capture", help="write the DMA packets of simulated frames to a capture file",
+        description="Simulate frames, run them through the bit-accurate model of the FPGA "
+                    "chain and write its DMA packets (header word + payload, exactly as the "
+                    "packetizer sends them) to a .dmacap file for `radar replay`.")
+    c.add_argument("--scene", required=True, help="scene JSON file or built-in name")
+    c.add_argument("--out", required=True, help="output .dmacap file")
+    c.add_argument("--frames", type=int, default=3,
+                   help=f"frames, 1..{MAX_CAPTURE_FRAMES} (default 3)")
+    c.add_argument("--packet-words", type=int, default=None,
+                   help="payload words per packet, PACKET_WORDS (default: the most that fit "
+                        "one UDP datagram of 65507 bytes with the header word: 1022 for the "
+                        "16 lanes of full, 4093 for the 4 of paper-fpga)")
+    c.add_argument("--preset", choices=presets, default=None, help="override the preset")
+    c.set_defaults(func=cmd_capture)
+
+    r = sub.add_parser(
+        "replay", help="send a capture over UDP as the board would",
+        description="Send each packet of a .dmacap capture as one UDP datagram, paced to "
+                    "a bit rate, optionally with injected loss, duplication and reordering.")
+    r.add_argument("--capture", required=True, help=".dmacap file")
+    r.add_argument("--host", default="127.0.0.1", help="destination address (default "
+                                                       "127.0.0.1)")
+    r.add_argument("--port", type=int, required=True, help="destination UDP port")
+    r.add_argument("--rate-mbps", type=float, default=766.0,
+                   help="pacing in Mbit/s (default 766, the paper's measured link rate; 0 = "
+                        "unpaced)")
+    r.add_argument("--loss", type=float, default=0.0, help="drop probability per packet")
+    r.add_argument("--duplicate", type=float, default=0.0, help="duplicate probability")
+    r.add_argument("--reorder", type=float, default=0.0,
+                   help="probability of swapping a packet with the next")
+    r.add_argument("--seed", type=int, default=0, help="seed of the injected faults")
+    r.set_defaults(func=cmd_replay)
+
+    v = sub.add_parser(
+        "receive", help="receive DMA packets over UDP and write the point cloud",
+        description="Receive UDP datagrams (one DMA packet each), reassemble frames, report "
+                    "lost/repeated/reordered/corrupt packets, and run host processing on "
+                    "every complete frame.")
+    v.add_argument("--preset", choices=presets, default=None,
+                   help="radar preset (default: learnt from the first packet's header)")
+    v.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    v.add_argument("--port", type=int, default=0, help="UDP port (default: any free port, "
+                                                       "printed)")
+    v.add_argument("--packet-words", type=int, default=None,
+                   help="PACKET_WORDS of the stream (default: learnt from the packet headers)")
+    v.add_argument("--frames", type=int, default=None, help="stop after this many frames")
+    v.add_argument("--idle-timeout", type=float, default=2.0,
+                   help="after the first datagram, stop when none arrived for this long, s "
+                        "(default 2)")
+    v.add_argument("--timeout", type=float, default=300.0,
+                   help="stop after this long in all (also the wait for the first datagram), "
+                        "s (default 300); exit status 1 if no usable frame arrived, Ctrl-C "
+                        "writes what arrived")
+    v.add_argument("--use-damaged", action="store_true",
+                   help="also process frames with missing packets (zeros where missing)")
+    v.add_argument("--json", required=True, help="output point cloud .json")
+    add_detection_options(v)
+    v.set_defaults(func=cmd_receive)

@@ -1,0 +1,227 @@
+"""``radar view``: serve the live view (:mod:`radar.view`) of a UDP stream, a replayed
+capture or a scene.
+
+    radar view --replay FILE.dmacap [--fps 20] [--loss P]   a capture, looped
+    radar view --udp-port P [--preset full]                 what `radar replay`/the board sends
+    radar view --scene table1 [--preset paper-fpga]          simulated frames
+    ... [--host 127.0.0.1] [--port 8050] [--gnn]
+
+The page is at http://HOST:PORT/. Binding to an address other than loopback needs
+``--allow-remote`` (the page has no authentication).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import ipaddress
+import sys
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from host.capture import read_capture
+from host.udp import UdpReceiver
+from model.config import PRESETS, RadarConfig, get_preset
+from model.radar_pipeline import PipelineParams, chain_gain
+from model.scene import EGO_SPEED_KMH, load_scene
+from model.simulate import simulate_scene
+from radar.common import CliError, add_detection_options, detection_params
+from radar.sources import get_source
+from radar.view.feed import Feed
+from radar.view.health import LinkHealth
+from radar.view.server import ViewServer
+from radar.view.sources import (
+    PacketIngest,
+    Processor,
+    load_replay,
+    replay_loop,
+    scene_loop,
+    udp_loop,
+)
+
+DEFAULT_PORT = 8050
+
+
+def is_loopback(host: str) -> bool:
+    """True for 127.0.0.0/8, ::1 and ``localhost``."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def preset_of_capture(path: Path) -> RadarConfig:
+    """The preset whose geometry matches a capture's header."""
+    info, packets = read_capture(path)
+    close = getattr(packets, "close", None)
+    if close:
+        close()
+    for name in sorted(PRESETS):
+        cfg = get_preset(name)
+        if info.matches(cfg):
+            return cfg
+    raise ValueError(f"{path}: no preset has the capture's geometry {info}")
+
+
+def _gnn(args: argparse.Namespace) -> Callable[..., list[dict[str, Any]]] | None:
+    if not args.gnn:
+        return None
+    print("radar view: loading the GNN (torch)", file=sys.stderr, flush=True)
+    from gnn.infer import detect_objects
+
+    return detect_objects
+
+
+def build(args: argparse.Namespace, stop: threading.Event
+          ) -> tuple[Feed, LinkHealth, list[threading.Thread], str]:
+    """Feed, health, the (not yet started) producer threads and a description of the
+    source, from parsed ``radar view`` options. Raises CliError on bad input."""
+    feed, health = Feed(), LinkHealth()
+    if args.fps < 0:
+        raise CliError("--fps: must be >= 0")
+    if not 0.0 <= args.loss <= 1.0:
+        raise CliError("--loss: probability must be in [0, 1]")
+    try:
+        if args.replay:
+            path = Path(args.replay)
+            cfg = get_preset(args.preset) if args.preset else preset_of_capture(path)
+            packet_words, frames = load_replay(path, cfg)
+            desc = f"replay {path.name}"
+        elif args.scene:
+            scene = load_scene(args.scene, args.preset)
+            cfg = scene.config
+            desc = f"scene {scene.name}"
+        else:
+            cfg = get_preset(args.preset or "full")
+            packet_words = args.packet_words
+            desc = f"UDP {args.udp_host}:{args.udp_port}"
+    except (ValueError, OSError) as exc:
+        raise CliError(str(exc)) from None
+    # the Table I scene's ego speed for its simulation; a capture or a link does not say
+    ego = args.ego_speed if args.ego_speed is not None else (
+        EGO_SPEED_KMH / 3.6 if args.scene and scene.name == "table1" else 0.0)
+    processor = Processor(cfg, feed, health, detection_params(args), _gnn(args), ego, source=desc)
+    threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
+                                daemon=True)]
+    if args.scene:
+        if args.frames < 1:
+            raise CliError("--frames: must be >= 1")
+
+        source = get_source(args.backend)
+
+        def make_cube(k: int):  # noqa: ANN202 - complex (n_virtual, n_range, n_doppler)
+            return source.cube(simulate_scene(scene, frame_index=k).samples, cfg)
+
+        threads.append(threading.Thread(target=scene_loop, name="view-scene", daemon=True,
+                                        args=(make_cube, args.frames, processor, health,
+                                              stop, args.fps)))
+        return feed, health, threads, desc
+    gain = chain_gain(cfg, PipelineParams(packet_words=packet_words))
+    try:
+        ingest = PacketIngest(cfg, packet_words, health, processor, gain)
+    except ValueError as exc:
+        raise CliError(f"--packet-words: {exc}") from None
+    if args.replay:
+        threads.append(threading.Thread(
+            target=replay_loop, name="view-replay", daemon=True,
+            args=(frames, ingest, stop, args.fps, not args.no_loop, args.loss, args.seed)))
+    else:
+        try:
+            rx = UdpReceiver(args.udp_host, args.udp_port)
+        except (OSError, ValueError) as exc:  # ValueError: port outside 0..65535
+            raise CliError(f"--udp-port: {exc}") from None
+        desc = f"UDP {args.udp_host}:{rx.port}"
+        processor.source = desc
+        threads.append(threading.Thread(target=udp_loop, name="view-udp", daemon=True,
+                                        args=(rx.sock, ingest, stop)))
+    return feed, health, threads, desc
+
+
+async def _serve(args: argparse.Namespace) -> int:
+    stop = threading.Event()
+    feed, health, threads, desc = build(args, stop)
+    server = ViewServer(feed, health, args.host, args.port)
+    try:
+        await server.start()
+    except OSError as exc:
+        raise CliError(f"--host/--port: cannot listen on {args.host}:{args.port}: "
+                       f"{exc.strerror or exc}") from None
+    for t in threads:
+        t.start()
+    print(f"radar view: http://{args.host}:{server.port}/ showing {desc} (Ctrl-C stops)",
+          flush=True)
+    t_end = time.monotonic() + args.duration if args.duration else None
+    try:
+        while t_end is None or time.monotonic() < t_end:
+            await asyncio.sleep(0.2)
+    finally:
+        stop.set()
+        await server.close()
+    return 0
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    if not is_loopback(args.host) and not args.allow_remote:
+        raise CliError(f"--host {args.host} is not a loopback address: the page has no "
+                       f"authentication; add --allow-remote to serve it anyway")
+    try:
+        return asyncio.run(_serve(args))
+    except KeyboardInterrupt:
+        return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
+    v = sub.add_parser(
+        "view", help="live browser view: range-Doppler maps, point cloud, link health",
+        description="Serve a live view (like TI's mmWave Demo Visualizer) at "
+                    "http://HOST:PORT/: range-Doppler map of one virtual channel and the "
+                    "integrated map, x-y point cloud coloured by velocity with GNN boxes, "
+                    "range profile and link health (frames/s, lost packets, damaged frames, "
+                    "sticky hardware flags, detections per frame). The source is a UDP "
+                    "stream (default), a replayed capture or a simulated scene. Every asset "
+                    "is served from the package: no internet needed.")
+    src = v.add_mutually_exclusive_group()
+    src.add_argument("--replay", metavar="FILE.dmacap",
+                     help="replay a capture (from `radar capture`), looped")
+    src.add_argument("--scene", help="simulate a scene (JSON file or built-in name, table1)")
+    src.add_argument("--udp-port", type=int, default=0,
+                     help="receive DMA packets on this UDP port (default source; 0 = any "
+                          "free port, printed)")
+    v.add_argument("--udp-host", default="127.0.0.1",
+                   help="address the UDP receiver binds (default 127.0.0.1)")
+    v.add_argument("--preset", choices=presets, default=None,
+                   help="radar preset (default: the capture's geometry, the scene's preset, "
+                        "or full for UDP)")
+    v.add_argument("--packet-words", type=int, default=1023,
+                   help="PACKET_WORDS of a UDP stream (default 1023)")
+    v.add_argument("--host", default="127.0.0.1",
+                   help="address the web page is served on (default 127.0.0.1)")
+    v.add_argument("--port", type=int, default=DEFAULT_PORT,
+                   help=f"web page port (default {DEFAULT_PORT}; 0 = any free port)")
+    v.add_argument("--allow-remote", action="store_true",
+                   help="allow --host to be a non-loopback address (no authentication!)")
+    v.add_argument("--fps", type=float, default=20.0,
+                   help="replay/scene frame rate, frames/s (default 20; 0 = as fast as "
+                        "possible)")
+    v.add_argument("--no-loop", action="store_true", help="replay the capture once")
+    v.add_argument("--loss", type=float, default=0.0,
+                   help="replay: drop each packet with this probability (link test)")
+    v.add_argument("--seed", type=int, default=0, help="seed of --loss")
+    v.add_argument("--frames", type=int, default=16,
+                   help="scene: frames simulated before the scene repeats (default 16)")
+    v.add_argument("--backend", choices=("model", "float"), default="float",
+                   help="scene: float reference (default, fast) or bit-accurate model")
+    v.add_argument("--gnn", action="store_true",
+                   help="classify objects with the GNN (shipped checkpoint), draw boxes")
+    v.add_argument("--ego-speed", type=float, default=None,
+                   help="ego speed along +x for the GNN's velocity compensation, m/s "
+                        "(default: 27.78 for --scene table1, else 0)")
+    v.add_argument("--duration", type=float, default=None,
+                   help="stop after this many seconds (default: run until Ctrl-C)")
+    add_detection_options(v)
+    v.set_defaults(func=cmd_view)

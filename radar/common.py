@@ -1,0 +1,113 @@
+"""Helpers shared by the ``radar`` commands: the one-line error, option groups, input and
+output checks."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import TypeVar
+
+from tqdm import tqdm
+
+from host.cfar import CfarParams
+from host.pipeline import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams
+from model.config import RadarConfig
+from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
+
+T = TypeVar("T")
+
+
+class CliError(Exception):
+    """Bad input: reported as one line, exit status 2."""
+
+
+def progress(iterable: Iterable[T], desc: str, total: int | None = None) -> Iterator[T]:
+    """tqdm progress bar on stderr when it is a terminal (quiet in CI logs)."""
+    return tqdm(iterable, desc=desc, total=total, disable=not sys.stderr.isatty(), leave=False)
+
+
+def scene_of(args: argparse.Namespace) -> Scene:
+    """The scene of ``--scene`` (file or built-in name) with ``--preset`` if given."""
+    try:
+        return load_scene(args.scene, getattr(args, "preset", None))
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+
+
+def detection_params(args: argparse.Namespace, scene_bf: bool = True,
+                     cfg: RadarConfig | None = None) -> DetectionParams:
+    """Host detection settings from the options of :func:`add_detection_options`, checked
+    against ``cfg`` when given (CFAR window larger than the map)."""
+    try:
+        cfar = CfarParams(pfa=args.pfa, guard=tuple(args.guard), train=tuple(args.train),
+                          kind="os" if args.detector == "os" else "ca")
+        params = DetectionParams(detector=args.detector, cfar=cfar,
+                                 paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
+                                 max_speed_mps=args.max_speed)
+        if cfg is not None:
+            params.check(cfg)
+        return params
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+
+
+def check(value: T, option: str, ok: bool, what: str) -> T:
+    """``value`` of ``option`` if ``ok``, else a one-line CliError saying what it must be."""
+    if not ok:
+        raise CliError(f"{option}: must be {what}, got {value!r}")
+    return value
+
+
+def count(value: int | None, option: str, hi: int, lo: int = 1) -> int | None:
+    """An integer option in lo..hi (None passes: option not given)."""
+    if value is None:
+        return None
+    return check(value, option, lo <= value <= hi, f"an integer in {lo}..{hi}")
+
+
+def warn(lines: Iterable[str], command: str) -> None:
+    """One ``radar <command>: warning: ...`` line on stderr per entry."""
+    for line in lines:
+        print(f"radar {command}: warning: {line}", file=sys.stderr)
+
+
+def out_file(path: str, suffix: str, option: str) -> Path:
+    """``path`` checked to end in ``suffix``, its folder created."""
+    p = Path(path)
+    if p.suffix != suffix:
+        raise CliError(f"{option}: {p} must end in {suffix}")
+    p.parent.mkdir(parents=True, exist_ok=True)
+    return p
+
+
+def ego_speed_mps(args: argparse.Namespace, scene: Scene | None) -> float:
+    """``--ego-speed`` (checked), else the scene's (``model.scene.default_ego_speed_mps``:
+    the Table I 100 km/h for ``table1``, 0 otherwise; 0 without a scene). ``radar detect
+    --gnn`` and ``radar gnn detect`` both use it."""
+    try:
+        if args.ego_speed is not None:
+            return check_ego_speed(args.ego_speed)
+    except ValueError as exc:
+        raise CliError(f"--{exc}") from None
+    return default_ego_speed_mps(scene) if scene is not None else 0.0
+
+
+def add_detection_options(p: argparse.ArgumentParser) -> None:
+    """Detector choice and CFAR settings."""
+    p.add_argument("--detector", choices=DETECTORS, default="ca",
+                   help="ca: 2-D CA-CFAR on the non-coherent map (default); os: OS-CFAR "
+                        "(slower); paper: the paper's threshold on channel 0")
+    p.add_argument("--pfa", type=float, default=1e-6,
+                   help="CFAR false-alarm probability per range-Doppler cell (default 1e-6)")
+    p.add_argument("--guard", type=int, nargs=2, default=(2, 2), metavar=("RANGE", "DOPPLER"),
+                   help="CFAR guard cells per side (default 2 2)")
+    p.add_argument("--train", type=int, nargs=2, default=(4, 8), metavar=("RANGE", "DOPPLER"),
+                   help="CFAR training cells per side (default 4 8)")
+    p.add_argument("--threshold-db", type=float, default=15.0,
+                   help="paper detector: threshold over the channel-0 median, dB (default 15)")
+    p.add_argument("--max-speed", type=float, default=MAX_RADIAL_SPEED_MPS,
+                   help="fastest radial speed to expect, m/s: velocities are unfolded within "
+                        "it and a point is flagged ambiguous when another velocity within it "
+                        f"explains the measurement (default {MAX_RADIAL_SPEED_MPS:g})")

@@ -1,0 +1,149 @@
+"""A :class:`radar.view.feed.ViewFrame` -> the JSON message one browser draws.
+
+Heat maps are reduced before they leave the host: max-pooled (so a one-cell target never
+disappears) to at most :data:`MAX_AXIS` cells per axis (``full`` 256 x 256 -> 128 x 128),
+converted to dB, and quantised to 8 bits over [``lo``, ``hi``] dB (``lo``: a little under the
+median, i.e. the noise floor; ``hi``: the peak; both rounded out to a 5 dB grid so the
+colour scale is steady), sent as base64. The page maps a code q back
+to ``lo + q * (hi - lo) / 255`` dB. Doppler is shifted so velocity increases left to right.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+import threading
+from collections import OrderedDict
+from typing import Any
+
+import numpy as np
+
+from model.config import RadarConfig
+from radar.view.feed import ViewFrame
+
+MAX_AXIS = 128
+"""Largest heat-map size per axis sent to the browser, cells."""
+
+FLOOR_BELOW_MEDIAN_DB = 3.0
+"""The colour scale starts this far below the map's median (noise floor), dB."""
+
+SCALE_STEP_DB = 5.0
+"""Colour-scale limits are rounded out to multiples of this, dB."""
+
+
+def pool_max(a: np.ndarray, max_axis: int = MAX_AXIS) -> np.ndarray:
+    """Max-pool a 2-D array by integer factors so neither axis exceeds ``max_axis``
+    (axes whose length is not a multiple of the factor are cropped at the end)."""
+    fr = max(1, math.ceil(a.shape[0] / max_axis))
+    fc = max(1, math.ceil(a.shape[1] / max_axis))
+    r, c = a.shape[0] // fr, a.shape[1] // fc
+    return a[:r * fr, :c * fc].reshape(r, fr, c, fc).max(axis=(1, 3))
+
+
+def pool_axis(x: np.ndarray, n_out: int) -> np.ndarray:
+    """Centre of each group when ``x`` (n,) is pooled down to ``n_out`` groups."""
+    f = len(x) // n_out
+    return x[:n_out * f].reshape(n_out, f).mean(axis=1)
+
+
+def velocity_axis(cfg: RadarConfig) -> np.ndarray:
+    """Velocity of each fft-shifted Doppler bin, m/s (n_doppler,), increasing."""
+    return (np.arange(cfg.n_doppler) - cfg.n_doppler // 2) * cfg.velocity_bin_mps
+
+
+def range_axis(cfg: RadarConfig) -> np.ndarray:
+    """Range of each range bin, m (n_range,)."""
+    return np.arange(cfg.n_range) * cfg.range_bin_m
+
+
+def heatmap(power: np.ndarray, cfg: RadarConfig) -> dict[str, Any]:
+    """Power map float (n_range, n_doppler), linear -> quantised heat-map message part."""
+    shifted = np.fft.fftshift(power, axes=1)
+    pooled = pool_max(shifted)
+    db = 10 * np.log10(np.maximum(pooled, 1e-20))
+    # on a SCALE_STEP_DB grid: the colour scale stays put from frame to frame, so the page
+    # redraws only the image, not the colour bar
+    hi = SCALE_STEP_DB * math.ceil(float(db.max()) / SCALE_STEP_DB)
+    lo = min(SCALE_STEP_DB * math.floor((float(np.median(db)) - FLOOR_BELOW_MEDIAN_DB)
+                                        / SCALE_STEP_DB), hi - SCALE_STEP_DB)
+    q = np.clip(np.rint((db - lo) * (255.0 / (hi - lo))), 0, 255).astype(np.uint8)
+    return {"q": base64.b64encode(q.tobytes()).decode("ascii"),
+            "rows": int(q.shape[0]), "cols": int(q.shape[1]),
+            "lo": round(lo, 2), "hi": round(hi, 2),
+            "range_m": _r(pool_axis(range_axis(cfg), q.shape[0])),
+            "velocity_mps": _r(pool_axis(velocity_axis(cfg), q.shape[1]))}
+
+
+def box_outline(obj: dict[str, Any]) -> tuple[list[float], list[float]]:
+    """Closed outline (x, y lists, 5 corners) of a GNN object's rotated box, m."""
+    h = math.radians(obj["heading_deg"])
+    c, s = math.cos(h), math.sin(h)
+    half_l, half_w = obj["length_m"] / 2, obj["width_m"] / 2
+    xs, ys = [], []
+    for dl, dw in ((1, 1), (1, -1), (-1, -1), (-1, 1), (1, 1)):
+        xs.append(round(obj["x_m"] + c * dl * half_l - s * dw * half_w, 3))
+        ys.append(round(obj["y_m"] + s * dl * half_l + c * dw * half_w, 3))
+    return xs, ys
+
+
+def _r(a: np.ndarray, nd: int = 3) -> list[float]:
+    return [round(float(v), nd) for v in a]
+
+
+def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dict[str, Any]:
+    """The message for one frame with virtual channel ``channel`` (clamped to the array)."""
+    cfg = frame.cfg
+    ch = min(max(int(channel), 0), cfg.n_virtual - 1)
+    cloud = frame.cloud
+    msg: dict[str, Any] = {
+        "type": "frame", "seq": frame.seq, "frame_id": frame.frame_id, "preset": cfg.name,
+        "source": frame.source, "channel": ch, "n_virtual": cfg.n_virtual,
+        "limits": {"max_range_m": round(cfg.max_range_m, 2),
+                   "max_velocity_mps": round(cfg.max_velocity_mps, 3)},
+        "rd": None, "nci": None, "profile": None,
+        "points": {"x": _r(cloud.x_m), "y": _r(cloud.y_m),
+                   "v": _r(cloud.radial_velocity_mps), "snr": _r(cloud.snr_db, 1),
+                   "range": _r(cloud.range_m)},
+        "boxes": [],
+        "health": health,
+    }
+    if frame.cube is not None:
+        p = frame.cube[ch].real.astype(np.float32) ** 2 + frame.cube[ch].imag.astype(
+            np.float32) ** 2
+        msg["rd"] = heatmap(p, cfg)
+    if frame.nci is not None:
+        msg["nci"] = heatmap(frame.nci, cfg)
+        prof = 10 * np.log10(np.maximum(frame.nci.sum(axis=1), 1e-20))
+        msg["profile"] = {"range_m": _r(range_axis(cfg)), "db": _r(prof, 2),
+                          "det_range_m": _r(cloud.range_m),
+                          "det_db": _r(prof[np.clip(cloud.range_bin, 0, cfg.n_range - 1)]
+                                       if len(cloud) else np.zeros(0), 2)}
+    for o in frame.objects:
+        xs, ys = box_outline(o)
+        msg["boxes"].append({"x": xs, "y": ys, "cls": o["class"],
+                             "label": f"{o['class']} {o['score']:.2f}",
+                             "cx": round(o["x_m"], 3), "cy": round(o["y_m"], 3)})
+    return msg
+
+
+class MessageCache:
+    """Serialised frame messages by (frame seq, channel), so browsers watching the same
+    channel share the work. Health is refreshed per send (it is cheap and changes often)."""
+
+    def __init__(self, size: int = 8) -> None:
+        self._lock = threading.Lock()
+        self._items: OrderedDict[tuple[int, int], dict[str, Any]] = OrderedDict()
+        self.size = size
+
+    def get(self, frame: ViewFrame, channel: int, health: dict[str, Any]) -> str:
+        key = (frame.seq, channel)
+        with self._lock:
+            msg = self._items.get(key)
+        if msg is None:
+            msg = frame_message(frame, channel, {})
+            with self._lock:
+                self._items[key] = msg
+                while len(self._items) > self.size:
+                    self._items.popitem(last=False)
+        return json.dumps({**msg, "health": health}, separators=(",", ":"))

