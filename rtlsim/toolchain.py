@@ -108,7 +108,8 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
     finally:
         for dat in (build_dir / "coverage.dat", build_dir / "logs" / "coverage.dat"):
             if cov and dat.exists():
-                keep = SIM_BUILD / "coverage" / f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
+                name = f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
+                keep = SIM_BUILD / "coverage" / name
                 keep.parent.mkdir(parents=True, exist_ok=True)
                 dat.replace(keep)
 

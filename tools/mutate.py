@@ -355,8 +355,8 @@ def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
 
 def run_mutant_formal(mutant: Mutant, timeout: float) -> tuple[str, float]:
     """MCY-style: run the module's proof (formal/<module>.sby, every task) on a copy
-    holding ``mutant``. A failed assertion or an unreachable cover kills it; "unknown" = the induction step
-    fails but no base-case counterexample was found within the depth."""
+    holding ``mutant``. A failed assertion or an unreachable cover kills it; "unknown" = the
+    induction step fails but no base-case counterexample was found within the depth."""
     t0 = time.monotonic()
     sby = REPO / "formal" / f"{mutant.module}.sby"
     if not sby.exists():
