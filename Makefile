@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl gnn-dataset gnn-train gnn-eval \
-        clean help formal coverage mutate view bench-view
+        clean help formal coverage mutate mutate-ci view bench-view
 all: test
 
 help:
@@ -79,7 +79,8 @@ bench-rtl: $(STAMP)
 include synth/synth.mk
 
 # Verification beyond simulation (README "Verification"): not part of `make test`, except
-# the fixed mutant subset and the tool sanity checks in tests/test_verif_tools.py.
+# the tool sanity checks in tests/test_verif_tools.py (the fixed mutant subset runs there only
+# with MUTATE_CI=1: `make mutate-ci`).
 MUTANTS ?= 40
 SEED    ?= 1
 
@@ -91,6 +92,9 @@ coverage: $(STAMP)
 
 mutate: $(STAMP)
 	$(RUN) python tools/mutate.py -n $(MUTANTS) --seed $(SEED)
+
+mutate-ci: $(STAMP)
+	MUTATE_CI=1 $(RUN) pytest -q -n 0 tests/test_verif_tools.py
 
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 

@@ -80,7 +80,7 @@ TESTS: dict[str, list[list[str]]] = {
 # (module, operator, text of the mutated line): robust to line moves.
 CI_MUTANTS = (
     ("frame_align", "const", "smp_q == SMP_W'(N_RANGE - 2)"),  # chirp end one sample early
-    ("frame_align", "drop", "in_beat  = s_axis_tvalid;"),      # input beat without TREADY
+    ("frame_align", "neg", "discard_q <= gap && sof;"),        # no discard after a gap
 )
 
 
