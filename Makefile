@@ -10,8 +10,9 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint gen bench bench-rtl gnn-dataset gnn-train gnn-eval \
-        clean help formal coverage mutate mutate-ci view bench-view
+.PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
+        gnn-eval clean help view bench-view test-detect-long \
+        formal coverage mutate mutate-ci
 all: test
 
 help:
@@ -23,6 +24,7 @@ help:
 	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core and radar_pipeline benchmarks (Verilator)"
+	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
@@ -70,11 +72,18 @@ gen: $(STAMP)
 
 bench: $(STAMP)
 	$(RUN) python -m model.bench_simulate
+	$(RUN) python -m model.bench_model
 	$(RUN) python -m host.bench_host
 
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
 	$(RUN) python tb/radar_pipeline/bench_radar_pipeline.py
+	$(RUN) python tb/radar_pipeline/bench_harness.py
+
+# not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
+SOAK_FRAMES ?= 1000
+soak: $(STAMP)
+	$(RUN) python -m rtlsim.harness.soak --frames $(SOAK_FRAMES)
 
 include synth/synth.mk
 
@@ -127,3 +136,8 @@ view: $(STAMP) $(VIEW_CAPTURE)
 
 bench-view: $(STAMP)
 	$(RUN) python -m radar.view.bench_view
+
+# On-chip detection blocks at every parameter set (make test runs a quick subset)
+.PHONY: test-detect-long
+test-detect-long: $(STAMP)
+	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain

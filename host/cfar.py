@@ -9,7 +9,8 @@ target's window sidelobes that wrap into the top bins meet a training window tha
 target itself, exactly as its sidelobes on the other side do. Which bins may be *reported*
 is a separate rule, ``RadarConfig.detection_bins`` (applied by :func:`detection_mask`).
 
-Thresholds for a configured false-alarm probability are derived, not tuned. A cell of a
+Thresholds for a configured false-alarm probability are derived, not tuned (the statistics
+live in ``model/cfar_stats.py``, shared with the FPGA CFAR model). A cell of a
 map that integrates ``n_channels`` independent channels non-coherently is Gamma(L, theta)
 distributed under noise (L = n_channels). For CA-CFAR, CUT / mean(training) is then
 F(2L, 2NL)-distributed for N independent training cells, so the factor is the F quantile.
@@ -26,14 +27,18 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy import integrate, optimize, stats
+from scipy import stats
 from scipy.ndimage import maximum_filter
 from scipy.signal import fftconvolve
 
-# Power correlation between bins i apart of a periodic-Hann-windowed DFT of white noise:
-# |sum w^2 e^{-j2pi i n/N}|^2 / (sum w^2)^2 -> 1, 4/9, 1/36 for i = 0, 1, 2; 0 beyond.
-HANN_POWER_CORRELATION = (1.0, 4.0 / 9.0, 1.0 / 36.0)
-RECT_POWER_CORRELATION = (1.0,)
+from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
+    HANN_POWER_CORRELATION,
+    RECT_POWER_CORRELATION,
+    ca_factor,
+    effective_cells_mask,
+    os_factor,
+)
+
 OS_MAX_ELEMENTS = 2 * 10**8
 """OS-CFAR holds (cells x training cells) values at once: bound on that product."""
 MAX_WINDOW_CELLS = 2048
@@ -78,58 +83,9 @@ def _kernel(params: CfarParams) -> np.ndarray:
     return k
 
 
-def _correlation_sum(kernel: np.ndarray, rho_r: tuple[float, ...],
-                     rho_d: tuple[float, ...]) -> float:
-    """sum over training-cell pairs of their power correlation (separable windows).
-
-    Only offsets where rho != 0 contribute, so the pair count per offset (the kernel's
-    autocorrelation there) is taken by shifting the mask: O(cells), not O(cells^2)."""
-    total = 0.0
-    nr, nd = kernel.shape
-    for dr, cr in enumerate(rho_r):
-        for dd, cd in enumerate(rho_d):
-            if dr >= nr or dd >= nd:
-                continue
-            pairs = float(np.sum(kernel[dr:, dd:] * kernel[:nr - dr, :nd - dd]))
-            if dd and dr:  # (+dr, +dd) and (+dr, -dd), each counted for both orders
-                pairs += float(np.sum(kernel[dr:, :nd - dd] * kernel[:nr - dr, dd:]))
-                total += 2 * cr * cd * pairs
-            elif dd or dr:
-                total += 2 * cr * cd * pairs
-            else:
-                total += pairs
-    return total
-
-
 def effective_cells(params: CfarParams, windowed: tuple[bool, bool] = (True, True)) -> float:
     """Number of independent cells with the same averaging power as the training set."""
-    k = _kernel(params)
-    n = k.sum()
-    rho_r = HANN_POWER_CORRELATION if windowed[0] else RECT_POWER_CORRELATION
-    rho_d = HANN_POWER_CORRELATION if windowed[1] else RECT_POWER_CORRELATION
-    return float(n * n / _correlation_sum(k, rho_r, rho_d))
-
-
-def ca_factor(pfa: float, n_channels: int, n_eff: float | np.ndarray) -> np.ndarray:
-    """CA-CFAR factor alpha: P(CUT > alpha * mean(train)) = pfa under noise."""
-    return np.asarray(stats.f.isf(pfa, 2 * n_channels, 2 * n_channels * np.asarray(n_eff)))
-
-
-@lru_cache(maxsize=64)
-def os_factor(pfa: float, n_channels: int, n_train: int, k: int) -> float:
-    """OS-CFAR factor alpha: P(CUT > alpha * (k-th smallest of n_train)) = pfa, cells
-    Gamma(n_channels) distributed (independent cells assumed)."""
-    g = stats.gamma(n_channels)
-    order = stats.beta(k, n_train - k + 1)  # CDF value of the k-th order statistic
-
-    def pfa_of(alpha: float) -> float:
-        # integrate over u = F(y), y = F^-1(u): E_u[ sf(alpha * ppf(u)) ]
-        val, _ = integrate.quad(lambda u: g.sf(alpha * g.ppf(u)) * order.pdf(u), 0.0, 1.0,
-                                limit=200)
-        return max(val, 1e-300)
-
-    return float(optimize.brentq(lambda a: np.log(pfa_of(a)) - np.log(pfa), 1e-3, 1e3,
-                                 xtol=1e-6))
+    return effective_cells_mask(_kernel(params), windowed)
 
 
 def check_window(params: CfarParams, shape: tuple[int, int]) -> None:

@@ -8,7 +8,11 @@ Input order (range FFT output, chirps TX-interleaved): word ``i = (c * n_range +
 chirp ``c = d * num_tx + t`` sent by TX ``t``, i.e. the input frame reshapes to
 ``(n_doppler, num_tx, n_range, num_rx)``.
 Output order (Doppler vectors): word ``j = (t * n_range + r) * n_doppler + d``, i.e.
-``(num_tx, n_range, n_doppler, num_rx)``, TLAST after every ``n_doppler`` words.
+``(num_tx, n_range, n_doppler, num_rx)``, TLAST after every ``n_doppler`` words
+(``read_order=0``, the RTL's READ_ORDER = 0), or with ``read_order=1`` (on-chip detection)
+``j = (r * num_tx + t) * n_doppler + d``, i.e. ``(n_range, num_tx, n_doppler, num_rx)``.
+Order 0 maps output j to input ``p(j) = rotl(j, ROT)``; order 1 to a bit permutation
+``p(j)[a] = j[sigma(a)]``; the in-place scheme writes frame k at ``p^k`` for both.
 """
 
 from __future__ import annotations
@@ -23,16 +27,35 @@ def _log2(n: int, name: str) -> int:
     return b
 
 
-def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
+                read_order: int = 0) -> np.ndarray:
     """Reorder one frame from chirp order to Doppler-vector order.
 
     frame: ``(num_tx * n_doppler * n_range, num_rx)`` words in input order.
-    Returns ``(num_tx * n_range * n_doppler, num_rx)`` words in output order.
+    Returns ``(num_tx * n_range * n_doppler, num_rx)`` words in output order
+    (``read_order`` 0: (t, r, d); 1: (r, t, d)).
     """
     frame = np.asarray(frame)
     num_rx = frame.shape[-1]
     cube = frame.reshape(n_doppler, num_tx, n_range, num_rx)
-    return np.ascontiguousarray(cube.transpose(1, 2, 0, 3)).reshape(-1, num_rx)
+    axes = (1, 2, 0, 3) if read_order == 0 else (2, 1, 0, 3)
+    return np.ascontiguousarray(cube.transpose(*axes)).reshape(-1, num_rx)
+
+
+def sigma(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+    """int ``(B,)``: READ_ORDER = 1 bit permutation, bit a of p(j) is bit sigma[a] of j."""
+    bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
+                  _log2(n_doppler, "n_doppler"))
+    a = np.arange(bt + br + bd)
+    return np.where(a < br, bt + bd + a, np.where(a < br + bt, bd + a - br, a - br - bt))
+
+
+def _permute(x: np.ndarray, perm: np.ndarray) -> np.ndarray:
+    """Bit a of the result is bit perm[a] of x."""
+    out = np.zeros_like(x)
+    for a, src in enumerate(perm):
+        out |= ((x >> int(src)) & 1) << a
+    return out
 
 
 def output_tlast(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
@@ -55,19 +78,27 @@ def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
     return ((x << s) | (x >> (bits - s))) & mask if s else x & mask
 
 
-def write_addresses(k: int, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+def write_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
+                    read_order: int = 0) -> np.ndarray:
     """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i) = p^k(i)."""
     b, rot = address_bits(num_tx, n_range, n_doppler)
-    return rotl(np.arange(1 << b), (k * rot) % b, b)
+    if read_order == 0:
+        return rotl(np.arange(1 << b), (k * rot) % b, b)
+    s = sigma(num_tx, n_range, n_doppler)
+    perm = np.arange(b)
+    for _ in range(k):
+        perm = s[perm]
+    return _permute(np.arange(1 << b, dtype=np.int64), perm)
 
 
-def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
+def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
+                   read_order: int = 0) -> np.ndarray:
     """int64 ``(frame_words,)``: slot read for output word j of frame k, R_k = W_{k+1}."""
-    return write_addresses(k + 1, num_tx, n_range, n_doppler)
+    return write_addresses(k + 1, num_tx, n_range, n_doppler, read_order)
 
 
 def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
-                    n_doppler: int) -> list[np.ndarray]:
+                    n_doppler: int, read_order: int = 0) -> list[np.ndarray]:
     """Run the in-place address scheme on a one-frame memory (checks the method itself).
 
     frames: list of input frames ``(frame_words, num_rx)``. Returns the output frames. Raises
@@ -80,20 +111,27 @@ def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
     read = np.ones(1 << b, dtype=bool)
     out = []
     for k, f in enumerate(frames):
-        wa = write_addresses(k, num_tx, n_range, n_doppler)
+        wa = write_addresses(k, num_tx, n_range, n_doppler, read_order)
         assert read[wa].all(), "in-place scheme overwrote an unread slot"
         mem[wa] = f
         read[:] = False
-        ra = read_addresses(k, num_tx, n_range, n_doppler)
+        ra = read_addresses(k, num_tx, n_range, n_doppler, read_order)
         out.append(mem[ra].copy())
         read[ra] = True
     return out
 
 
-def frame_period(num_tx: int, n_range: int, n_doppler: int) -> int:
-    """Frames after which the in-place address pattern repeats: B / gcd(B, ROT)."""
+def frame_period(num_tx: int, n_range: int, n_doppler: int, read_order: int = 0) -> int:
+    """Frames after which the in-place address pattern repeats: B / gcd(B, ROT) for order
+    0, the order of the bit permutation sigma for order 1."""
     b, rot = address_bits(num_tx, n_range, n_doppler)
-    return b // np.gcd(b, rot)
+    if read_order == 0:
+        return b // np.gcd(b, rot)
+    s = sigma(num_tx, n_range, n_doppler)
+    perm, k = s.copy(), 1
+    while not np.array_equal(perm, np.arange(b)):
+        perm, k = s[perm], k + 1
+    return k
 
 
 def memory_bits(num_tx: int, num_rx: int, n_range: int, n_doppler: int, data_w: int = 16,

@@ -117,10 +117,11 @@ def _as_frames(x: np.ndarray) -> np.ndarray:
     return x
 
 
-def fft_fixed(x: np.ndarray, *, inverse: bool = False, window: bool = False,
-              scale_sch: int | None = None, data_w: int = 16,
-              guard_w: int = 4) -> FftFixedResult:
-    """Bit-accurate fixed-point FFT of ``fft_axis``.
+def fft_fixed_reference(x: np.ndarray, *, inverse: bool = False, window: bool = False,
+                        scale_sch: int | None = None, data_w: int = 16,
+                        guard_w: int = 4) -> FftFixedResult:
+    """Bit-accurate fixed-point FFT of ``fft_axis``, stage by stage in int64: the plain
+    statement of the arithmetic above, kept as the reference of :func:`fft_fixed`.
 
     ``x``: complex (frames, N, lanes) or (frames, N) with integer-valued I/Q in
     ``[-2**(data_w-1), 2**(data_w-1)-1]``. ``scale_sch``: bit s = 1 divides stage s by 2
@@ -191,6 +192,195 @@ def fft_fixed(x: np.ndarray, *, inverse: bool = False, window: bool = False,
     br = bitrev(n)
     y = (re + 1j * im)[:, br, :]
     return FftFixedResult(y=y, overflow=ov[:, br])
+
+
+
+# ---- fast path ------------------------------------------------------------------------------
+# Same arithmetic as :func:`fft_fixed_reference`, computed on floating-point integers: sums
+# of integers and products of a W-bit sample with a Q1.16 coefficient are exact in float64
+# (< 2**53), so are the W+1-bit butterfly sums in float32 when W + 1 <= 24; ``rnd(v, k)``
+# is ``rint(v * 2**-k)`` (scaling by a power of two is exact and ``rint`` rounds half to
+# even). I and Q sit side by side on a last axis of 2, so each numpy call handles both; frames
+# are processed in chunks that fit the L2 cache; saturation is checked with two reductions
+# per stage and the per-beat overflow flags are only built once something saturated.
+
+CHUNK_BYTES = 1 << 19
+"""Working-set size of one chunk of frames (fits a 1 MiB L2 cache with its temporaries)."""
+
+
+def planar_dtype(data_w: int = 16, guard_w: int = 4) -> type:
+    """float32 when the internal width (plus one carry bit) fits its 24-bit mantissa."""
+    return np.float32 if data_w + 1 + guard_w + 1 <= 24 else np.float64
+
+
+def _rint_scaled(v: np.ndarray, k: int) -> np.ndarray:
+    """In place: ``v <- rint(v / 2**k)`` (convergent rounding, exact for integers)."""
+    if k:
+        np.multiply(v, 2.0 ** -k, out=v)
+        np.rint(v, out=v)
+    return v
+
+
+class _Sat:
+    """Saturation to ``w``-bit signed of planar (chunk, n, lanes, 2) arrays, in place.
+
+    ``bound`` carries a proven upper bound of the magnitudes so far: while it stays inside
+    the range the check is skipped; otherwise two reductions decide and re-tighten it.
+    """
+
+    def __init__(self, w: int, bound: float) -> None:
+        self.lo, self.hi = -float(1 << (w - 1)), float((1 << (w - 1)) - 1)
+        self.bound = bound
+
+    def __call__(self, v: np.ndarray) -> np.ndarray | None:
+        """Clip ``v`` in place; returns the (chunk, n) beats that saturated, or None."""
+        if self.bound <= self.hi or v.size == 0:
+            return None
+        mx, mn = float(v.max()), float(v.min())
+        self.bound = max(mx, -mn)
+        if mx <= self.hi and mn >= self.lo:
+            return None
+        mask = ((v < self.lo) | (v > self.hi)).any(axis=(-1, -2))
+        np.clip(v, self.lo, self.hi, out=v)
+        self.bound = -self.lo
+        return mask
+
+
+TWIDDLE_GAIN = (1.0 + 0.71 / (1 << COEF_FRAC)) * 2.0 ** 0.5
+"""Bound of |rnd((re C + im S) / 2**16)| / max(|re|, |im|): |(C, S)| <= 2**16 + 0.71 (ROM
+rounding), |(re, im)| <= sqrt(2) max(|re|, |im|)."""
+
+
+def _or(a: np.ndarray | None, b: np.ndarray | None) -> np.ndarray | None:
+    if a is None:
+        return b
+    return a if b is None else a | b
+
+
+def _fft_chunk(p: np.ndarray, n: int, inverse: bool, scale_sch: int, w: int, guard_w: int,
+               data_w: int, tw: list[np.ndarray | None]) -> tuple[np.ndarray, np.ndarray | None]:
+    """Stages of :func:`fft_fixed_reference` on a planar chunk (c, n, lanes, 2), windowed and
+    shifted already; returns (output before bit reversal, overflow (c, n) or None)."""
+    c, _, lanes, _ = p.shape
+    lg = n.bit_length() - 1
+    bound = float(np.abs(p).max(initial=0.0))
+    sat_w = _Sat(w, bound)
+    ov: np.ndarray | None = None
+    out = np.empty_like(p)
+    for s in range(lg):
+        d = n >> (s + 1)
+        if s % 2 == 1:  # BF-II: second input of odd blocks times -j (+j inverse)
+            q = p.reshape(c, n // (4 * d), 2, 2, d, lanes, 2)[:, :, 1, 1]
+            tmp = q[..., 0].copy()
+            if inverse:
+                np.negative(q[..., 1], out=q[..., 0])
+                q[..., 1] = tmp
+            else:
+                q[..., 0] = q[..., 1]
+                np.negative(tmp, out=q[..., 1])
+        a = p.reshape(c, n // (2 * d), 2, d, lanes, 2)
+        o = out.reshape(c, n // (2 * d), 2, d, lanes, 2)
+        np.add(a[:, :, 0], a[:, :, 1], out=o[:, :, 0])
+        np.subtract(a[:, :, 0], a[:, :, 1], out=o[:, :, 1])
+        scaled = (scale_sch >> s) & 1
+        _rint_scaled(out, scaled)
+        sat_w.bound = sat_w.bound if scaled else 2.0 * sat_w.bound
+        mask = sat_w(out)
+        if ov is not None:
+            o2 = ov.reshape(c, n // (2 * d), 2, d)
+            o_in = o2[:, :, 0] | o2[:, :, 1]
+            ov = np.stack([o_in, o_in], axis=2).reshape(c, n)
+        ov = _or(ov, mask)
+        p, out = out, p
+        if tw[s] is not None:  # twiddle after the pair (s-1, s): exact in complex128
+            z = p.astype(np.float64).view(np.complex128)[..., 0]     # (c, n, lanes)
+            z *= tw[s][None, :, None]                    # twiddles pre-scaled by 2**-16
+            zf = np.rint(z.view(np.float64).reshape(p.shape), out=z.view(np.float64)
+                         .reshape(p.shape))
+            sat_w.bound = np.floor(sat_w.bound * TWIDDLE_GAIN) + 1.0
+            ov = _or(ov, sat_w(zf))
+            p[...] = zf
+    _rint_scaled(p, guard_w)
+    ov = _or(ov, _Sat(data_w, np.ceil(sat_w.bound / (1 << guard_w)))(p))
+    return p, ov
+
+
+def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = False,
+                     scale_sch: int | None = None, data_w: int = 16, guard_w: int = 4
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Fast bit-accurate ``fft_axis`` on planar I/Q, identical to :func:`fft_fixed_reference`.
+
+    ``p``: real array (frames, N, lanes, 2) of integer I (index 0) and Q (index 1) in
+    ``data_w``-bit range. Returns (array (frames, N, lanes, 2) of the integer outputs in
+    natural bin order, dtype :func:`planar_dtype`; bool (frames, N) overflow per beat).
+    """
+    if p.ndim != 4 or p.shape[-1] != 2:
+        raise ValueError("planar input must be (frames, N, lanes, 2)")
+    frames, n, lanes, _ = p.shape
+    _check(n, data_w, guard_w)
+    lg = n.bit_length() - 1
+    if scale_sch is None:
+        scale_sch = default_scale_sch(n)
+    lim = 1 << (data_w - 1)
+    if p.size and (p.min() < -lim or p.max() >= lim):
+        raise ValueError(f"input does not fit {data_w}-bit two's complement")
+    dt = planar_dtype(data_w, guard_w)
+    w = data_w + 1 + guard_w
+    cos_t, sin_t = cos_table(), sin_table()
+    tw: list[np.ndarray | None] = [None] * lg
+    for s in range(1, lg, 2):
+        if s + 1 < lg:
+            kk = twiddle_index(n, n >> (s - 1))
+            sgn = 1.0 if inverse else -1.0        # (re + j im) * (C -+ j S)
+            tw[s] = (cos_t[kk] + 1j * sgn * sin_t[kk]) * 2.0 ** -COEF_FRAC
+    # window and its rounding shift in one exact factor (x * h < 2**31, scaled by 2**-k)
+    h = (hann_window(n) * 2.0 ** (guard_w - COEF_FRAC))[None, :, None, None] if window \
+        else None
+    br = bitrev(n)
+    y = np.empty((frames, n, lanes, 2), dtype=dt)
+    ov = np.zeros((frames, n), dtype=bool)
+    step = max(1, CHUNK_BYTES // (n * lanes * 2 * np.dtype(dt).itemsize))
+    for f0 in range(0, frames, step):
+        sl = slice(f0, min(f0 + step, frames))
+        if window:
+            x = np.rint(p[sl] * h).astype(dt, order="C")
+        else:
+            x = p[sl].astype(dt, order="C") * float(1 << guard_w)
+        out, o = _fft_chunk(x, n, inverse, scale_sch, w, guard_w, data_w, tw)
+        y[sl] = out[:, br]
+        if o is not None:
+            ov[sl] = o[:, br]
+    return y, ov
+
+
+def to_planar(x: np.ndarray) -> np.ndarray:
+    """complex (...) -> float (..., 2) with I at index 0 and Q at index 1 (a view when the
+    input is contiguous complex64/complex128)."""
+    x = np.asarray(x)
+    if x.dtype in (np.complex64, np.complex128) and x.flags.c_contiguous:
+        return x.view(x.real.dtype).reshape(x.shape + (2,))
+    return np.stack([np.real(x), np.imag(x)], axis=-1).astype(np.float64)
+
+
+def from_planar(p: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`to_planar`: complex128 (...)."""
+    return p[..., 0].astype(np.float64) + 1j * p[..., 1]
+
+
+def fft_fixed(x: np.ndarray, *, inverse: bool = False, window: bool = False,
+              scale_sch: int | None = None, data_w: int = 16,
+              guard_w: int = 4) -> FftFixedResult:
+    """Bit-accurate fixed-point FFT of ``fft_axis`` (fast path, identical results to
+    :func:`fft_fixed_reference`).
+
+    ``x``: complex (frames, N, lanes) or (frames, N) with integer-valued I/Q in
+    ``[-2**(data_w-1), 2**(data_w-1)-1]``. ``scale_sch``: bit s = 1 divides stage s by 2
+    (default all ones: 1/N overall). Returns :class:`FftFixedResult` (natural order).
+    """
+    x = _as_frames(x)
+    y, ov = fft_fixed_planar(to_planar(x), inverse=inverse, window=window,
+                             scale_sch=scale_sch, data_w=data_w, guard_w=guard_w)
+    return FftFixedResult(y=from_planar(y), overflow=ov)
 
 
 def fft_float(x: np.ndarray, *, inverse: bool = False, window: bool = False,

@@ -24,7 +24,7 @@ import numpy as np
 from model.axis_packetizer import check_geometry, cube_to_payload, packetize
 from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
-from model.fft_axis import fft_fixed
+from model.fft_axis import fft_fixed_planar, fft_fixed_reference, from_planar, to_planar
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -94,20 +94,34 @@ class ChainOutput:
         return self.payload.transpose(0, 3, 1, 2).reshape(num_tx * num_rx, n_range, n_doppler)
 
 
-def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
-              ) -> ChainOutput:
-    """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube."""
+def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None,
+              reference: bool = False) -> ChainOutput:
+    """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube.
+
+    ``reference``: use the stage-by-stage int64 FFT (``fft_fixed_reference``, slow) instead
+    of the fast path; the results are identical (checked by tests/test_model_fast.py).
+    """
     params = params or PipelineParams()
     cfg.check_adc(adc)
-    # range FFT, one transform per chirp, lanes = RX
-    rng = fft_fixed(np.transpose(adc, (0, 2, 1)), window=params.window,
-                    scale_sch=params.range_scale_sch)
-    words = rng.y.reshape(-1, cfg.num_rx)                       # chirp-major input order
-    turned = corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
-    dop = fft_fixed(turned.reshape(-1, cfg.n_doppler, cfg.num_rx), window=params.window,
-                    scale_sch=params.doppler_scale_sch)
-    payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
-    return ChainOutput(payload, int(rng.overflow.sum()), int(dop.overflow.sum()))
+    if reference:
+        rng = fft_fixed_reference(np.transpose(adc, (0, 2, 1)), window=params.window,
+                                  scale_sch=params.range_scale_sch)
+        words = rng.y.reshape(-1, cfg.num_rx)                   # chirp-major input order
+        turned = corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+        dop = fft_fixed_reference(turned.reshape(-1, cfg.n_doppler, cfg.num_rx),
+                                  window=params.window, scale_sch=params.doppler_scale_sch)
+        payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+        return ChainOutput(payload, int(rng.overflow.sum()), int(dop.overflow.sum()))
+    # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values
+    planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_range, rx, 2)
+    rng_p, rng_ov = fft_fixed_planar(planar, window=params.window,
+                                     scale_sch=params.range_scale_sch)
+    turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
+                         cfg.n_doppler)
+    dop_p, dop_ov = fft_fixed_planar(turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2),
+                                     window=params.window, scale_sch=params.doppler_scale_sch)
+    payload = from_planar(dop_p).reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+    return ChainOutput(payload, int(rng_ov.sum()), int(dop_ov.sum()))
 
 
 def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None

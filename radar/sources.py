@@ -7,7 +7,7 @@ radar cubes complex (n_virtual, n_range, n_doppler) in the float reference's uni
 - ``model``: bit-accurate model of ``radar_pipeline`` (:func:`model.radar_pipeline.scaled_cube`),
   exactly what the FPGA sends, divided by the chain's gain;
 - ``float``: the float64 reference of the chain (:func:`model.reference.radar_cube`), fast;
-- ``rtl``: the Verilated ``radar_pipeline`` (:func:`rtlsim.pipeline_rtl.run_pipeline_rtl`),
+- ``rtl``: the Verilated ``radar_pipeline`` (:func:`rtlsim.harness.run_pipeline`, the C++ harness),
   its DMA packets decoded by :class:`host.stream.StreamDecoder` like the board's.
 
 A new source is one :class:`FrameSource` subclass with a ``name``: it registers itself in
@@ -90,7 +90,7 @@ class RtlSource(FrameSource):
         """All frames stream through the RTL back to back (one simulation); the DMA packets
         are decoded like the board's."""
         from host.stream import StreamDecoder
-        from rtlsim.pipeline_rtl import run_pipeline_rtl
+        from rtlsim.harness import run_pipeline
 
         frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
         if frame_bits > RTL_SIM_MAX_FRAME_BITS:
@@ -101,7 +101,7 @@ class RtlSource(FrameSource):
         print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters); the first "
               f"build takes a minute or two", file=sys.stderr)
         try:
-            packets, status = run_pipeline_rtl(adcs, cfg, self.chain)
+            packets, status = run_pipeline(adcs, cfg, self.chain)
         except (RuntimeError, FileNotFoundError, ImportError) as exc:
             raise SourceError(str(exc)) from None
         dec = StreamDecoder(cfg, self.chain.packet_words)

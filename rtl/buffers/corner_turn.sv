@@ -23,7 +23,11 @@ module corner_turn #(
   // Chirps per TX per frame (output Doppler vector length), power of two, 2..4096.
   parameter int N_DOPPLER = 256,
   // Bits of I and of Q per lane, 8..32.
-  parameter int DATA_W = 16
+  parameter int DATA_W = 16,
+  // Output order. 0: for TX t, for range bin r (the radar cube, DESIGN 3.2);
+  // 1: for range bin r, for TX t (on-chip detection, docs/detect.md: all TX of a range bin
+  // together). The Doppler vector is the same; with NUM_TX = 1 both orders are equal.
+  parameter int READ_ORDER = 0
 ) (
   input  wire logic                          clk,
   input  wire logic                          rst,
@@ -72,6 +76,9 @@ module corner_turn #(
   end
   if (B > 24) begin : g_bad_frame_words
     $fatal(1, "%m: NUM_TX*N_RANGE*N_DOPPLER above 2^24 words");
+  end
+  if (READ_ORDER < 0 || READ_ORDER > 1) begin : g_bad_read_order
+    $fatal(1, "%m: READ_ORDER=%0d not 0 or 1", READ_ORDER);
   end
 
   // rotl(x, s) on B bits, 0 <= s < B
@@ -126,12 +133,48 @@ module corner_turn #(
   assign wr_frame_end  = (wr_cnt_q == '1);
   assign chirp_end     = (wr_cnt_q[BR-1:0] == '1);
   assign ram_wr_en     = wr_beat;
-  assign ram_wr_addr   = rotl(wr_cnt_q, wr_shift_q);
 
   assign rd_start    = pending_q && !rd_active_q;
   assign rd_issue    = rd_active_q && can_issue;
   assign ram_rd_en   = rd_issue;
-  assign ram_rd_addr = rotl(rd_cnt_q, rd_shift_q);
+
+  // Addresses. READ_ORDER 0: W_k(i) = rotl(i, k*ROT mod B) (header comment).
+  // READ_ORDER 1: output j = (r*NUM_TX + t)*N_DOPPLER + d maps to input p(j), a bit
+  // permutation (not a rotation): bit a of p(j) is bit SIGMA[a] of j. The in-place scheme
+  // holds for any bit permutation: W_k = p^k, whose bit a is bit sigma_k[a] of the index,
+  // sigma_0 = identity, sigma_{k+1}[a] = SIGMA[sigma_k[a]]; the read of frame k uses
+  // sigma_{k+1} (= W_{k+1}, as for the rotation).
+  if (READ_ORDER == 0) begin : g_rot
+    assign ram_wr_addr = rotl(wr_cnt_q, wr_shift_q);
+    assign ram_rd_addr = rotl(rd_cnt_q, rd_shift_q);
+  end else begin : g_perm
+    // SIGMA[a]: input-index bits are {d, t, r} (r lowest), output-index bits {r, t, d}
+    function automatic logic [SH_W-1:0] sigma(input int a);
+      if (a < BR)           sigma = SH_W'(BT + BD + a);        // r
+      else if (a < BR + BT) sigma = SH_W'(BD + (a - BR));       // t
+      else                  sigma = SH_W'(a - BR - BT);         // d
+    endfunction
+    logic [SH_W-1:0] wr_perm_q [B];
+    logic [SH_W-1:0] rd_perm_q [B];
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        for (int a = 0; a < B; a++) wr_perm_q[a] <= SH_W'(a);
+      end else if (wr_beat && wr_frame_end) begin
+        for (int a = 0; a < B; a++) begin
+          for (int c = 0; c < B; c++) if (wr_perm_q[a] == SH_W'(c)) wr_perm_q[a] <= sigma(c);
+        end
+      end
+      if (rd_start) rd_perm_q <= wr_perm_q;   // already advanced to sigma_{k+1}
+    end
+    always_comb begin
+      for (int a = 0; a < B; a++) begin
+        ram_wr_addr[a] = wr_cnt_q[wr_perm_q[a]];
+        ram_rd_addr[a] = rd_cnt_q[rd_perm_q[a]];
+      end
+    end
+    logic unused_rot;
+    assign unused_rot = ^{rd_shift_q};
+  end
 
   always_ff @(posedge clk) begin
     p_last_q <= (rd_cnt_q[BD-1:0] == '1);

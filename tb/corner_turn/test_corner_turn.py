@@ -21,6 +21,7 @@ class TB(AxisTB):
         self.n_range = param("N_RANGE")
         self.n_doppler = param("N_DOPPLER")
         assert param("DATA_W") == 16
+        self.read_order = param("READ_ORDER", 0)
         self.frame_words = self.num_tx * self.n_range * self.n_doppler
 
     def random_frame(self) -> np.ndarray:
@@ -51,7 +52,7 @@ class TB(AxisTB):
 
     def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
         for k, (g, f) in enumerate(zip(got, sent, strict=True)):
-            exp = ct.corner_turn(f, self.num_tx, self.n_range, self.n_doppler)
+            exp = ct.corner_turn(f, self.num_tx, self.n_range, self.n_doppler, self.read_order)
             if not np.array_equal(g, exp):
                 bad = np.nonzero((g != exp).any(axis=1))[0]
                 raise AssertionError(f"frame {k}: {len(bad)} words differ, first at {bad[0]}")
@@ -90,7 +91,7 @@ async def test_random_stalls(dut):
     """Random and long TVALID gaps / TREADY stalls over a full cycle of the address pattern."""
     tb = TB(dut)
     await tb.reset()
-    period = ct.frame_period(tb.num_tx, tb.n_range, tb.n_doppler)
+    period = ct.frame_period(tb.num_tx, tb.n_range, tb.n_doppler, tb.read_order)
     nfr = 2 if tb.frame_words > 4096 else period + 2
     tb.set_idle_generator(random_pause(0.3, 1))
     tb.set_backpressure_generator(bursty_pause(2, max_run=3 * tb.n_doppler, busy_fraction=0.4))
@@ -163,6 +164,8 @@ PARAMS = [
     dict(NUM_TX=4, NUM_RX=16, N_RANGE=8, N_DOPPLER=16),
     # paper-fpga preset: 1 TX x 4 RX, 64 range bins, 256 chirps (16384 x 128-bit words)
     dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
+    # on-chip detection order (r, t, d): bit-permutation addresses, period 7 frames
+    dict(NUM_TX=4, NUM_RX=2, N_RANGE=4, N_DOPPLER=8, READ_ORDER=1),
 ]
 
 
@@ -174,14 +177,15 @@ def test_corner_turn(parameters: dict) -> None:
                parameters={"DATA_W": 16, **parameters})
 
 
+@pytest.mark.parametrize("read_order", [0, 1])
 @pytest.mark.parametrize("shape", [(1, 4, 8), (4, 8, 16), (2, 4, 4), (4, 2, 2), (1, 64, 256)])
-def test_in_place_model(shape: tuple[int, int, int]) -> None:
+def test_in_place_model(shape: tuple[int, int, int], read_order: int) -> None:
     """The in-place address scheme (one frame of memory) reproduces the transpose over more
     than a full period of its address pattern, never overwriting an unread slot."""
     nt, nr, nd = shape
     rng = np.random.default_rng(0)
     frames = [rng.integers(0, 1 << 32, (nt * nr * nd, 2), dtype=np.uint32)
-              for _ in range(ct.frame_period(nt, nr, nd) + 2)]
-    out = ct.in_place_stream(frames, nt, nr, nd)
+              for _ in range(ct.frame_period(nt, nr, nd, read_order) + 2)]
+    out = ct.in_place_stream(frames, nt, nr, nd, read_order)
     for f, o in zip(frames, out, strict=True):
-        assert np.array_equal(o, ct.corner_turn(f, nt, nr, nd))
+        assert np.array_equal(o, ct.corner_turn(f, nt, nr, nd, read_order))

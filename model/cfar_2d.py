@@ -1,0 +1,246 @@
+"""Bit-exact model of ``rtl/detect/cfar_2d.sv`` (2-D CA/GO/SO-CFAR on the integrated power
+map) and the threshold scales it needs, derived from a requested Pfa with the host CFAR's
+statistics (``model/cfar_stats.py``).
+
+Maps are int64 ``(n_range, n_doppler)`` powers (``model/nci.py``), Doppler in natural FFT
+order and circular. Window per cell under test (CUT) at (q, d): rows q-PR..q+PR, columns
+d-PD..d+PD (mod n_doppler) minus the guard rectangle (rows q-GR..q+GR, columns d-GD..d+GD),
+PR = GR + TR, PD = GD + TD.
+
+Range edges: rows outside ``0 .. n_range - blank_top - 1`` do not exist (not training cells,
+not tested); the window is cut there and the threshold scale is recomputed for the cells
+that remain, the same rule as the host CFAR. The scale of a row depends only on its edge
+index ``e`` (0..PR-1: PR-e rows cut below; PR: interior; PR+1..2PR: e-PR rows cut above).
+The top ``blank_top`` range bins are the negative beat frequencies of a complex-IF range FFT
+(host fix pending): blanked rows never detect and never train.
+
+Kinds: ``ca`` sums all training cells; ``go``/``so`` take the greater/smaller of the two
+Doppler halves (column offsets < 0 and > 0; the CUT's own column is in neither half).
+Decision (exact integers): ``power * 2^scale_frac > S * scale[e]``, S the kind's training sum.
+
+Output word of the RTL (one per cell, LSB first): power ``pow_w`` bits, training sum S
+``sum_w`` bits, training cell count ``cnt_w`` bits, detect 1 bit; tuser ``{r, d}``; order per
+row: d = PD..n_doppler-1, 0..PD-1 (:func:`output_order`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from model.cfar_stats import ca_factor, effective_cells_mask, go_so_factor
+
+KINDS = ("ca", "go", "so")
+
+
+@dataclass(frozen=True)
+class Cfar2dConfig:
+    """RTL parameters of ``cfar_2d`` (validation mirrors its $fatal checks).
+
+    guard/train: cells per side along (range, Doppler). scale_w/scale_frac: unsigned fixed
+    point of the threshold scale.
+    """
+
+    n_range: int
+    n_doppler: int
+    pow_w: int
+    guard: tuple[int, int] = (2, 2)
+    train: tuple[int, int] = (4, 8)
+    kind: str = "ca"
+    blank_top: int = 0
+    scale_w: int = 32
+    scale_frac: int = 20
+
+    def __post_init__(self) -> None:
+        for name, n in (("n_range", self.n_range), ("n_doppler", self.n_doppler)):
+            if n < 4 or n > 4096 or n & (n - 1):
+                raise ValueError(f"{name}={n} must be a power of two in 4..4096")
+        if not 8 <= self.pow_w <= 62:
+            raise ValueError(f"pow_w={self.pow_w} not in 8..62")
+        if any(not 0 <= g <= 15 for g in self.guard) or any(not 1 <= t <= 15
+                                                            for t in self.train):
+            raise ValueError("guard must be in 0..15 and train in 1..15 cells per side")
+        if self.kind not in KINDS:
+            raise ValueError(f"kind: must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        if 2 * self.pd + 1 > self.n_doppler:
+            raise ValueError(f"Doppler window {2 * self.pd + 1} wider than n_doppler")
+        if self.blank_top < 0 or self.rows < 2 * self.pr + 1:
+            raise ValueError(f"blank_top={self.blank_top} leaves {self.rows} rows, need >= "
+                             f"{2 * self.pr + 1}")
+        if not (2 <= self.scale_w <= 48 and 0 <= self.scale_frac < self.scale_w):
+            raise ValueError("scale_w must be 2..48 and 0 <= scale_frac < scale_w")
+        if self.sum_w > 63:
+            raise ValueError("training sum above 63 bits does not fit the int64 model")
+
+    @property
+    def pr(self) -> int:
+        return self.guard[0] + self.train[0]
+
+    @property
+    def pd(self) -> int:
+        return self.guard[1] + self.train[1]
+
+    @property
+    def rows(self) -> int:
+        """Range rows that exist for the CFAR (tested and training)."""
+        return self.n_range - self.blank_top
+
+    @property
+    def n_edge(self) -> int:
+        """Entries of the scale table (edge indices)."""
+        return 2 * self.pr + 1
+
+    @property
+    def cnt_w(self) -> int:
+        return ((2 * self.pr + 1) * (2 * self.pd + 1) - 1).bit_length()
+
+    @property
+    def sum_w(self) -> int:
+        return self.pow_w + self.cnt_w
+
+    @property
+    def out_bytes(self) -> int:
+        return (self.pow_w + self.sum_w + self.cnt_w + 1 + 7) // 8
+
+    def hdl_parameters(self) -> dict[str, int]:
+        """HDL parameters of ``cfar_2d`` for this configuration."""
+        return dict(N_RANGE=self.n_range, N_DOPPLER=self.n_doppler, POW_W=self.pow_w,
+                    GUARD_R=self.guard[0], GUARD_D=self.guard[1], TRAIN_R=self.train[0],
+                    TRAIN_D=self.train[1], KIND=KINDS.index(self.kind),
+                    BLANK_TOP=self.blank_top, SCALE_W=self.scale_w,
+                    SCALE_FRAC=self.scale_frac)
+
+
+@dataclass
+class CfarCells:
+    """Per-cell results, each ``(n_range, n_doppler)``: ``power`` and ``train_sum`` int64,
+    ``count`` int64 training cells in the sum, ``detect`` bool."""
+
+    power: np.ndarray
+    train_sum: np.ndarray
+    count: np.ndarray
+    detect: np.ndarray
+
+    def noise(self) -> np.ndarray:
+        """Mean training power per cell, float64 ``(n_range, n_doppler)``."""
+        return self.train_sum / np.maximum(self.count, 1)
+
+
+def edge_index(q: int, cfg: Cfar2dConfig) -> int:
+    """Scale-table index of range row q (clamped for blanked rows)."""
+    lo = max(0, cfg.pr - q)
+    hi = min(cfg.pr, max(0, q + cfg.pr - (cfg.rows - 1)))
+    return cfg.pr - lo if lo else cfg.pr + hi
+
+
+def window_rows(q: int, cfg: Cfar2dConfig) -> np.ndarray:
+    """bool ``(2PR+1,)``: window row k (range row q-PR+k) exists."""
+    rows = q - cfg.pr + np.arange(2 * cfg.pr + 1)
+    return (rows >= 0) & (rows < cfg.rows)
+
+
+def training_mask(cfg: Cfar2dConfig, e: int, half: bool) -> np.ndarray:
+    """Training cells for edge index e, float ``(2PR+1, 2PD+1)`` (CUT at the centre);
+    ``half``: only the left Doppler half (offsets < 0)."""
+    (gr, gd), (pr, pd) = cfg.guard, (cfg.pr, cfg.pd)
+    k = np.ones((2 * pr + 1, 2 * pd + 1))
+    k[pr - gr:pr + gr + 1, pd - gd:pd + gd + 1] = 0.0
+    if half:
+        k[:, pd:] = 0.0
+    if e < pr:
+        k[:pr - e] = 0.0
+    elif e > pr:
+        k[2 * pr + 1 - (e - pr):] = 0.0
+    return k
+
+
+def threshold_factors(cfg: Cfar2dConfig, pfa: float, n_channels: int,
+                      windowed: tuple[bool, bool] = (True, True)
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Per edge index: (alpha float ``(2PR+1,)``, training cells int ``(2PR+1,)``) such
+    that ``CUT > alpha * S / cells`` has false-alarm probability ``pfa`` under noise.
+
+    Effective cells scale with the cells that remain at range edges (host rule:
+    N_eff = cells * N_eff(full window) / cells(full window)).
+    """
+    half = cfg.kind != "ca"
+    full = training_mask(cfg, cfg.pr, half)
+    eff_per_cell = effective_cells_mask(full, windowed) / full.sum()
+    alphas, cells = [], []
+    for e in range(cfg.n_edge):
+        c = int(training_mask(cfg, e, half).sum())
+        n_eff = c * eff_per_cell
+        a = (float(ca_factor(pfa, n_channels, n_eff)) if not half
+             else go_so_factor(pfa, n_channels, n_eff, cfg.kind))
+        alphas.append(a)
+        cells.append(c)
+    return np.array(alphas), np.array(cells, dtype=np.int64)
+
+
+def scale_table(cfg: Cfar2dConfig, pfa: float, n_channels: int,
+                windowed: tuple[bool, bool] = (True, True)) -> np.ndarray:
+    """Fixed-point threshold scales int64 ``(2PR+1,)``: round(alpha / cells * 2^frac)
+    (the RTL's ``cfg_scale`` input, entry e at bits ``e*scale_w``)."""
+    alpha, cells = threshold_factors(cfg, pfa, n_channels, windowed)
+    s = np.rint(alpha / cells * (1 << cfg.scale_frac)).astype(np.int64)
+    if (s >= 1 << cfg.scale_w).any() or (s < 1).any():
+        raise ValueError(f"threshold scale {alpha / cells} does not fit {cfg.scale_w} bits "
+                         f"with {cfg.scale_frac} fraction bits")
+    return s
+
+
+def pack_scale(scale: np.ndarray, cfg: Cfar2dConfig) -> int:
+    """Scale table as the integer value of the RTL's ``cfg_scale`` port."""
+    return sum(int(v) << (e * cfg.scale_w) for e, v in enumerate(scale))
+
+
+def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCells:
+    """Run the CFAR on one map. power: int ``(n_range, n_doppler)``; scale: int
+    ``(2PR+1,)`` from :func:`scale_table`."""
+    p = np.asarray(power, dtype=np.int64)
+    if p.shape != (cfg.n_range, cfg.n_doppler):
+        raise ValueError(f"power: expected {(cfg.n_range, cfg.n_doppler)}, got {p.shape}")
+    (gr, gd), pr, pd = cfg.guard, cfg.pr, cfg.pd
+    train_sum = np.zeros_like(p)
+    count = np.zeros_like(p)
+    detect = np.zeros(p.shape, dtype=bool)
+    frac = 1 << cfg.scale_frac
+    for q in range(cfg.n_range):
+        rowv = window_rows(q, cfg)
+        rows = q - pr + np.nonzero(rowv)[0]
+        inner = rows[np.abs(rows - q) <= gr]
+        vo = p[rows].sum(axis=0)
+        vi = p[inner].sum(axis=0)
+        n_out, n_in = len(rows), len(inner)
+
+        def win(v: np.ndarray, js: range) -> np.ndarray:
+            return sum((np.roll(v, -j) for j in js), np.zeros_like(v))
+
+        left = win(vo, range(-pd, 0)) - win(vi, range(-gd, 0))
+        right = win(vo, range(1, pd + 1)) - win(vi, range(1, gd + 1))
+        if cfg.kind == "ca":
+            s = left + right + vo - vi
+            count[q] = n_out * (2 * pd + 1) - n_in * (2 * gd + 1)
+        else:
+            s = np.maximum(left, right) if cfg.kind == "go" else np.minimum(left, right)
+            count[q] = n_out * pd - n_in * gd
+        train_sum[q] = s
+        if q < cfg.rows:
+            sc = int(scale[edge_index(q, cfg)])
+            detect[q] = [int(c) * frac > int(t) * sc for c, t in zip(p[q], s, strict=True)]
+    return CfarCells(p, train_sum, count, detect)
+
+
+def output_order(cfg: Cfar2dConfig) -> np.ndarray:
+    """int ``(n_range * n_doppler, 2)``: (r, d) of the RTL's output cells in stream order."""
+    d = (np.arange(cfg.n_doppler) + cfg.pd) % cfg.n_doppler
+    r = np.repeat(np.arange(cfg.n_range), cfg.n_doppler)
+    return np.stack([r, np.tile(d, cfg.n_range)], axis=1)
+
+
+def unpack_cell(value: int, cfg: Cfar2dConfig) -> tuple[int, int, int, bool]:
+    """RTL output word -> (power, train_sum, count, detect)."""
+    pw, sw, cw = cfg.pow_w, cfg.sum_w, cfg.cnt_w
+    return (value & ((1 << pw) - 1), (value >> pw) & ((1 << sw) - 1),
+            (value >> (pw + sw)) & ((1 << cw) - 1), bool((value >> (pw + sw + cw)) & 1))

@@ -1,0 +1,110 @@
+"""Bit-exact model of ``rtl/detect/detect_chain.sv``: Doppler-FFT words (mode-1 order) ->
+non-coherent integration -> 2-D CFAR -> detection records (``OUTPUT_MODE = 1``,
+DESIGN 3.4). The record stream then goes through ``axis_packetizer``
+(``model/axis_packetizer.py``) like the cube does in mode 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from model import cfar_2d, detect_records, nci
+
+KIND_CODES = {k: i for i, k in enumerate(cfar_2d.KINDS)}
+
+
+@dataclass(frozen=True)
+class DetectConfig:
+    """Detector settings (RTL parameters of ``detect_chain`` plus the Pfa the scale table
+    is derived from). guard/train: cells per side along (range, Doppler); ``windowed``:
+    Hann windows before the (range, Doppler) FFTs (cell correlation in the Pfa arithmetic);
+    ``blank_top``: top range bins blanked (negative beat frequencies)."""
+
+    num_tx: int
+    num_rx: int
+    n_range: int
+    n_doppler: int
+    guard: tuple[int, int] = (2, 2)
+    train: tuple[int, int] = (4, 8)
+    kind: str = "ca"
+    blank_top: int = 0
+    max_detections: int = 256
+    pfa: float = 1e-6
+    windowed: tuple[bool, bool] = (True, True)
+    scale_w: int = 32
+    scale_frac: int = 20
+
+    def __post_init__(self) -> None:
+        if self.num_tx < 1 or self.num_tx > 16 or self.num_tx & (self.num_tx - 1):
+            raise ValueError(f"num_tx={self.num_tx} must be a power of two in 1..16")
+        if not 1 <= self.num_rx <= 64:
+            raise ValueError(f"num_rx={self.num_rx} not in 1..64")
+        if not 1 <= self.max_detections <= 65535:
+            raise ValueError(f"max_detections={self.max_detections} not in 1..65535")
+        _ = self.cfar  # validates the CFAR geometry
+
+    @property
+    def pow_w(self) -> int:
+        return nci.power_width(self.num_tx, self.num_rx)
+
+    @property
+    def cfar(self) -> cfar_2d.Cfar2dConfig:
+        return cfar_2d.Cfar2dConfig(
+            n_range=self.n_range, n_doppler=self.n_doppler, pow_w=self.pow_w, guard=self.guard,
+            train=self.train, kind=self.kind, blank_top=self.blank_top, scale_w=self.scale_w,
+            scale_frac=self.scale_frac)
+
+    @property
+    def frame_words(self) -> int:
+        return detect_records.frame_words(self.num_tx, self.num_rx, self.max_detections)
+
+    def scale(self) -> np.ndarray:
+        """Threshold scale table int64 ``(2PR+1,)`` for the configured Pfa."""
+        return cfar_2d.scale_table(self.cfar, self.pfa, self.num_tx * self.num_rx,
+                                   self.windowed)
+
+    def hdl_parameters(self) -> dict[str, int]:
+        """HDL parameters of ``detect_chain``."""
+        return dict(NUM_TX=self.num_tx, NUM_RX=self.num_rx, N_RANGE=self.n_range,
+                    N_DOPPLER=self.n_doppler, GUARD_R=self.guard[0], GUARD_D=self.guard[1],
+                    TRAIN_R=self.train[0], TRAIN_D=self.train[1], KIND=KIND_CODES[self.kind],
+                    BLANK_TOP=self.blank_top, SCALE_W=self.scale_w, SCALE_FRAC=self.scale_frac,
+                    MAX_DETECTIONS=self.max_detections)
+
+
+def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
+               ) -> tuple[list[detect_records.Record], cfar_2d.CfarCells]:
+    """All detections of one frame in output order (not truncated) and the CFAR cells.
+
+    words: uint32 ``(n_range * num_tx * n_doppler, num_rx)`` packed {Q, I}, (r, t, d) order.
+    """
+    w = np.asarray(words, dtype=np.uint32)
+    power = nci.nci(w, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+    cells = cfar_2d.cfar_2d(power, cfg.cfar, scale)
+    snap = w.reshape(cfg.n_range, cfg.num_tx, cfg.n_doppler, cfg.num_rx)
+    recs = []
+    for r, d in cfar_2d.output_order(cfg.cfar):
+        if cells.detect[r, d]:
+            recs.append(detect_records.Record(
+                range_bin=int(r), doppler_bin=int(d), power=int(cells.power[r, d]),
+                noise_sum=int(cells.train_sum[r, d]), cells=int(cells.count[r, d]),
+                snapshot=snap[r, :, d, :].copy()))
+    return recs, cells
+
+
+def detect_stream(frames: Iterable[np.ndarray], cfg: DetectConfig,
+                  scale: np.ndarray | None = None) -> list[np.ndarray]:
+    """Record streams of consecutive frames after reset: list of uint32
+    ``(frame_words, num_rx)``, one per frame (frame ids from 0, sticky truncation)."""
+    sc = cfg.scale() if scale is None else scale
+    out = []
+    sticky = False
+    for k, f in enumerate(frames):
+        recs, _ = detections(f, cfg, sc)
+        out.append(detect_records.encode_frame(recs, len(recs), cfg.num_tx, cfg.num_rx,
+                                               cfg.max_detections, frame_id=k, sticky=sticky))
+        sticky = sticky or len(recs) > cfg.max_detections
+    return out

@@ -1,0 +1,203 @@
+"""cocotb testbench of ``rtl/detect/cfar_2d.sv`` against ``model/cfar_2d.py``."""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.triggers import with_timeout
+from cocotbext.axi import AxiStreamFrame
+
+from model import cfar_2d as cm
+from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
+
+KIND_NAMES = cm.KINDS
+N_CHANNELS = 4  # virtual channels of the test maps (Gamma(4) noise)
+PFA = 1e-2      # high on purpose: every frame has noise detections as well as targets
+
+
+class TB(AxisTB):
+    def __init__(self, dut) -> None:
+        super().__init__(dut)
+        for comp in (self.source, self.sink):
+            comp.log.setLevel(logging.WARNING)
+        self.cfg = cm.Cfar2dConfig(
+            n_range=param("N_RANGE"), n_doppler=param("N_DOPPLER"), pow_w=param("POW_W"),
+            guard=(param("GUARD_R"), param("GUARD_D")), train=(param("TRAIN_R"), param("TRAIN_D")),
+            kind=KIND_NAMES[param("KIND")], blank_top=param("BLANK_TOP"))
+        self.scale = cm.scale_table(self.cfg, PFA, N_CHANNELS)
+        dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg)
+        self.in_bytes = (self.cfg.pow_w + 7) // 8
+        self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+
+    def random_map(self) -> np.ndarray:
+        """Gamma(4) noise (mean 4000) with a few strong cells, one at full scale."""
+        c = self.cfg
+        p = self.rng.gamma(N_CHANNELS, 1000.0, (c.n_range, c.n_doppler))
+        n_t = max(2, c.n_range * c.n_doppler // 64)
+        idx = self.rng.integers(0, c.n_range * c.n_doppler, n_t)
+        p.flat[idx] *= self.rng.uniform(5, 500, n_t)
+        p = np.minimum(p.astype(np.int64), (1 << c.pow_w) - 1)
+        p.flat[idx[0]] = (1 << c.pow_w) - 1
+        return p
+
+    async def send_map(self, power: np.ndarray) -> None:
+        for row in power:
+            data = b"".join(int(v).to_bytes(self.in_bytes, "little") for v in row)
+            await self.source.send(AxiStreamFrame(data))
+
+    async def recv_maps(self, n: int) -> list[list[tuple[int, int, int, int, int, bool]]]:
+        """n frames of output cells as (r, d, power, sum, count, detect) in stream order."""
+        c = self.cfg
+        bd = (c.n_doppler - 1).bit_length()
+        frames = []
+        # a hang fails after 20x the stall-free row time
+        limit = 20 * 10 * (c.n_doppler + 2 * c.pd) * (c.pr + 2)
+        for _ in range(n):
+            cells = []
+            for _r in range(c.n_range):
+                f = await with_timeout(self.sink.recv(compact=False), limit, "ns")
+                raw = bytes(f.tdata)
+                assert len(raw) == c.n_doppler * c.out_bytes, f"row of {len(raw)} bytes"
+                for i in range(c.n_doppler):
+                    v = int.from_bytes(raw[i * c.out_bytes:(i + 1) * c.out_bytes], "little")
+                    tu = f.tuser[i * c.out_bytes]
+                    cells.append((tu >> bd, tu & ((1 << bd) - 1), *cm.unpack_cell(v, c)))
+            frames.append(cells)
+        return frames
+
+    def check(self, got: list, sent: list[np.ndarray]) -> int:
+        """Compare every cell with the model; returns the number of detections."""
+        n_det = 0
+        order = cm.output_order(self.cfg)
+        for k, (cells, power) in enumerate(zip(got, sent, strict=True)):
+            exp = cm.cfar_2d(power, self.cfg, self.scale)
+            for i, (r, d, pw, s, cnt, det) in enumerate(cells):
+                er, ed = order[i]
+                want = (int(er), int(ed), int(exp.power[er, ed]), int(exp.train_sum[er, ed]),
+                        int(exp.count[er, ed]), bool(exp.detect[er, ed]))
+                assert (r, d, pw, s, cnt, det) == want, f"frame {k} cell {i}: got " \
+                    f"{(r, d, pw, s, cnt, det)}, expected {want}"
+            n_det += int(exp.detect.sum())
+        return n_det
+
+
+@cocotb.test()
+async def test_throughput(dut):
+    """Back-to-back frames without stalls; clocks per frame against the pass schedule."""
+    tb = TB(dut)
+    tb.start_meter()
+    await tb.reset()
+    c = tb.cfg
+    maps = [tb.random_map() for _ in range(3)]
+    rx = cocotb.start_soon(tb.recv_maps(3))
+    for m in maps:
+        await tb.send_map(m)
+    got = await rx
+    n_det = tb.check(got, maps)
+    span = tb.out_last - tb.in_first + 1
+    ideal = c.n_range * c.n_doppler + (c.n_range) * 2 * c.pd + (c.pr + 1) * c.n_doppler
+    tb.log.info("%d cells/frame, %d detections in 3 frames; %d clocks for 3 frames "
+                "(schedule %d per frame, %.3f cells per clock)", c.n_range * c.n_doppler,
+                n_det, span, ideal, 3 * c.n_range * c.n_doppler / span)
+    assert span <= 3 * ideal + 16, (span, ideal)
+    assert n_det > 0
+    assert int(dut.detection_count.value) == n_det
+    assert int(dut.frame_count.value) == 3 and int(dut.status_framing_error.value) == 0
+
+
+@cocotb.test()
+async def test_random_stalls(dut):
+    """Random and long TVALID gaps / TREADY stalls over several frames."""
+    tb = TB(dut)
+    await tb.reset()
+    n = tb.cfg.n_doppler
+    tb.set_idle_generator(random_pause(0.3, 1))
+    tb.set_backpressure_generator(bursty_pause(2, max_run=2 * n, busy_fraction=0.4))
+    maps = [tb.random_map() for _ in range(4)]
+    rx = cocotb.start_soon(tb.recv_maps(4))
+    for k, m in enumerate(maps):
+        if k == 2:
+            tb.set_idle_generator(bursty_pause(3, max_run=n))
+            tb.set_backpressure_generator(random_pause(0.5, 4))
+        await tb.send_map(m)
+    got = await rx
+    tb.check(got, maps)
+    assert int(dut.status_framing_error.value) == 0
+
+
+@cocotb.test()
+async def test_framing_error(dut):
+    """A misplaced TLAST is flagged (sticky); cells are still placed by count."""
+    tb = TB(dut)
+    await tb.reset()
+    m = tb.random_map()
+    b = tb.in_bytes
+    rx = cocotb.start_soon(tb.recv_maps(1))
+    data = b"".join(int(v).to_bytes(b, "little") for v in m.reshape(-1))
+    n = tb.cfg.n_doppler
+    await tb.source.send(AxiStreamFrame(data[:(n - 1) * b]))  # TLAST one cell early
+    await tb.source.send(AxiStreamFrame(data[(n - 1) * b:2 * n * b]))
+    for r in range(2, tb.cfg.n_range):
+        await tb.source.send(AxiStreamFrame(data[r * n * b:(r + 1) * n * b]))
+    got = await rx
+    tb.check(got, [m])
+    assert int(dut.status_framing_error.value) == 1
+
+
+@cocotb.test()
+async def test_reset_recovery(dut):
+    """Reset in mid-frame (while rows are tested and the output stalls), then clean frames."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.set_backpressure_generator(random_pause(0.5, 8))
+    cocotb.start_soon(tb.send_map(tb.random_map()))
+    await tb.cycles(tb.cfg.n_range * tb.cfg.n_doppler * 3 // 4)
+    tb.source.clear()
+    await tb.reset()
+    tb.sink.clear()
+    assert int(dut.frame_count.value) == 0 and int(dut.detection_count.value) == 0
+    assert int(dut.m_axis_tvalid.value) == 0
+    tb.set_idle_generator(random_pause(0.2, 9))
+    tb.set_backpressure_generator(no_pause())
+    maps = [tb.random_map() for _ in range(2)]
+    rx = cocotb.start_soon(tb.recv_maps(2))
+    for m in maps:
+        await tb.send_map(m)
+    got = await rx
+    tb.check(got, maps)
+
+
+# ------------------------------------------------------------------------------------------
+# pytest: one Verilator build per HDL parameter set
+PARAMS = [
+    # GO with top range bins blanked, asymmetric window
+    dict(N_RANGE=16, N_DOPPLER=32, POW_W=34, GUARD_R=1, GUARD_D=2, TRAIN_R=2, TRAIN_D=3, KIND=1,
+         BLANK_TOP=3),
+]
+LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
+    # smallest: 4 x 4 map, no guard, one training cell per side, CA
+    dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
+         BLANK_TOP=1),
+    # SO, Doppler window nearly the whole row (wrap on both sides)
+    dict(N_RANGE=16, N_DOPPLER=8, POW_W=38, GUARD_R=0, GUARD_D=1, TRAIN_R=3, TRAIN_D=2, KIND=2,
+         BLANK_TOP=0),
+    # paper-fpga: 64 x 256 map of 1 TX x 4 RX (34-bit power), the host's default window
+    dict(N_RANGE=64, N_DOPPLER=256, POW_W=34, GUARD_R=2, GUARD_D=2, TRAIN_R=4, TRAIN_D=8,
+         KIND=0, BLANK_TOP=0),
+]
+if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
+    PARAMS += LONG_PARAMS
+
+
+@pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: "_".join(
+    f"{k}{v}" for k, v in p.items()))
+def test_cfar_2d(parameters: dict) -> None:
+    here = Path(__file__).resolve().parent
+    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/cfar_2d.sv")]
+    run_cocotb("cfar_2d", sources, "test_cfar_2d", here, parameters=parameters)
