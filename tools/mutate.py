@@ -32,6 +32,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -342,10 +343,14 @@ def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
             left = timeout - (time.monotonic() - t0)
             cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
                    "no:cacheprovider", *stage]
+            # own process group: a timeout ends pytest and the simulator it started
+            proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
+                                    stderr=subprocess.DEVNULL, start_new_session=True)
             try:
-                proc = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True,
-                                      timeout=max(left, 1.0))
+                proc.wait(timeout=max(left, 1.0))
             except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
                 return "timeout", time.monotonic() - t0
             if proc.returncode != 0:
                 verdict = "killed"
