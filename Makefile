@@ -11,7 +11,8 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
-        gnn-eval clean help view bench-view test-detect-long
+        gnn-eval clean help view bench-view test-detect-long \
+        formal coverage mutate mutate-ci
 all: test
 
 help:
@@ -31,6 +32,9 @@ help:
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
 	@echo "make view            live browser view of the Table I replay at http://127.0.0.1:8050/"
 	@echo "make bench-view      browser display updates/s and memory of radar view (table)"
+	@echo "make formal          SymbiYosys proofs of formal/*.sby (k-induction, bmc, cover), table"
+	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
+	@echo "make mutate          mutation testing of rtl/ (MUTANTS=40 SEED=1), score per module"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
@@ -83,6 +87,24 @@ soak: $(STAMP)
 	$(RUN) python -m rtlsim.harness.soak --frames $(SOAK_FRAMES)
 
 include synth/synth.mk
+
+# Verification beyond simulation (README "Verification"): not part of `make test`, except
+# the tool sanity checks in tests/test_verif_tools.py (the fixed mutant subset runs there only
+# with MUTATE_CI=1: `make mutate-ci`).
+MUTANTS ?= 40
+SEED    ?= 1
+
+formal: $(STAMP)
+	$(RUN) python tools/formal.py
+
+coverage: $(STAMP)
+	$(RUN) python tools/coverage.py
+
+mutate: $(STAMP)
+	$(RUN) python tools/mutate.py -n $(MUTANTS) --seed $(SEED)
+
+mutate-ci: $(STAMP)
+	MUTATE_CI=1 $(RUN) pytest -q -n 0 tests/test_verif_tools.py
 
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import shutil
 import sys
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -21,6 +22,15 @@ SIM_BUILD = REPO / "sim_build"
 BUILD_ARGS = ("--assert", "-Wall", "-Wno-fatal", "-O3", "--x-assign", "fast",
               "--x-initial", "unique")
 """Verilator options of every build: assertions on, warnings shown (lint is `make lint`)."""
+COVERAGE_ARGS = ("--coverage-line", "--coverage-toggle")
+"""Extra Verilator options when the environment sets ``COVERAGE=1`` (``make coverage``):
+such builds go to ``<tag>_cov`` folders and each run's ``coverage.dat`` is kept under
+``sim_build/coverage/``."""
+
+
+def coverage_enabled() -> bool:
+    """True when ``COVERAGE=1``: build with line and toggle coverage."""
+    return os.environ.get("COVERAGE", "0") not in ("", "0")
 
 
 PCH_FIX = "CFG_CXXFLAGS_PCH_I=-include"
@@ -79,16 +89,29 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
 
     ensure_verilator_env()
     parameters = dict(parameters or {})
-    build_dir = SIM_BUILD / toplevel / param_tag(parameters)
+    cov = coverage_enabled()
+    build_dir = SIM_BUILD / toplevel / (param_tag(parameters) + ("_cov" if cov else ""))
     runner = get_runner("verilator")
     runner.build(sources=[str(s) for s in sources], hdl_toplevel=toplevel,
-                 parameters=parameters, build_dir=build_dir, build_args=list(BUILD_ARGS),
+                 parameters=parameters, build_dir=build_dir,
+                 build_args=list(BUILD_ARGS) + (list(COVERAGE_ARGS) if cov else []),
                  timescale=("1ns", "1ps"), waves=waves, always=False)
     env = {f"PARAM_{k}": str(v) for k, v in parameters.items()}
     env.update(extra_env or {})
-    return runner.test(test_module=test_module, hdl_toplevel=toplevel, build_dir=build_dir,
-                       test_dir=build_dir, parameters=parameters, extra_env=env,
-                       testcase=testcase, waves=waves, plusargs=["+verilator+rand+reset+2"])
+    if cov:  # cocotb reads COVERAGE too (Python coverage of the testbench): not wanted here
+        env.setdefault("COCOTB_USER_COVERAGE", "0")
+    try:
+        return runner.test(test_module=test_module, hdl_toplevel=toplevel, build_dir=build_dir,
+                           test_dir=build_dir, parameters=parameters, extra_env=env,
+                           testcase=testcase, waves=waves,
+                           plusargs=["+verilator+rand+reset+2"])
+    finally:
+        for dat in (build_dir / "coverage.dat", build_dir / "logs" / "coverage.dat"):
+            if cov and dat.exists():
+                name = f"{toplevel}__{build_dir.name}__{time.time_ns()}.dat"
+                keep = SIM_BUILD / "coverage" / name
+                keep.parent.mkdir(parents=True, exist_ok=True)
+                dat.replace(keep)
 
 
 def run_cocotb(toplevel: str, sources: Sequence[Path], test_module: str, test_dir: Path,

@@ -124,7 +124,9 @@ module axis_packetizer #(
     logic             damaged;   // a word of the packet was marked damaged upstream
   } desc_t;
 
-  desc_t desc_q [NUM_BANKS];
+  // (plain vectors: Yosys mis-reads an unpacked array of packed structs, formal/README)
+  localparam int DESC_W = 2 * LEN_W + SEQ_W + 32 + 4;  // $bits(desc_t)
+  logic [DESC_W-1:0] desc_q [NUM_BANKS];
   logic [NUM_BANKS-1:0] full_q;            // bank holds a complete packet not yet fully read
 
   // ---------------------------------------------------------------------------------------
@@ -306,6 +308,99 @@ module axis_packetizer #(
   assign framing_error_count  = framing_cnt_q;
   assign frame_count          = frame_cnt_q;
   assign packet_count         = packet_cnt_q;
+
+`ifdef FORMAL
+  // Formal properties (formal/axis_packetizer.sby). Sequence numbers and packet lengths:
+  // the open packet's position and sequence number stay inside the frame's packet plan;
+  // the full banks form a contiguous ring from rd_bank_q; every stored descriptor holds a
+  // sequence number < NPKT, LAST exactly on the frame's last packet, and (no drops) the
+  // planned length; consecutive full banks hold consecutive sequence numbers; a bank under
+  // input is never read; sticky flags. bmc adds the output framing: each packet is
+  // HEADER + its planned length words closed by TLAST, its header carries MAGIC and the
+  // expected sequence number.
+  logic                  f_past = 1'b0;
+  logic [SEQ_W-1:0]      f_out_seq = '0;
+  logic [LEN_W:0]        f_out_pos = '0;
+  logic [BANK_W:0]       f_nfull;
+  logic [BANK_W-1:0]     f_b, f_nb;
+  desc_t                 f_d, f_dn;
+  initial assume (rst);
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_out_seq <= '0;
+      f_out_pos <= '0;
+    end else if (m_axis_tvalid && m_axis_tready) begin
+      f_out_pos <= m_axis_tlast ? '0 : f_out_pos + 1'b1;
+      if (m_axis_tlast) f_out_seq <= (f_out_seq == SEQ_W'(NPKT - 1)) ? '0 : f_out_seq + 1'b1;
+    end
+  end
+  always_comb begin
+    f_nfull = '0;
+    for (int i = 0; i < NUM_BANKS; i++) f_nfull = f_nfull + (BANK_W+1)'(full_q[i]);
+  end
+  always_comb begin
+    f_b  = '0;
+    f_nb = '0;
+    f_d  = '0;
+    f_dn = '0;
+    if (f_past && !rst) begin
+      assume (frame_q != '1);
+      assert (seq_q <= SEQ_W'(NPKT - 1));
+      assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
+      if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));
+      if (INPUT_BACKPRESSURE) assert (LEN_W'(pos_q) == wr_cnt_q && wr_drop_q == '0 && !ovf_q);
+      // ring of full banks from the read bank to the write bank
+      assert ((BANK_W+1)'(BANK_W'(wr_bank_q - rd_bank_q)) == f_nfull ||
+              (wr_bank_q == rd_bank_q && f_nfull == (BANK_W+1)'(NUM_BANKS)));
+      if (!full_q[rd_bank_q]) assert (rd_idx_q == '0 && !hdr_sent_q);
+      for (int i = 0; i < NUM_BANKS; i++) begin
+        f_b  = rd_bank_q + BANK_W'(i);
+        f_nb = f_b + 1'b1;
+        f_d  = desc_q[f_b];
+        f_dn = desc_q[f_nb];
+        if (full_q[f_b]) begin
+          assert (f_d.seq <= SEQ_W'(NPKT - 1));
+          assert (f_d.last == (f_d.seq == SEQ_W'(NPKT - 1)));
+          assert (f_d.len != '0 && f_d.len <= LEN_W'(PACKET_WORDS));
+          if (INPUT_BACKPRESSURE) begin
+            assert (f_d.drops == '0);
+            assert (f_d.len == (f_d.last ? LEN_W'(LAST_LEN) : LEN_W'(PACKET_WORDS)));
+            // the next packet (stored or open) carries the next sequence number
+            if (full_q[f_nb] && f_nb != rd_bank_q)
+              assert (f_dn.seq == (f_d.last ? '0 : f_d.seq + 1'b1));
+            if (f_nb == wr_bank_q)
+              assert (seq_q == (f_d.last ? '0 : f_d.seq + 1'b1));
+          end
+        end
+      end
+      if (full_q[rd_bank_q]) assert (LEN_W'(rd_idx_q) < rd_desc.len);
+      if (store) assert (!full_q[wr_bank_q]);
+`ifdef F_OUTPUT_FRAMING
+      if (m_axis_tvalid) begin
+        if (f_out_pos == '0 && HEADER) begin
+          assert (m_axis_tdata[31:24] == MAGIC && m_axis_tdata[15:4] == f_out_seq);
+          assert (!m_axis_tlast);
+        end
+        if (INPUT_BACKPRESSURE)
+          assert (m_axis_tlast == (f_out_pos == (LEN_W+1)'(HEADER) - 1'b1 +
+                   ((f_out_seq == SEQ_W'(NPKT - 1)) ? (LEN_W+1)'(LAST_LEN) :
+                                                       (LEN_W+1)'(PACKET_WORDS))));
+      end
+`endif
+    end
+  end
+  always_ff @(posedge clk) if (f_past && !$past(rst) && !rst) begin
+    if ($past(ovf_q)) assert (ovf_q);
+    if ($past(framing_q)) assert (framing_q);
+  end
+  always_comb if (f_past && !rst) begin
+    cover (f_nfull == (BANK_W+1)'(NUM_BANKS));
+    cover (m_axis_tvalid && m_axis_tlast && !m_axis_tready && f_out_seq == SEQ_W'(NPKT - 1));
+    cover (frame_cnt_q == 32'd2);
+    cover (framing_q || ovf_q);
+  end
+`endif
 
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(NUM_RX*32 + 2), .ASSUME(1'b1)) u_chk_s_axis (

@@ -65,7 +65,45 @@ module buf_out_fifo #(
     end
   end
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // Formal properties (formal/buf_out_fifo.sby; also checked inside every parent's proof).
+  // Credit: stored + in flight == issued - popped, never above DEPTH; pointers differ by the
+  // count; the output port obeys AXI-Stream (rtl/common/axis_checker.sv).
+  logic f_past = 1'b0;
+  logic [7:0] f_issued = '0, f_popped = '0;
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_issued <= '0;
+      f_popped <= '0;
+    end else begin
+      f_issued <= f_issued + 8'(issue);
+      f_popped <= f_popped + 8'(pop);
+    end
+  end
+`ifdef F_TOP_BUF_OUT_FIFO
+  initial assume (rst);
+  always_comb if (!rst) assume (!issue || can_issue);
+`endif
+  always_comb if (f_past && !rst) begin
+    assert (!issue || can_issue);
+    assert (count_q <= (PTR_W+1)'(DEPTH));
+    assert (credit_q == count_q + (PTR_W+1)'(inflight_q));
+    assert (credit_q == (PTR_W+1)'(f_issued - f_popped));
+    assert (PTR_W'(wr_ptr_q - rd_ptr_q) == count_q[PTR_W-1:0]);
+  end
+  always_comb if (f_past && !rst) begin
+    cover (count_q == (PTR_W+1)'(DEPTH));
+    cover (pop && push && count_q == (PTR_W+1)'(1));
+  end
+  axis_checker #(.PAYLOAD_W(WIDTH)) f_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready), .payload(m_axis_tdata));
+`endif
+
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   always_ff @(posedge clk) begin
     if (!rst) begin
       assert (!(issue && !can_issue)) else $error("buf_out_fifo: read issued without credit");

@@ -225,7 +225,73 @@ module chirp_pingpong #(
     .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
     .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // Formal properties (formal/chirp_pingpong.sby). Chirps never mix: a bank holding an
+  // unread chirp is never written, only a full bank is read, banks are filled and drained in
+  // turn, a committed chirp is N_RANGE kept samples written at positions 0..N_RANGE-1;
+  // chirps committed - chirps read == full banks; with ADC_BACKPRESSURE nothing is dropped;
+  // status flags sticky. bmc adds the output framing (TLAST every N_RANGE words, TUSER only
+  // on a chirp's first word), which sits in the output FIFO.
+  logic                f_past = 1'b0;
+  logic [N_RANGE-1:0]  f_wmask;        // positions written of the chirp being written
+  logic [7:0]          f_commits = '0;
+  logic [POS_W-1:0]    f_out_pos = '0;
+  initial assume (rst);
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_wmask   <= '0;
+      f_commits <= '0;
+      f_out_pos <= '0;
+    end else begin
+      if (ram_wr_en) f_wmask <= (first ? '0 : f_wmask) | (N_RANGE'(1) << pos_q);
+      else if (beat && first) f_wmask <= '0;
+      if (commit) f_commits <= f_commits + 8'd1;
+      if (m_axis_tvalid && m_axis_tready) f_out_pos <= m_axis_tlast ? '0 : f_out_pos + 1'b1;
+    end
+  end
+  always_comb if (f_past && !rst) begin
+    assume (chirps_out_q != '1);
+    assert ({1'b0, pos_q} <= (POS_W+1)'(N_RANGE - 1));
+    if (ram_wr_en) assert (!full_q[wr_bank_q]);
+    if (!skip_q && !discard_q && pos_q != '0) assert (!full_q[wr_bank_q]);
+    if (issue) assert (full_q[rd_bank_q]);
+    if (wr_bank_q == rd_bank_q) assert (full_q[0] == full_q[1]);
+    else assert (full_q[rd_bank_q] && !full_q[wr_bank_q]);
+    if (!full_q[rd_bank_q]) assert (rd_idx_q == '0);
+    if (commit) assert ((f_wmask | (N_RANGE'(1) << pos_q)) == '1);
+    // kept samples of the open chirp are exactly the positions below pos_q
+    if (!skip_q && !discard_q && pos_q != '0)
+      assert (f_wmask == (N_RANGE'(1) << pos_q) - 1'b1);
+    assert (8'(f_commits - 8'(chirps_out_q)) == 8'(full_q[0]) + 8'(full_q[1]));
+    if (ADC_BACKPRESSURE) begin
+      if (beat) assert (keep || skip_q);
+      assert (drop_cnt_q == '0 && !ovf_q);
+      if (pos_q != '0 && !skip_q) assert (!discard_q);
+    end
+`ifdef F_OUTPUT_FRAMING
+    if (m_axis_tvalid) begin
+      assert (m_axis_tlast == (f_out_pos == POS_W'(N_RANGE - 1)));
+      if (f_out_pos != '0) assert (m_axis_tuser == 2'b00);
+    end
+`endif
+  end
+  always_ff @(posedge clk) if (f_past && !$past(rst) && !rst) begin
+    if ($past(ovf_q)) assert (ovf_q);
+    if ($past(framing_q)) assert (framing_q);
+  end
+  always_comb if (f_past && !rst) begin
+    cover (full_q == 2'b11);
+    cover (m_axis_tvalid && m_axis_tlast && !m_axis_tready);
+    cover (chirps_out_q == 32'd1 && framing_q);
+    cover (chirps_out_q == 32'd1 && (ovf_q || ADC_BACKPRESSURE));
+  end
+`endif
+
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   // block invariant: with ADC_BACKPRESSURE nothing is ever dropped
   always_ff @(posedge clk) begin
     if (!rst && ADC_BACKPRESSURE && beat) assert (keep || skip_q)

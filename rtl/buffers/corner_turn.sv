@@ -253,7 +253,68 @@ module corner_turn #(
     .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
     .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
 
-`ifndef SYNTHESIS
+`ifdef FORMAL
+  // Formal properties (formal/corner_turn.sby). In place: a slot is written only after the
+  // previous frame's word in it was read (f_pend: written, not yet read; write never hits an
+  // unread slot, read never hits an unwritten one), the writer never overtakes the reader,
+  // reader and writer agree on the frame's rotation; no beat created or lost (words read ==
+  // words written, frame by frame); output TLAST every N_DOPPLER words, TUSER on word 0
+  // (bounded: those sit in the output FIFO).
+  logic             f_past = 1'b0;
+  logic [(1<<B)-1:0] f_pend = '0;
+  logic [B-1:0]     f_out_pos = '0;
+  logic [7:0]       f_words_in = '0, f_words_out = '0;
+  initial assume (rst);
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_pend      <= '0;
+      f_out_pos   <= '0;
+      f_words_in  <= '0;
+      f_words_out <= '0;
+    end else begin
+      if (rd_issue) f_pend[ram_rd_addr] <= 1'b0;
+      if (wr_beat) f_pend[ram_wr_addr] <= 1'b1;
+      if (m_axis_tvalid && m_axis_tready) f_out_pos <= f_out_pos + 1'b1;
+      f_words_in  <= f_words_in + 8'(wr_beat);
+      f_words_out <= f_words_out + 8'(rd_issue);
+    end
+  end
+  always_comb if (f_past && !rst) begin
+    if (wr_beat) assert (!f_pend[ram_wr_addr] || (rd_issue && ram_rd_addr == ram_wr_addr));
+    if (rd_issue) assert (f_pend[ram_rd_addr]);
+    if (wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q);
+    assert (!(pending_q && rd_active_q));
+    if (!rd_active_q) assert (rd_cnt_q == '0);
+    if (rd_active_q) assert (rd_shift_q == wr_shift_q && wr_cnt_q <= rd_cnt_q);
+    if (pending_q) assert (wr_cnt_q == '0);
+    assert ({1'b0, wr_shift_q} < (SH_W+1)'(B) && {1'b0, rd_shift_q} < (SH_W+1)'(B));
+    for (int j = 0; j < (1 << B); j++) begin
+      assert (f_pend[rotl(B'(j), wr_shift_q)] ==
+              (pending_q || (rd_active_q && B'(j) >= rd_cnt_q) || B'(j) < wr_cnt_q));
+    end
+    // words written - words read == words stored unread (no word created or lost)
+    assert (8'(f_words_in - f_words_out) ==
+            8'(wr_cnt_q) + (pending_q ? 8'(1 << B) : 8'd0) +
+            (rd_active_q ? 8'(1 << B) - 8'(rd_cnt_q) : 8'd0));
+`ifdef F_OUTPUT_FRAMING
+    if (m_axis_tvalid) begin
+      assert (m_axis_tlast == (f_out_pos[BD-1:0] == '1));
+      assert (m_axis_tuser[0] == (f_out_pos == '0));
+    end
+`endif
+  end
+  always_comb if (f_past && !rst) begin
+    cover (frames_out == 32'd2);
+    cover (wr_beat && rd_active_q && wr_cnt_q == rd_cnt_q - 1'b1);  // writer right behind
+    cover (m_axis_tvalid && m_axis_tlast && m_axis_tuser[0] == 1'b0 && !m_axis_tready);
+  end
+`endif
+
+`ifdef FORMAL
+  // (the FORMAL block above states this property for the proof)
+`elsif SYNTHESIS
+`else
   // block invariant (in place): never write a slot of the frame being read before reading it
   always_ff @(posedge clk) begin
     if (!rst && wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)

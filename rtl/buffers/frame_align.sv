@@ -158,6 +158,66 @@ module frame_align #(
   assign chirps_filled    = fill_cnt_q;
   assign chirps_discarded = disc_cnt_q;
 
+`ifdef FORMAL
+  // Formal properties (formal/frame_align.sby). Output framing: every output chirp is
+  // N_RANGE words with TLAST on the last, every output frame FRAME_CHIRPS chirps; PASS moves
+  // beats 1:1 (none created or lost), FILL emits zeros only and runs to the frame's end,
+  // DISCARD emits nothing; the fill, damage and discard counters count exactly those events.
+  logic        f_past = 1'b0;
+  logic [31:0] f_fill_chirps = '0, f_dmg_frames = '0, f_disc_chirps = '0;
+  logic [SMP_W-1:0] f_in_pos = '0;  // input sample index: the input contract is whole chirps
+  initial assume (rst);
+  always_comb if (!rst && s_axis_tvalid) assume (s_axis_tlast == (f_in_pos == SMP_W'(N_RANGE - 1)));
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) f_in_pos <= '0;
+    else if (in_beat) f_in_pos <= s_axis_tlast ? '0 : f_in_pos + 1'b1;
+    if (rst) begin
+      f_fill_chirps <= '0;
+      f_dmg_frames  <= '0;
+      f_disc_chirps <= '0;
+    end else begin
+      if (state_q == FILL && out_beat && chirp_end) f_fill_chirps <= f_fill_chirps + 1;
+      if (frame_done && frame_done_damaged) f_dmg_frames <= f_dmg_frames + 1;
+      if (state_q == DISCARD && in_beat && s_axis_tlast) f_disc_chirps <= f_disc_chirps + 1;
+    end
+  end
+  always_comb if (f_past && !rst) begin
+    assume (f_fill_chirps != '1 && f_disc_chirps != '1 && f_dmg_frames != '1);  // no saturation
+    assert (state_q == PASS || state_q == FILL || state_q == DISCARD);
+    assert (smp_q <= SMP_W'(N_RANGE - 1));
+    assert (chirp_q <= CHP_W'(FRAME_CHIRPS - 1));
+    assert (m_axis_tlast == (smp_q == SMP_W'(N_RANGE - 1)));
+    if (state_q == PASS) assert (in_beat == out_beat);
+    if (state_q == FILL) assert (m_axis_tvalid && m_axis_tdata == '0 && !s_axis_tready);
+    if (state_q == DISCARD) assert (!m_axis_tvalid);
+    // input and output chirps stay aligned: PASS forwards whole chirps
+    assert (in_first_q == (f_in_pos == '0));
+    if (state_q == PASS) assert (smp_q == f_in_pos);
+    if (state_q == FILL) assert (in_first_q);
+    if (state_q == DISCARD) assert (smp_q == '0 && chirp_q == '0);
+    // a clean frame start where no frame has begun is forwarded: no fill, no discard
+    if (state_q == PASS && at_first && sof && !gap && !frame_begun)
+      assert (!need_fill && !need_discard);
+    // a clean chirp inside a begun frame is forwarded too
+    if (state_q == PASS && at_first && !sof && !gap && frame_begun)
+      assert (!need_fill && !need_discard);
+    assert (fill_cnt_q == f_fill_chirps);
+    assert (dmg_cnt_q == f_dmg_frames);
+    assert (disc_cnt_q == f_disc_chirps);
+  end
+  always_ff @(posedge clk) if (f_past && !$past(rst) && !rst) begin
+    // a fill runs to the end of its frame
+    if ($past(state_q == FILL) && !$past(out_beat && frame_end)) assert (state_q == FILL);
+  end
+  always_comb if (f_past && !rst) begin
+    cover (frame_done && !frame_done_damaged);
+    cover (frame_done && frame_done_damaged && discard_q);
+    cover (state_q == DISCARD && disc_stop);
+    cover (chirps_discarded == 32'd1 && frames_damaged == 32'd1 && frame_done);
+  end
+`endif
+
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(WORD_W + 3), .ASSUME(1'b1)) u_chk_s_axis (
     .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),

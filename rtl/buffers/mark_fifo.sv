@@ -70,6 +70,49 @@ module mark_fifo #(
   assign overflow  = ovf_q;
   assign underflow = unf_q;
 
+`ifdef FORMAL
+  // Formal properties (formal/mark_fifo.sby). Occupancy: count == accepted pushes - accepted
+  // pops (modulo the counter width), never above DEPTH; slots past the count hold 0; head
+  // order; overflow/underflow sticky and set exactly on a refused push/pop.
+  logic          f_past = 1'b0;
+  logic [CW-1:0] f_pushes = '0, f_pops = '0;
+  initial assume (rst);
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_pushes <= '0;
+      f_pops   <= '0;
+    end else begin
+      f_pushes <= f_pushes + CW'(do_push);
+      f_pops   <= f_pops + CW'(do_pop);
+    end
+  end
+  always_comb if (f_past && !rst) begin
+    assert (cnt_q <= CW'(DEPTH));
+    assert (cnt_q == CW'(f_pushes - f_pops));
+    for (int i = 0; i < DEPTH; i++) if (CW'(i) >= cnt_q) assert (q[i] == '0);
+  end
+  always_ff @(posedge clk) if (f_past && $past(rst)) begin
+    assert (cnt_q == '0 && !ovf_q && !unf_q);  // reset clears the queue and both flags
+  end
+  always_ff @(posedge clk) if (f_past && !$past(rst) && !rst) begin
+    // sticky flags, and set only by a refused operation
+    if ($past(ovf_q)) assert (ovf_q);
+    if ($past(unf_q)) assert (unf_q);
+    assert (ovf_q == ($past(ovf_q) || $past(push && full && !pop)));
+    assert (unf_q == ($past(unf_q) || $past(pop && empty)));
+    // a push into an empty queue (or one holding a single popped mark) is the next head
+    if ($past(push && (cnt_q == '0 || (cnt_q == CW'(1) && pop))))
+      assert (head == $past(push_data));
+    // a pop exposes the second-oldest mark
+    if ($past(pop && cnt_q >= CW'(2))) assert (head == $past(q[1]));
+  end
+  always_comb if (f_past && !rst) begin
+    cover (full);
+    cover (ovf_q && unf_q && cnt_q == CW'(1));
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

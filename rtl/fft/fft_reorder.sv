@@ -91,6 +91,71 @@ module fft_reorder #(
   assign m_axis_tuser  = m_user_q;
   assign m_axis_tlast  = m_last_q;
   assign m_axis_tvalid = m_valid_q;
+
+  // AXI4-Stream protocol on the output port (rtl/common/axis_checker.sv)
+  axis_checker #(.PAYLOAD_W(WIDTH + 1 + LOG2N)) u_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
+    .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
+
+`ifdef FORMAL
+  // Formal properties (formal/fft_reorder.sby). Bank reuse: a slot is written only when it
+  // holds no unread sample (f_pend: written, not yet read) and read only when it holds one;
+  // the reader takes the banks in the order they were filled; TLAST/TUSER positions.
+  logic         f_past = 1'b0;
+  logic [2*N-1:0] f_pend = '0;
+  logic [LOG2N-1:0] f_wpos = '0;   // write positions arrive in pipeline order 0..N-1
+  logic             f_written, f_unread;
+  function automatic logic [LOG2N-1:0] f_bitrev(input logic [LOG2N-1:0] x);
+    for (int b = 0; b < LOG2N; b++) f_bitrev[b] = x[LOG2N-1-b];
+  endfunction
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_pend <= '0;
+      f_wpos <= '0;
+    end else begin
+      if (pop) f_pend[{rb_q, rd_ptr_q}] <= 1'b0;
+      if (wr_en) begin
+        f_pend[{wb_q, wr_addr}] <= 1'b1;
+        f_wpos <= f_wpos + 1'b1;
+      end
+    end
+  end
+`ifdef F_TOP_FFT_REORDER
+  initial assume (rst);
+  always_comb if (!rst) begin
+    assume (!wr_en || wr_ok);
+    assume (wr_pos == f_wpos);
+  end
+`endif
+  always_comb begin
+    f_written = 1'b0;
+    f_unread  = 1'b0;
+    if (f_past && !rst) begin
+    if (wr_en) assert (!f_pend[{wb_q, wr_addr}] || (pop && {rb_q, rd_ptr_q} == {wb_q, wr_addr}));
+    if (pop) assert (f_pend[{rb_q, rd_ptr_q}]);
+    // bank order invariants
+    if (wb_q != rb_q) assert (!full_q[wb_q]);
+    if (wb_q == rb_q) assert (full_q[0] == full_q[1]);
+    if (!full_q[rb_q]) assert (!full_q[!rb_q] && rd_ptr_q == '0 && wb_q == rb_q);
+    if (m_axis_tvalid) assert (m_axis_tlast == (m_axis_tuser == LOG2N'(N - 1)));
+    // inductive form of the bank reuse rule: which slots hold unread samples
+    for (int b = 0; b < 2; b++) begin
+      for (int i = 0; i < N; i++) begin
+        f_written = (b == int'(wb_q)) && (f_bitrev(LOG2N'(i)) < f_wpos);
+        f_unread  = full_q[b] && !(b == int'(rb_q) && LOG2N'(i) < rd_ptr_q);
+        assert (f_pend[b*N + i] == (f_written || f_unread));
+        if (f_written && full_q[b]) assert (b == int'(rb_q) && LOG2N'(i) < rd_ptr_q);
+      end
+    end
+  end
+  end
+  always_comb if (f_past && !rst) begin
+    cover (full_q == 2'b11);
+    cover (m_axis_tvalid && m_axis_tlast && !m_axis_tready);
+    cover (wr_en && full_q[wb_q]);   // a slot of the bank under read is reused
+  end
+`endif
 endmodule
 
 `default_nettype wire

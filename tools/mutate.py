@@ -1,0 +1,510 @@
+"""Mutation testing of the RTL: apply one source-level bug at a time, run the testbenches
+that cover the mutated module, and count the mutants the regression kills.
+
+Operators (one textual change on one line of ``rtl/**/*.sv``):
+  rel      relational swap (== <-> !=, < <-> <=, > <-> >=)
+  arith    + <-> -
+  logic    && <-> ||
+  drop     a term dropped from an && / || condition
+  neg      a ! dropped
+  const    off-by-one constant (``X - 1`` -> ``X``, ``- 2``; ``1'b1`` <-> ``1'b0``; '0 <-> '1)
+  noreset  a register left out of the reset branch
+  sticky   a sticky flag made non-sticky (``if (c) f <= 1'b1;`` -> ``f <= c;``)
+  swap     two fields of a concatenation swapped
+
+Lines inside ``ifdef FORMAL`` / ``ifndef SYNTHESIS`` blocks, parameter checks, comments and
+axis_checker instances are never mutated (they are checks, not design). Each mutant runs in
+its own copy of the tree (``rtl``, ``tb``, ``host``, ``model`` copied into a temporary
+folder), so the worktree is never modified and runs are parallel-safe. The sample is
+deterministic for a given ``--seed``.
+
+    python tools/mutate.py --list frame_align          # every candidate mutant
+    python tools/mutate.py -n 40 --seed 1              # 40 mutants spread over modules
+    python tools/mutate.py --ci                        # the fixed CI subset
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import json
+import os
+import random
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+RTL = REPO / "rtl"
+OUT = REPO / "out" / "mutate"
+COPY_DIRS = tuple(d for d in ("rtl", "tb", "host", "model", "rtlsim", "radar")
+                  if (REPO / d).is_dir())
+
+# module -> pytest stages, cheapest first: a mutant is killed by the first stage that fails
+# (stage 1 is the smallest parameter set of the most specific testbench), and survives only
+# if every stage passes.
+_Q_FA = "tb/frame_align/test_frame_align.py::test_frame_align[rx2_n4]"
+_Q_CP = ("tb/chirp_pingpong/test_chirp_pingpong.py::"
+         "test_chirp_pingpong[NUM_RX1_N_RANGE8_ADC_BACKPRESSURE0]")
+_Q_CT = "tb/corner_turn/test_corner_turn.py::test_corner_turn[NUM_TX1_NUM_RX1_N_RANGE4_N_DOPPLER8]"
+_Q_PK = ("tb/axis_packetizer/test_axis_packetizer.py::test_axis_packetizer[NUM_RX1_PACKET_WORDS8_"
+         "FRAME_WORDS52_NUM_BANKS4_HEADER1_INPUT_BACKPRESSURE0_TLAST_PERIOD13]")
+_Q_FFT = ("tb/fft_axis/test_fft_axis.py::"
+          "test_fft_axis[N16_NUM_CH2_DATA_W12_GUARD_W2_WINDOW1_SCALE_SCH10]")
+_FFT = [[_Q_FFT], ["tb/fft_axis/test_fft_axis.py"]]
+TESTS: dict[str, list[list[str]]] = {
+    "frame_align": [[_Q_FA], ["tb/frame_align"]],
+    "chirp_pingpong": [[_Q_CP], ["tb/chirp_pingpong", "-k", "test_chirp_pingpong"]],
+    "corner_turn": [[_Q_CT], ["tb/corner_turn", "-k", "test_corner_turn"]],
+    "axis_packetizer": [[_Q_PK], ["tb/axis_packetizer", "-k", "test_axis_packetizer"]],
+    "buf_out_fifo": [[_Q_CP, _Q_CT], ["tb/chirp_pingpong", "tb/corner_turn",
+                                      "tb/axis_packetizer"]],
+    "buf_sdp_ram": [[_Q_CP, _Q_CT], ["tb/chirp_pingpong", "tb/corner_turn"]],
+    "mark_fifo": [["tb/radar_pipeline"]],
+    "radar_pipeline": [["tb/radar_pipeline"]],
+    "fft_axis": _FFT,
+    "fft_reorder": _FFT,
+    "fft_sdf_bf": _FFT,
+    "fft_twiddle": _FFT,
+    "fft_window": _FFT,
+}
+
+# The fixed CI subset (tests/test_mutate_ci.py): realistic one-line bugs in the cheapest
+# testbenches; every one must be killed.
+# (module, operator, text of the mutated line): robust to line moves.
+CI_MUTANTS = (
+    ("frame_align", "const", "smp_q == SMP_W'(N_RANGE - 2)"),  # chirp end one sample early
+    ("frame_align", "neg", "discard_q <= gap && sof;"),        # no discard after a gap
+)
+
+
+def ci_mutants() -> list[Mutant]:
+    """The fixed CI subset as mutants (fails loudly if the RTL no longer has one)."""
+    out = []
+    for module, op, text in CI_MUTANTS:
+        found = [m for m in candidates(module) if m.op == op and text in m.after]
+        if not found:
+            raise SystemExit(f"error: CI mutant {module}/{op} '{text}' no longer exists")
+        out.append(found[0])
+    return out
+
+
+@dataclass(frozen=True)
+class Mutant:
+    """One single-line change of one RTL file."""
+
+    module: str
+    op: str
+    index: int      # index among the module's mutants of this operator
+    path: str       # relative to the repository
+    line: int       # 1-based
+    before: str
+    after: str
+
+    @property
+    def ident(self) -> str:
+        return f"{self.module}:{self.op}:{self.index}"
+
+    def diff(self) -> str:
+        return "".join(difflib.unified_diff(
+            [self.before + "\n"], [self.after + "\n"],
+            f"a/{self.path}:{self.line}", f"b/{self.path}:{self.line}", n=0))
+
+
+# ----------------------------------------------------------------------------------------
+# Candidate generation
+
+def _design_lines(text: str) -> Iterator[tuple[int, str]]:
+    """(0-based index, line) of the lines that are design (not checks or comments)."""
+    skip_depth = 0
+    in_checker = False
+    in_fatal = False
+    for i, line in enumerate(text.splitlines()):
+        s = line.strip()
+        if re.match(r"`ifdef\s+FORMAL|`ifndef\s+SYNTHESIS", s):
+            skip_depth += 1
+            continue
+        if skip_depth:
+            if s.startswith("`ifdef") or s.startswith("`ifndef"):
+                skip_depth += 1
+            elif s.startswith("`endif"):
+                skip_depth -= 1
+            continue
+        if s.startswith("axis_checker"):
+            in_checker = True
+        if in_checker:
+            if s.endswith(");"):
+                in_checker = False
+            continue
+        if "g_bad_" in s or "$fatal" in s:
+            in_fatal = "$fatal" not in s or not s.endswith(");")
+            continue
+        if in_fatal:
+            in_fatal = not s.endswith(");")
+            continue
+        if not s or s.startswith("//") or s.startswith("`") or s.startswith("parameter") \
+                or s.startswith("localparam") or s.startswith("input") \
+                or s.startswith("output") or s.startswith("module") or s.startswith("import"):
+            continue
+        yield i, line
+
+
+def _code_part(line: str) -> tuple[str, str]:
+    """Split off a trailing // comment."""
+    k = line.find("//")
+    return (line, "") if k < 0 else (line[:k], line[k:])
+
+
+def _expr_spans(code: str) -> list[tuple[int, int]]:
+    """Character spans of expressions on a line: the right-hand side of an assignment and
+    the condition of an ``if``; the ``<=`` of a non-blocking assignment is excluded."""
+    spans: list[tuple[int, int]] = []
+    m = re.search(r"\bif\s*\(", code)
+    if m:
+        depth, j = 1, m.end()
+        while j < len(code) and depth:
+            depth += {"(": 1, ")": -1}.get(code[j], 0)
+            j += 1
+        spans.append((m.end(), j - 1))
+        rest = j
+    else:
+        rest = 0
+    m2 = re.search(r"(<=|(?<![=!<>])=(?!=))", code[rest:])
+    if m2:
+        spans.append((rest + m2.end(), len(code)))
+    return spans
+
+
+_REL = {"==": "!=", "!=": "==", "<=": "<", "<": "<=", ">=": ">", ">": ">="}
+_REL_RE = re.compile(r"==|!=|<=|>=|(?<![<>])<(?![<=])|(?<![<>-])>(?![>=])")
+
+
+def _ops_in(code: str, spans, regex: re.Pattern[str]) -> Iterator[re.Match[str]]:
+    for a, b in spans:
+        yield from regex.finditer(code, a, b)
+
+
+def candidates(module: str) -> list[Mutant]:
+    """Every mutant of ``rtl/**/<module>.sv``, in a fixed order."""
+    files = sorted(RTL.glob(f"**/{module}.sv"))
+    if not files:
+        raise SystemExit(f"error: no rtl/**/{module}.sv")
+    path = files[0]
+    rel = str(path.relative_to(REPO))
+    text = path.read_text()
+    lines = text.splitlines()
+    found: dict[str, list[tuple[int, str]]] = {}
+
+    def balance(t: str) -> tuple[int, int, int]:
+        return t.count("(") - t.count(")"), t.count("[") - t.count("]"), \
+            t.count("{") - t.count("}")
+
+    def add(op: str, i: int, new: str) -> None:
+        if new != lines[i] and balance(new) == balance(lines[i]):
+            found.setdefault(op, []).append((i, new))
+
+    reset_block: set[int] = set()
+    for i, line in _design_lines(text):
+        code, comment = _code_part(line)
+        spans = _expr_spans(code)
+        # relational
+        for m in _ops_in(code, spans, _REL_RE):
+            add("rel", i, code[:m.start()] + _REL[m.group()] + code[m.end():] + comment)
+        # arithmetic (not in bit ranges [a-1:0] or widths)
+        for m in _ops_in(code, spans, re.compile(r"(?<=[\w)\]']) ([+-]) (?=[\w(])")):
+            before = code[:m.start()]
+            if before.count("[") > before.count("]"):
+                continue
+            new = "-" if m.group(1) == "+" else "+"
+            add("arith", i, code[:m.start(1)] + new + code[m.end(1):] + comment)
+        # logic
+        for m in _ops_in(code, spans, re.compile(r"&&|\|\|")):
+            new = "||" if m.group() == "&&" else "&&"
+            add("logic", i, code[:m.start()] + new + code[m.end():] + comment)
+        # dropped term: "a && b" -> "a" (the operand after the operator, up to the next
+        # operator or closing paren at the same depth)
+        for m in _ops_in(code, spans, re.compile(r"\s(&&|\|\|)\s")):
+            j, depth = m.end(), 0
+            while j < len(code):
+                ch = code[j]
+                if ch in "([{":
+                    depth += 1
+                elif ch in ")]}":
+                    if depth == 0:
+                        break
+                    depth -= 1
+                elif depth == 0 and (code.startswith("&&", j) or code.startswith("||", j)
+                                     or ch in ";?:,"):
+                    break
+                j += 1
+            tail = code[j:]
+            if tail.startswith("&&") or tail.startswith("||"):
+                tail = " " + tail
+            add("drop", i, code[:m.start()].rstrip() + tail.lstrip(" ") if tail.startswith((
+                ")", ";", "?", ":", ",")) else code[:m.start()] + tail + comment)
+        # negation dropped
+        for m in _ops_in(code, spans, re.compile(r"!(?!=)")):
+            add("neg", i, code[:m.start()] + code[m.end():] + comment)
+        # constants
+        for m in _ops_in(code, spans, re.compile(r"- 1\b(?!')|- 32'd1|-\s*1'b1")):
+            add("const", i, code[:m.start()] + "- 2" + code[m.end():] + comment)
+            add("const", i, code[:m.start()] + "- 0" + code[m.end():] + comment)
+        for m in _ops_in(code, spans, re.compile(r"1'b[01]")):
+            new = "1'b0" if m.group() == "1'b1" else "1'b1"
+            add("const", i, code[:m.start()] + new + code[m.end():] + comment)
+        # sticky flag: "if (c) f <= 1'b1;" -> "f <= c;"
+        m = re.match(r"^(\s*)if \((.*)\) (\w+) <= 1'b1;\s*$", code)
+        if m:
+            add("sticky", i, f"{m.group(1)}{m.group(3)} <= {m.group(2)};")
+        # multi-line form "if (c) begin / f <= 1'b1;": assign f <= c before the if (the
+        # inner assignment then repeats the same value: f follows c, it is not sticky)
+        m = re.match(r"^(\s*)(\w+_q)\s*<= 1'b1;\s*$", code)
+        mi = re.match(r"^(\s*)if \((.*)\) begin(.*)$", lines[i - 1]) if i > 0 else None
+        if m and mi:
+            add("sticky", i - 1, f"{mi.group(1)}{m.group(2)} <= {mi.group(2)}; "
+                                 f"if ({mi.group(2)}) begin{mi.group(3)}")
+        # swapped fields in a concatenation of plain names
+        for m in re.finditer(r"\{(\s*[\w\[\]:.]+\s*),(\s*[\w\[\]:.]+\s*)([,}])", code):
+            a, b = m.group(1), m.group(2)
+            add("swap", i, code[:m.start()] + "{" + b.strip() + ", " + a.strip() + m.group(3)
+                + code[m.end():] + comment)
+        if re.match(r"^\s*if \(rst\) begin", code):
+            j = i + 1
+            while j < len(lines) and not re.match(r"^\s*end\b", lines[j]):
+                reset_block.add(j)
+                j += 1
+    # register left out of reset
+    for j in sorted(reset_block):
+        m = re.match(r"^(\s*)(\w+)\s*<=.*;\s*$", lines[j])
+        if m:
+            add("noreset", j, f"{m.group(1)}// (mutant: {m.group(2)} not reset)")
+    out: list[Mutant] = []
+    for op in sorted(found):
+        for k, (i, new) in enumerate(found[op]):
+            out.append(Mutant(module, op, k, rel, i + 1, lines[i], new))
+    return out
+
+
+# ----------------------------------------------------------------------------------------
+# Running
+
+def apply(mutant: Mutant, root: Path) -> None:
+    """Write the mutant's line into the copy of the tree at ``root``."""
+    p = root / mutant.path
+    lines = p.read_text().splitlines(keepends=True)
+    assert lines[mutant.line - 1].rstrip("\n") == mutant.before, "source changed"
+    lines[mutant.line - 1] = mutant.after + "\n"
+    p.write_text("".join(lines))
+
+
+def compiles(mutant: Mutant, root: Path) -> bool:
+    """Verilator lint of the mutated module (a mutant that does not compile is invalid,
+    not killed: it says nothing about the testbench)."""
+    sys.path.insert(0, str(REPO))
+    from rtlsim.toolchain import ensure_verilator_env
+    ensure_verilator_env()
+    dirs = [a for d in sorted({p.parent for p in (root / "rtl").rglob("*.sv")})
+            for a in ("-y", str(d))]
+    pkgs = sorted(str(p) for p in (root / "rtl").rglob("*_pkg.sv"))
+    cmd = ["verilator", "--lint-only", "-Wno-fatal", "--assert", *dirs, *pkgs,
+           str(root / mutant.path), "--top-module", Path(mutant.path).stem]
+    return subprocess.run(cmd, cwd=root, capture_output=True).returncode == 0
+
+
+def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
+               quick: bool = False) -> tuple[str, float]:
+    """Run the covering testbenches on a copy of the tree holding ``mutant``.
+    Returns ("killed" | "survived" | "timeout" | "invalid", seconds); a timeout counts as
+    killed, a mutant that does not compile is "invalid" and not counted."""
+    t0 = time.monotonic()
+    with tempfile.TemporaryDirectory(prefix="mutant_") as tmp:
+        root = Path(tmp)
+        for d in COPY_DIRS:
+            shutil.copytree(REPO / d, root / d,
+                            ignore=shutil.ignore_patterns("__pycache__", "sim_build"))
+        shutil.copy(REPO / "pyproject.toml", root / "pyproject.toml")
+        apply(mutant, root)
+        if not compiles(mutant, root):
+            return "invalid", time.monotonic() - t0
+        env = dict(os.environ)
+        env["PYTHONPATH"] = f"{root}{os.pathsep}{env.get('PYTHONPATH', '')}"
+        stages = [tests] if tests else TESTS[mutant.module]
+        if quick:
+            stages = stages[:1]
+        verdict = "survived"
+        for stage in stages:
+            left = timeout - (time.monotonic() - t0)
+            cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
+                   "no:cacheprovider", *stage]
+            # own process group: a timeout ends pytest and the simulator it started
+            proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
+                                    stderr=subprocess.DEVNULL, start_new_session=True)
+            try:
+                proc.wait(timeout=max(left, 1.0))
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+                return "timeout", time.monotonic() - t0
+            if proc.returncode != 0:
+                verdict = "killed"
+                break
+    return verdict, time.monotonic() - t0
+
+
+def run_mutant_formal(mutant: Mutant, timeout: float) -> tuple[str, float]:
+    """MCY-style: run the module's proof (formal/<module>.sby, every task) on a copy
+    holding ``mutant``. A failed assertion or an unreachable cover kills it; "unknown" = the
+    induction step fails but no base-case counterexample was found within the depth."""
+    t0 = time.monotonic()
+    sby = REPO / "formal" / f"{mutant.module}.sby"
+    if not sby.exists():
+        return "invalid", 0.0
+    sys.path.insert(0, str(REPO / "tools"))
+    from formal import sby_command, sby_tasks
+    _, tasks, _ = sby_tasks(sby)
+    with tempfile.TemporaryDirectory(prefix="mutant_") as tmp:
+        root = Path(tmp)
+        for d in ("rtl", "formal"):
+            shutil.copytree(REPO / d, root / d)
+        apply(mutant, root)
+        env = dict(os.environ)
+        env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
+        verdict = "survived"
+        for task in tasks:  # an unreachable cover kills too (behaviour made impossible)
+            try:
+                proc = subprocess.run([*sby_command(), "-d", str(root / f"w_{task}"),
+                                       str(root / "formal" / sby.name), task],
+                                      cwd=root / "formal", env=env, capture_output=True,
+                                      text=True, timeout=timeout)
+            except subprocess.TimeoutExpired:
+                return "timeout", time.monotonic() - t0
+            m = re.search(r"DONE \((\w+), rc=\d+\)", proc.stdout)
+            word = m.group(1) if m else "ERROR"
+            if word == "FAIL":
+                return "killed", time.monotonic() - t0
+            if word == "ERROR":
+                return "invalid", time.monotonic() - t0
+            if word != "PASS":
+                verdict = "unknown"
+    return verdict, time.monotonic() - t0
+
+
+def sample(modules: list[str], n: int, seed: int) -> list[Mutant]:
+    """``n`` mutants spread round-robin over ``modules``, deterministic for ``seed``."""
+    rng = random.Random(seed)
+    pools = {}
+    for mod in modules:
+        pool = candidates(mod)
+        rng.shuffle(pool)
+        pools[mod] = pool
+    out: list[Mutant] = []
+    while len(out) < n and any(pools.values()):
+        for mod in modules:
+            if pools[mod] and len(out) < n:
+                out.append(pools[mod].pop())
+    return out
+
+
+def report(results: list[tuple[Mutant, str, float]]) -> str:
+    """Markdown summary: score per module, then every surviving diff."""
+    rows: dict[str, list[int]] = {}
+    for m, verdict, _ in results:
+        if verdict in ("invalid", "unknown"):
+            continue
+        r = rows.setdefault(m.module, [0, 0])
+        r[0 if verdict != "survived" else 1] += 1
+    lines = ["| module | mutants | killed | survived | score |", "|---|---:|---:|---:|---:|"]
+    tk = ts = 0
+    for mod, (k, s) in sorted(rows.items()):
+        lines.append(f"| {mod} | {k + s} | {k} | {s} | {100 * k / (k + s):.0f}% |")
+        tk, ts = tk + k, ts + s
+    if tk + ts:
+        lines.append(f"| **all** | {tk + ts} | {tk} | {ts} | {100 * tk / (tk + ts):.0f}% |")
+    surv = [m for m, v, _ in results if v == "survived"]
+    if surv:
+        lines += ["", "Surviving mutants:", ""]
+        for m in surv:
+            lines += [f"- `{m.ident}`", "```diff", m.diff().rstrip(), "```"]
+    return "\n".join(lines)
+
+
+def save(path: Path, m: Mutant, verdict: str, secs: float) -> None:
+    """Add (or replace) one verdict in the JSON results file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows = json.loads(path.read_text()) if path.exists() else []
+    rows = [r for r in rows if r["ident"] != m.ident]
+    rows.append({**asdict(m), "ident": m.ident, "verdict": verdict, "seconds": round(secs)})
+    path.write_text(json.dumps(rows, indent=1))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("modules", nargs="*", help="RTL module names (default: all in TESTS)")
+    ap.add_argument("-n", type=int, default=20, help="mutants to run (spread over modules)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--list", action="store_true", help="print the candidates and stop")
+    ap.add_argument("--ci", action="store_true", help="run the fixed CI subset")
+    ap.add_argument("--id", action="append", help="run these mutants (module:op:index)")
+    ap.add_argument("--quick", action="store_true",
+                    help="first (cheapest) test stage only: survivors are not final")
+    ap.add_argument("--formal", action="store_true",
+                    help="kill mutants with the module's SymbiYosys proof instead of its tests")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep the verdicts already in --json, run only the rest")
+    ap.add_argument("--timeout", type=float, default=300.0,
+                    help="seconds per mutant (a hang counts as killed)")
+    ap.add_argument("--json", type=Path, default=OUT / "results.json")
+    args = ap.parse_args(argv)
+    modules = args.modules or list(TESTS)
+    if args.formal and not args.modules:
+        modules = [m for m in TESTS if (REPO / "formal" / f"{m}.sby").exists()]
+    unknown = [m for m in modules if m not in TESTS]
+    if unknown:
+        print(f"error: no testbench mapping for {unknown} (see TESTS)", file=sys.stderr)
+        return 2
+    if args.list:
+        for mod in modules:
+            for m in candidates(mod):
+                print(f"{m.ident:28s} {m.path}:{m.line}: {m.after.strip()}")
+        return 0
+    if args.ci:
+        chosen = ci_mutants()
+    elif args.id:
+        wanted = list(args.id)
+        pool = {m.ident: m for mod in {w.split(":")[0] for w in wanted}
+                for m in candidates(mod)}
+        missing = [w for w in wanted if w not in pool]
+        if missing:
+            print(f"error: unknown mutants {missing}", file=sys.stderr)
+            return 2
+        chosen = [pool[w] for w in wanted]
+    else:
+        chosen = sample(modules, args.n, args.seed)
+    results: list[tuple[Mutant, str, float]] = []
+    if args.resume and args.json.exists():
+        done = {r["ident"]: r for r in json.loads(args.json.read_text())}
+        results = [(m, done[m.ident]["verdict"], done[m.ident]["seconds"]) for m in chosen
+                   if m.ident in done]
+        chosen = [m for m in chosen if m.ident not in done]
+    for m in chosen:
+        verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
+                         else run_mutant(m, args.timeout, quick=args.quick or args.ci))
+        results.append((m, verdict, secs))
+        print(f"{m.ident:28s} {verdict:8s} {secs:6.0f} s  {m.path}:{m.line}: "
+              f"{m.after.strip()[:60]}", flush=True)
+        save(args.json, m, verdict, secs)
+    text = report(results)
+    print()
+    print(text)
+    return 0 if not args.ci or all(v != "survived" for _, v, _ in results) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
