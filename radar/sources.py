@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Iterator
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
@@ -30,7 +31,15 @@ SOURCES: dict[str, type[FrameSource]] = {}
 """Registered sources by name, in definition order (model, float, rtl)."""
 
 RTL_SIM_MAX_FRAME_BITS = 16 * 2**20
-"""Largest corner-turn frame the RTL source simulates (paper-fpga: 2 Mib; full: 128 Mib)."""
+"""Largest corner-turn frame the RTL source keeps on chip (paper-fpga: 2 Mib); a larger one
+(full: 128 Mib) runs with FRAME_STORE = 1, the corner turn in external memory, as on the board."""
+
+FULL_AXI_DATA_W = 512
+"""AXI_DATA_W of the external frame store when the RTL source needs it (the ZCU106 PL DDR4
+through MIG: 512-bit user interface at the 100 MHz fabric clock, docs/frame_store.md)."""
+
+FPGA_CLOCK_HZ = 100e6
+"""The fabric clock the ADC samples are paced against (the paper's 100 MHz)."""
 
 
 class SourceError(Exception):
@@ -92,16 +101,26 @@ class RtlSource(FrameSource):
         from host.stream import StreamDecoder
         from rtlsim.harness import run_pipeline
 
+        chain = self.chain
         frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
-        if frame_bits > RTL_SIM_MAX_FRAME_BITS:
-            raise SourceError(f"preset {cfg.name!r} needs a {frame_bits / 2**20:.0f} Mib "
-                              f"corner turn (external DDR4 on the ZCU106), too large to "
-                              f"simulate here; use --preset paper-fpga")
+        if frame_bits > RTL_SIM_MAX_FRAME_BITS and not chain.frame_store:
+            # too large for on-chip memory: the corner turn goes to DDR4 (FRAME_STORE = 1),
+            # here the harness's AXI4 memory model; the payload is the same (DESIGN.md 3.3)
+            chain = replace(chain, frame_store=True, axi_data_w=FULL_AXI_DATA_W)
+        adc_gap, chirp_gap = 0.0, 0          # on-chip corner turn: ADC at one sample/clock
+        if chain.frame_store:
+            # the ADC at its real sample rate against the 100 MHz fabric clock (TVALID gaps)
+            # and the idle part of each chirp period, as the board's memory sees it
+            adc_gap = max(0.0, 1.0 - cfg.sample_rate_hz / FPGA_CLOCK_HZ)
+            chirp_gap = max(0, round((cfg.chirp_period_s - cfg.sampled_chirp_s)
+                                     * FPGA_CLOCK_HZ))
         adcs = list(adc_frames)
-        print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters); the first "
-              f"build takes a minute or two", file=sys.stderr)
+        print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters, "
+              f"FRAME_STORE={int(chain.frame_store)}); the first build takes a minute or two "
+              f"(about ten for the 16-lane full top)", file=sys.stderr)
         try:
-            packets, status = run_pipeline(adcs, cfg, self.chain)
+            packets, status = run_pipeline(adcs, cfg, chain, adc_gap=adc_gap, chirp_gap=chirp_gap,
+                                           frame_store=chain.frame_store)
         except (RuntimeError, FileNotFoundError, ImportError) as exc:
             raise SourceError(str(exc)) from None
         dec = StreamDecoder(cfg, self.chain.packet_words)

@@ -1,9 +1,10 @@
 """Open resource estimate without Vivado: Yosys ``synth_xilinx -family xcup`` per block.
 
 Every job reads ``rtl/`` as written (the plain file list ``rtl/**/*.sv``, packages first, see
-:func:`rtl_files`), sets the HDL parameters of one block, synthesizes it out of context for
-UltraScale+ (no I/O buffers, no clock buffer, flattened) and counts the mapped cells. The
-result is a markdown table beside the paper's Table II, written to ``OUT/estimate.md``
+:func:`rtl_files`, narrowed to the files its top elaborates by :func:`files_for`), sets the
+HDL parameters of one block, synthesizes it out of context for UltraScale+ (no I/O buffers,
+no clock buffer, flattened) and counts the mapped cells. The result is a markdown table
+beside the paper's Table II, written to ``OUT/estimate.md``
 (and ``OUT/estimate.json``).
 
 Usage (from the repository root, through ``tools/venv-run``)::
@@ -21,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -54,7 +56,7 @@ _LUTRAM_LUTS = {
 class Job:
     """One synthesis run: a block (HDL top) at one parameter set.
 
-    Every job reads the whole file list :func:`rtl_files`; ``uram`` adds ``-uram`` (the big
+    Every job reads its part of the file list (:func:`files_for`); ``uram`` adds ``-uram`` (the big
     buffers: corner turn, packetizer, top); ``expect_dsp``
     is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
     """
@@ -201,6 +203,24 @@ def rtl_files(rtl: Path = RTL) -> list[Path]:
     return [p.resolve() for p in files]
 
 
+def files_for(top: str, files: list[Path]) -> list[Path]:
+    """The part of the file list :func:`rtl_files` that ``top`` elaborates: every package and
+    the files of the modules it instantiates, directly or below (a module's file is named
+    after it). Still read as written, in the same order; the subset only keeps Yosys' wasm
+    build inside its 4 GiB address space, which the whole tree's ASTs plus the Xilinx cell
+    library exceed."""
+    by_name = {p.stem: p for p in files}
+    words = {name: set(re.findall(r"\b\w+\b", p.read_text())) for name, p in by_name.items()}
+    need, todo = set(), [top]
+    while todo:
+        name = todo.pop()
+        if name in need or name not in by_name:
+            continue
+        need.add(name)
+        todo.extend(w for w in words[name] if w in by_name and w != name)
+    return [p for p in files if p.stem.endswith("_pkg") or p.stem in need]
+
+
 def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
     reads = " ".join(str(f) for f in files)
@@ -323,7 +343,7 @@ def main(argv: list[str] | None = None) -> int:
     results: list[Result] = []
     for job in jobs:
         print(f"synth-estimate: {job.name} ({job.top} {job.label}) ...", flush=True)
-        r = run_job(job, files, work, yosys)
+        r = run_job(job, files_for(job.top, files), work, yosys)
         if r.skipped:
             print(f"  skipped: {r.skipped}", flush=True)
         elif r.error:

@@ -81,9 +81,6 @@ def test_detect_two_frames_paper_fpga(tmp_path):
 
 def test_detect_errors(tmp_path, capsys):
     assert main(["detect", "--scene", "table1", "--json", str(tmp_path / "a.json"),
-                 "--backend", "rtl"]) == 2  # full preset: too large to simulate
-    assert "--preset paper-fpga" in capsys.readouterr().err
-    assert main(["detect", "--scene", "table1", "--json", str(tmp_path / "a.json"),
                  "--frames", "0"]) == 2
     assert "--frames" in capsys.readouterr().err
     assert main(["detect", "--scene", "table1", "--json", str(tmp_path / "a.json"),

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from synth.vivado_flow import parse_utilization
-from synth.yosys_estimate import RTL, job_sets, main, rtl_files
+from synth.yosys_estimate import RTL, files_for, job_sets, main, rtl_files
 
 
 def _code(path: Path) -> str:
@@ -80,3 +80,14 @@ def test_ci_estimate(tmp_path: Path) -> None:
 
     table = (tmp_path / "estimate.md").read_text()
     assert "paper Table II" in table and "| ci/fft_axis |" in table
+
+
+def test_files_for_takes_what_the_top_elaborates() -> None:
+    files = rtl_files()
+    fft = {p.stem for p in files_for("fft_axis", files)}
+    assert {"fft_pkg", "fft_rom_pkg", "fft_axis", "fft_sdf_bf", "fft_reorder",
+            "axis_checker"} <= fft
+    assert not fft & {"corner_turn", "radar_pipeline", "frame_store_axi"}
+    top = {p.stem for p in files_for("radar_pipeline", files)}
+    assert {"fft_axis", "corner_turn", "chirp_pingpong", "frame_align", "mark_fifo",
+            "frame_store_axi", "axis_packetizer", "axis_checker"} <= top

@@ -191,5 +191,5 @@ if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     f"{k}{v}" for k, v in p.items()))
 def test_detect_records(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/detect_records.sv")]
+    sources = rtl_sources("common/*.sv", "buffers/buf_*.sv", "detect/detect_records.sv")
     run_cocotb("detect_records", sources, "test_detect_records", here, parameters=parameters)
