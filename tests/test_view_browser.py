@@ -66,7 +66,7 @@ def _counter(page, key: str) -> str:
     return page.locator(f"#h-{key}").inner_text()
 
 
-@pytest.mark.xfail(strict=False, reason="on a fresh clone after the merges of this session the page "
+@pytest.mark.xfail(strict=False, reason="on a fresh clone after this session's merges the page "
                    "never reached 3 frames within 90 s (open in issue 17)")
 def test_view_in_browser(capture, tmp_path):
     from playwright.sync_api import sync_playwright
