@@ -118,7 +118,7 @@ def _window_response(n: int, offset: float, windowed: bool) -> float:
     return float(abs(np.sum(w * np.exp(-2j * np.pi * offset * np.arange(n) / n))) / w.sum())
 
 
-def _interp(lm: float, c: float, lp: float) -> float:
+def gaussian_offset(lm: float, c: float, lp: float) -> float:
     """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation)."""
     den = lm - 2 * c + lp
     if den >= 0:
@@ -212,25 +212,43 @@ def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.n
         return 10 * np.log10(np.maximum(sigma, 1e-30))
 
 
-def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
-                 frame: int = 0) -> PointCloud:
-    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
-    params = params or DetectionParams()
-    cfg.check_cube(cube)
-    cells, noise, nci = detect_cells(cube, cfg, params)
-    logp = np.log(np.maximum(nci, 1e-30))
+def peak_offsets(logp: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Fractional (range, Doppler) offsets of peaks from their cell centres, float (n, 2)
+    in (-0.5, 0.5), by Gaussian interpolation over the 3 log-power samples along each axis
+    (Doppler circular; 0 at the range ends). logp: float (n_range, n_doppler) log power;
+    cells: int (n, 2) of (range_bin, doppler_bin)."""
+    nr, nd = logp.shape
+    out = np.zeros((len(cells), 2))
+    for i, (r, d) in enumerate(cells):
+        if 0 < r < nr - 1:
+            out[i, 0] = gaussian_offset(logp[r - 1, d], logp[r, d], logp[r + 1, d])
+        out[i, 1] = gaussian_offset(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
+    return out
+
+
+def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
+                      noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
+                      params: DetectionParams, frame: int = 0) -> PointCloud:
+    """Point cloud of detected cells (steps 3 to 5 of the module docstring), whether they
+    come from a cube (:func:`process_cube`) or from the FPGA's records
+    (``host.record_points``).
+
+    cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
+    (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
+    power: float (n,) non-coherent power sum_v |x_v|^2; noise: float (n,) mean noise power
+    per cell of the non-coherent map; offsets: float (n, 2) fractional (range, Doppler)
+    offsets of the peak from the cell centre, bins.
+    """
     nr, nd = cfg.n_range, cfg.n_doppler
     sbins = signed_bins(nd)
     cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
     rows: dict[str, list[float]] = {k: [] for k in (
         "range_m", "azimuth_deg", "radial_velocity_mps", "power_db", "snr_db", "amp_adc",
         "range_bin", "doppler_bin", "ambiguous")}
-    for (r, d), noise_cell in zip(cells, noise, strict=True):
-        dr = _interp(logp[r - 1, d], logp[r, d], logp[r + 1, d]) if 0 < r < nr - 1 else 0.0
-        dd = _interp(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
-        x = cube[:, r, d]
+    for (r, d), x, p_cell, noise_cell, (dr, dd) in zip(cells, snapshots, power, noise,
+                                                       offsets, strict=True):
         noise_ch = noise_cell / cfg.n_virtual
-        cell_snr_db = 10 * np.log10(max(nci[r, d] - noise_cell, 1e-30) / noise_cell) \
+        cell_snr_db = 10 * np.log10(max(p_cell - noise_cell, 1e-30) / noise_cell) \
             + 10 * np.log10(cfg.n_virtual)
         fold, ambiguous = _choose_fold(x, cfg, d, (int(sbins[d]) + dd) * cfg.velocity_bin_mps,
                                        cell_snr_db, params)
@@ -261,6 +279,18 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
         a["range_m"], a["azimuth_deg"], a["radial_velocity_mps"], a["power_db"], a["snr_db"],
         rcs, a["range_bin"].astype(int), a["doppler_bin"].astype(int),
         a["ambiguous"].astype(bool), frame=frame)
+
+
+def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
+                 frame: int = 0) -> PointCloud:
+    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
+    params = params or DetectionParams()
+    cfg.check_cube(cube)
+    cells, noise, nci = detect_cells(cube, cfg, params)
+    offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
+    r, d = cells[:, 0], cells[:, 1]
+    return points_from_cells(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params,
+                             frame)
 
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,

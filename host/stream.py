@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
@@ -107,6 +108,19 @@ class Frame:
         return bool(self.valid.all()) and not self.problems
 
 
+class DecodedFrameLike(Protocol):
+    """What every decoded frame offers (a cube :class:`Frame` or a record frame)."""
+
+    frame_id: int
+    problems: list[str]
+
+    @property
+    def complete(self) -> bool: ...
+
+
+FrameT = TypeVar("FrameT", bound=DecodedFrameLike)
+
+
 @dataclass
 class StreamStats:
     """Counters of a decoder's lifetime."""
@@ -131,31 +145,40 @@ class _Open:
     full_id: int = 0
 
 
-class StreamDecoder:
-    """Groups DMA packets into frames and decodes them into radar cubes.
+class PacketDecoder(Generic[FrameT]):
+    """Groups DMA packets into frames of ``frame_words`` payload words of ``num_rx`` lanes
+    (loss, repeat, reorder and truncation detection); subclasses turn a frame's words into
+    their frame type (:meth:`_make_frame`): the radar cube (:class:`StreamDecoder`) or
+    detection records (``host.records.RecordDecoder``).
 
-    ``cfg``: radar configuration (cube shape, lanes). ``packet_words``: payload words per
-    packet (the packetizer's PACKET_WORDS). ``reorder_window``: a frame stays open until a
-    packet of a frame this many ids later arrives, so packets reordered across a frame
-    boundary are still placed; a frame that has all its packets closes at once.
+    ``packet_words``: payload words per packet (the packetizer's PACKET_WORDS).
+    ``reorder_window``: a frame stays open until a packet of a frame this many ids later
+    arrives, so packets reordered across a frame boundary are still placed; a frame that has
+    all its packets closes at once.
     """
 
-    def __init__(self, cfg: RadarConfig, packet_words: int, reorder_window: int = 2) -> None:
-        self.cfg = cfg
-        self.num_rx = cfg.num_rx
-        self.word_bytes = 4 * cfg.num_rx
-        self.frame_words = cfg.num_tx * cfg.n_range * cfg.n_doppler
+    def __init__(self, num_rx: int, frame_words: int, packet_words: int,
+                 reorder_window: int = 2) -> None:
+        self.num_rx = num_rx
+        self.word_bytes = 4 * num_rx
+        self.frame_words = frame_words
         check_geometry(self.frame_words, packet_words)
         self.packet_words = packet_words
         self.n_packets = packets_per_frame(self.frame_words, packet_words)
         self.reorder_window = max(1, reorder_window)
         # frame id width on the wire: 32 bits when header lane 2 exists, else 8 bits
-        self.id_bits = 32 if cfg.num_rx > 2 else 8
+        self.id_bits = 32 if num_rx > 2 else 8
         self.stats = StreamStats()
         self.stream_problems: list[str] = []
         self._open: dict[int, _Open] = {}
         self._closed: list[int] = []  # recently closed ids, to recognise late packets
         self._buf = bytearray()
+
+    def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
+                    problems: list[str]) -> FrameT:
+        """A decoded frame from its payload, uint32 (frame_words, num_rx) (zeros where
+        missing), ``valid`` bool (frame_words,) and the packet problems found."""
+        raise NotImplementedError
 
     # ---- helpers --------------------------------------------------------------------------
     def _problem(self, msg: str) -> None:
@@ -173,7 +196,7 @@ class StreamDecoder:
         return max(0, min(self.packet_words, self.frame_words - start))
 
     # ---- packet input ---------------------------------------------------------------------
-    def push_packet(self, data: bytes) -> list[Frame]:
+    def push_packet(self, data: bytes) -> list[FrameT]:
         """One DMA packet (header word + payload, little-endian lanes). Returns the frames
         this packet completed or pushed out of the reorder window."""
         self.stats.packets += 1
@@ -205,7 +228,7 @@ class StreamDecoder:
             self.stats.late_packets += 1
             self._problem(f"late or repeated packet {hdr.seq} of already closed frame {fid}")
             return []
-        out: list[Frame] = []
+        out: list[FrameT] = []
         # frames too old for the reorder window close now, incomplete
         for old in sorted(self._open, key=lambda k: self._newer(k, fid)):
             if self._newer(fid, old) >= self.reorder_window:
@@ -218,7 +241,7 @@ class StreamDecoder:
             out.append(self._close(fid))
         return out
 
-    def _close(self, fid: int) -> Frame:
+    def _close(self, fid: int) -> FrameT:
         entry = self._open.pop(fid)
         self._closed.append(fid)
         del self._closed[:-4 * self.reorder_window]
@@ -231,11 +254,7 @@ class StreamDecoder:
             valid = np.zeros(self.frame_words, bool)
         else:
             problems, words, valid = decoded[0].errors, decoded[0].words, decoded[0].valid
-        cfg = self.cfg
-        cube = payload_words_to_cube(words, cfg)
-        frame = Frame(frame_id=fid, cube=cube,
-                      valid=valid.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler),
-                      problems=list(problems))
+        frame = self._make_frame(fid, words, valid, list(problems))
         if frame.complete:
             self.stats.frames_complete += 1
         else:
@@ -263,19 +282,19 @@ class StreamDecoder:
             last_seq = seqs[i]
         return out
 
-    def flush(self) -> list[Frame]:
+    def flush(self) -> list[FrameT]:
         """Close every open frame (end of stream), oldest first."""
         ids = sorted(self._open, key=lambda k: self._newer(k, next(iter(self._open))))
         return [self._close(k) for k in ids]
 
     # ---- raw byte stream input ------------------------------------------------------------
-    def push_bytes(self, data: bytes) -> list[Frame]:
+    def push_bytes(self, data: bytes) -> list[FrameT]:
         """Raw stream bytes (no packet boundaries): packets are cut by their header's
         payload length (lane 1, or the nominal length for num_rx < 2). After garbage the
         decoder resynchronises byte by byte on a plausible header (magic, sequence number
         and length consistent with the frame geometry); skipped bytes are counted."""
         self._buf.extend(data)
-        out: list[Frame] = []
+        out: list[FrameT] = []
         wb = self.word_bytes
         while len(self._buf) >= wb:
             length = self._header_length(bytes(self._buf[:wb]))
@@ -316,7 +335,7 @@ class StreamDecoder:
         self.stats.garbage_bytes += n
         del self._buf[:n]
 
-    def finish(self) -> list[Frame]:
+    def finish(self) -> list[FrameT]:
         """End of a raw stream: leftover bytes are reported, open frames closed."""
         if self._buf:
             self._problem(f"{len(self._buf)} trailing bytes do not form a whole packet "
@@ -324,3 +343,23 @@ class StreamDecoder:
             self.stats.garbage_bytes += len(self._buf)
             self._buf.clear()
         return self.flush()
+
+
+class StreamDecoder(PacketDecoder[Frame]):
+    """Groups DMA packets into frames and decodes them into radar cubes.
+
+    ``cfg``: radar configuration (cube shape, lanes). ``packet_words``: payload words per
+    packet (the packetizer's PACKET_WORDS). ``reorder_window``: see :class:`PacketDecoder`.
+    """
+
+    def __init__(self, cfg: RadarConfig, packet_words: int, reorder_window: int = 2) -> None:
+        super().__init__(cfg.num_rx, cfg.num_tx * cfg.n_range * cfg.n_doppler, packet_words,
+                         reorder_window)
+        self.cfg = cfg
+
+    def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
+                    problems: list[str]) -> Frame:
+        cfg = self.cfg
+        return Frame(frame_id=fid, cube=payload_words_to_cube(words, cfg),
+                     valid=valid.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler),
+                     problems=problems)

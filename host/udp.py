@@ -2,7 +2,8 @@
 
 :class:`UdpSender` replays packets as the board would (optionally paced to a bit rate, with
 injected loss, duplication and reordering for testing); :class:`UdpReceiver` feeds arriving
-datagrams to a :class:`host.stream.StreamDecoder`. Both are meant for 127.0.0.1 in tests.
+datagrams to a :class:`host.stream.PacketDecoder` (a cube ``StreamDecoder`` or a detection
+record ``host.records.RecordDecoder``). Both are meant for 127.0.0.1 in tests.
 """
 
 from __future__ import annotations
@@ -12,8 +13,9 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
-from host.stream import Frame, StreamDecoder
+from host.stream import PacketDecoder
 
 UDP_MAX_PAYLOAD = 65507
 """Largest UDP payload over IPv4, bytes."""
@@ -136,7 +138,7 @@ class UdpReceiver:
                  rcvbuf_bytes: int = 16 << 20) -> None:
         check_port(port)
         self.interrupted = False
-        self.decoder: StreamDecoder | None = None
+        self.decoder: PacketDecoder[Any] | None = None
         self.datagrams = 0
         self.unusable: list[str] = []  # datagrams no decoder could be built from
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -156,10 +158,11 @@ class UdpReceiver:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def receive(self, decoder: StreamDecoder | None, max_frames: int | None = None,
+    def receive(self, decoder: PacketDecoder[Any] | None, max_frames: int | None = None,
                 idle_timeout_s: float = 1.0, total_timeout_s: float = 60.0,
-                on_frame: Callable[[Frame], None] | None = None,
-                make_decoder: Callable[[bytes], StreamDecoder] | None = None) -> list[Frame]:
+                on_frame: Callable[[Any], None] | None = None,
+                make_decoder: Callable[[bytes], PacketDecoder[Any]] | None = None
+                ) -> list[Any]:
         """Decode datagrams until ``max_frames`` frames are out, the link has been idle for
         ``idle_timeout_s`` *after the first datagram*, or ``total_timeout_s`` has passed
         (which also bounds the wait for the first one); then close open frames. Ctrl-C
@@ -173,10 +176,10 @@ class UdpReceiver:
         if decoder is None and make_decoder is None:
             raise ValueError("receive: needs a decoder or make_decoder")
         self.decoder = decoder
-        frames: list[Frame] = []
+        frames: list[Any] = []
         deadline = time.monotonic() + total_timeout_s
 
-        def emit(new: list[Frame]) -> None:
+        def emit(new: list[Any]) -> None:
             for f in new:
                 frames.append(f)
                 if on_frame:

@@ -10,6 +10,11 @@ radar cubes complex (n_virtual, n_range, n_doppler) in the float reference's uni
 - ``rtl``: the Verilated ``radar_pipeline`` (:func:`rtlsim.harness.run_pipeline`, the C++ harness),
   its DMA packets decoded by :class:`host.stream.StreamDecoder` like the board's.
 
+With the on-chip detector (``radar detect --detect fpga``, ``OUTPUT_MODE = 1``) a source
+gives the frames' detection records instead (:meth:`FrameSource.record_frames`): ``model``
+runs the bit-accurate chain in mode 1 and ``rtl`` the Verilated top in mode 1; both send
+their DMA packets as bytes through :class:`host.records.RecordDecoder`, like the board's.
+
 A new source is one :class:`FrameSource` subclass with a ``name``: it registers itself in
 :data:`SOURCES`.
 """
@@ -18,13 +23,16 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Iterator
-from dataclasses import replace
+from dataclasses import fields, replace
 from typing import ClassVar
 
 import numpy as np
 
+from host.records import DetectionFrame, RecordDecoder
+from model.axis_packetizer import pack_iq, packetize_stream, words_to_bytes
 from model.config import RadarConfig
-from model.radar_pipeline import PipelineParams, chain_gain, scaled_cube
+from model.detect_chain import DetectConfig, detect_stream
+from model.radar_pipeline import PipelineParams, chain_gain, run_chain, scaled_cube
 from model.reference import radar_cube
 
 SOURCES: dict[str, type[FrameSource]] = {}
@@ -72,6 +80,24 @@ class FrameSource:
         for adc in adc_frames:
             yield self.cube(adc, cfg)
 
+    def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
+                       dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
+        """DMA packets of the chain in ``OUTPUT_MODE = 1`` (detection records), uint32
+        (words, num_rx) each or their wire bytes, header word first. SourceError when the
+        source has none."""
+        raise SourceError(f"--backend {self.name} has no on-chip detector (use model or rtl "
+                          f"with --detect fpga)")
+
+    def record_frames(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
+                      dcfg: DetectConfig) -> Iterator[DetectionFrame]:
+        """Consecutive ADC frames -> their decoded record frames, in order: the DMA packets
+        of :meth:`record_packets` go through :class:`host.records.RecordDecoder` as bytes,
+        exactly as the board's would."""
+        dec = RecordDecoder(dcfg, self.chain.packet_words)
+        for p in self.record_packets(adc_frames, cfg, dcfg):
+            yield from dec.push_packet(p if isinstance(p, bytes) else words_to_bytes(p))
+        yield from dec.flush()
+
 
 class ModelSource(FrameSource):
     name = "model"
@@ -80,6 +106,17 @@ class ModelSource(FrameSource):
     def cube(self, adc: np.ndarray, cfg: RadarConfig) -> np.ndarray:
         # complex64 like the cube decoded from the DMA stream, so both give identical clouds
         return scaled_cube(adc, cfg, self.chain)
+
+
+    def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
+                       dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
+        # the chain in mode 1: Doppler-FFT words in (r, t, d) order -> detect_chain ->
+        # packetizer (model.detect_chain, docs/detect.md), one frame at a time
+        for k, adc in enumerate(adc_frames):
+            payload = run_chain(adc, cfg, self.chain).payload       # (tx, r, d, rx)
+            words = pack_iq(payload.transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
+            stream = detect_stream([words], dcfg)
+            yield from packetize_stream(stream, self.chain.packet_words, first_frame_id=k)
 
 
 class FloatSource(FrameSource):
@@ -95,18 +132,22 @@ class RtlSource(FrameSource):
     help = "the Verilated radar_pipeline"
     per_frame = False
 
-    def cubes(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig) -> Iterator[np.ndarray]:
-        """All frames stream through the RTL back to back (one simulation); the DMA packets
-        are decoded like the board's."""
-        from host.stream import StreamDecoder
-        from rtlsim.harness import run_pipeline
-
+    def _chain(self, cfg: RadarConfig) -> PipelineParams:
+        """The chain with FRAME_STORE = 1 when the frame does not fit on chip."""
         chain = self.chain
         frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
         if frame_bits > RTL_SIM_MAX_FRAME_BITS and not chain.frame_store:
             # too large for on-chip memory: the corner turn goes to DDR4 (FRAME_STORE = 1),
             # here the harness's AXI4 memory model; the payload is the same (DESIGN.md 3.3)
             chain = replace(chain, frame_store=True, axi_data_w=FULL_AXI_DATA_W)
+        return chain
+
+    def _run(self, adcs: list[np.ndarray], cfg: RadarConfig, chain: PipelineParams
+             ) -> tuple[list[np.ndarray], object]:
+        """DMA packets and status of the Verilated top for ``adcs`` (SourceError on a
+        build or run failure)."""
+        from rtlsim.harness import run_pipeline
+
         adc_gap, chirp_gap = 0.0, 0          # on-chip corner turn: ADC at one sample/clock
         if chain.frame_store:
             # the ADC at its real sample rate against the 100 MHz fabric clock (TVALID gaps)
@@ -114,15 +155,22 @@ class RtlSource(FrameSource):
             adc_gap = max(0.0, 1.0 - cfg.sample_rate_hz / FPGA_CLOCK_HZ)
             chirp_gap = max(0, round((cfg.chirp_period_s - cfg.sampled_chirp_s)
                                      * FPGA_CLOCK_HZ))
-        adcs = list(adc_frames)
         print(f"building/running the RTL (radar_pipeline, {cfg.name} parameters, "
               f"FRAME_STORE={int(chain.frame_store)}); the first build takes a minute or two "
               f"(about ten for the 16-lane full top)", file=sys.stderr)
         try:
-            packets, status = run_pipeline(adcs, cfg, chain, adc_gap=adc_gap, chirp_gap=chirp_gap,
-                                           frame_store=chain.frame_store)
-        except (RuntimeError, FileNotFoundError, ImportError) as exc:
+            return run_pipeline(adcs, cfg, chain, adc_gap=adc_gap, chirp_gap=chirp_gap,
+                                frame_store=chain.frame_store)
+        except (RuntimeError, FileNotFoundError, ImportError, TypeError) as exc:
             raise SourceError(str(exc)) from None
+
+    def cubes(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig) -> Iterator[np.ndarray]:
+        """All frames stream through the RTL back to back (one simulation); the DMA packets
+        are decoded like the board's."""
+        from host.stream import StreamDecoder
+
+        adcs = list(adc_frames)
+        packets, status = self._run(adcs, cfg, self._chain(cfg))
         dec = StreamDecoder(cfg, self.chain.packet_words)
         decoded = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
         if len(decoded) != len(adcs) or not all(f.complete for f in decoded):
@@ -132,6 +180,16 @@ class RtlSource(FrameSource):
         gain = chain_gain(cfg, self.chain)
         for f in sorted(decoded, key=lambda f: f.frame_id):
             yield f.cube / gain
+
+    def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
+                       dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
+        """All frames through the Verilated top in OUTPUT_MODE = 1 (one simulation)."""
+        if "output_mode" not in {f.name for f in fields(PipelineParams)}:
+            raise SourceError("the RTL top has no OUTPUT_MODE = 1 (on-chip detection) on "
+                              "this branch yet: use --backend model")
+        chain = replace(self._chain(cfg), output_mode=1, detect=dcfg)  # type: ignore[call-arg]
+        packets, _ = self._run(list(adc_frames), cfg, chain)
+        yield from packets
 
 
 def get_source(name: str, chain: PipelineParams | None = None) -> FrameSource:

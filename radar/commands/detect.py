@@ -1,6 +1,12 @@
 """``radar detect``: frames of a scene through a frame source (model, float, rtl) and the
 host processing to the point cloud JSON of DESIGN.md section 4, optionally GNN objects and
-figures."""
+figures.
+
+``--detect host`` (default): the source gives radar cubes, the host runs the CFAR
+(``host.pipeline.process_cube``). ``--detect fpga``: the chain runs its on-chip detector
+(``OUTPUT_MODE = 1``), the source gives decoded detection records
+(``host.records.RecordDecoder``) and the host goes on from them
+(``host.record_points.process_records``): the same point cloud JSON."""
 
 from __future__ import annotations
 
@@ -13,9 +19,15 @@ from typing import Any
 
 import numpy as np
 
-from host.pipeline import process_cube
+from host.pipeline import DetectionParams, process_cube
 from host.pointcloud import PointCloud
+from host.record_points import process_records
+from host.records import DEFAULT_MAX_DETECTIONS, fpga_detect_config, record_arrays
+from model.cfar_2d import KINDS
+from model.config import RadarConfig
+from model.detect_chain import DetectConfig
 from model.observability import scene_report
+from model.radar_pipeline import chain_gain
 from model.simulate import simulate_scene
 from radar.common import (
     CliError,
@@ -34,6 +46,25 @@ from radar.sources import SOURCES, SourceError, get_source
 
 MAX_DETECT_FRAMES = 10_000
 """Largest --frames (90 s of radar time; the command keeps every cloud in memory)."""
+MAX_FPGA_DETECTIONS = 65535
+"""Largest --max-detections (the record index is 16 bits)."""
+
+
+def fpga_config(args: argparse.Namespace, cfg: RadarConfig, params: DetectionParams
+                ) -> DetectConfig:
+    """The on-chip detector's settings from the options (CliError on a bad combination)."""
+    if args.detector != "ca":
+        raise CliError(f"--detect fpga: the FPGA runs a CA/GO/SO CFAR (--fpga-cfar), not "
+                       f"--detector {args.detector}")
+    if args.plots:
+        raise CliError("--plots: needs the radar cube, which --detect fpga does not send "
+                       "(use --detect host)")
+    count(args.max_detections, "--max-detections", MAX_FPGA_DETECTIONS)
+    try:
+        return fpga_detect_config(cfg, params.cfar, args.fpga_cfar, args.max_detections,
+                                  (params.range_window, params.doppler_window))
+    except ValueError as exc:
+        raise CliError(f"--detect fpga: {exc}") from None
 
 
 def cmd_detect(args: argparse.Namespace) -> int:
@@ -57,13 +88,35 @@ def cmd_detect(args: argparse.Namespace) -> int:
             yield adc.samples
 
     try:
-        for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
-            cloud = process_cube(cube, cfg, params, frame=k)
-            clouds.append(cloud)
-            per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": saturated[k]})
-            if args.gnn:
-                objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
-            last_cube = cube
+        if args.detect == "fpga":
+            dcfg = fpga_config(args, cfg, params)
+            gain = chain_gain(cfg, get_source(args.backend).chain)
+            frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
+            for k, f in enumerate(frames):
+                arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
+                cloud = process_records(arr, cfg, params, frame=k)
+                clouds.append(cloud)
+                per_frame.append({"frame": k, "points": len(cloud),
+                                  "adc_saturated": saturated[k] if k < len(saturated) else 0,
+                                  "records": len(f.records), "detections": f.detections,
+                                  "truncated": f.truncated, "complete": f.complete,
+                                  "problems": f.problems})
+                if f.truncated:
+                    warn([f"frame {k}: {f.detections} cells passed the CFAR, only "
+                          f"--max-detections {dcfg.max_detections} were sent"], "detect")
+                if not f.complete:
+                    warn([f"frame {k} damaged: {'; '.join(f.problems[:3])}"], "detect")
+                if args.gnn:
+                    objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
+        else:
+            for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
+                cloud = process_cube(cube, cfg, params, frame=k)
+                clouds.append(cloud)
+                per_frame.append({"frame": k, "points": len(cloud),
+                                  "adc_saturated": saturated[k]})
+                if args.gnn:
+                    objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
+                last_cube = cube
     except SourceError as exc:
         raise CliError(f"--backend {args.backend}: {exc}") from None
     except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
@@ -74,7 +127,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
               f"harmonics of the clipped echo can appear as false points"], "detect")
     cloud = PointCloud.concat(clouds)
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
-    doc.update({"backend": args.backend, "detector": args.detector, "scene": scene.name,
+    doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
+                "scene": scene.name,
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
                 "frame_info": per_frame, **report})
     if args.gnn:
@@ -113,5 +167,17 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="ego speed along +x for the GNN's velocity compensation, m/s "
                         "(default: 27.78 for table1, else 0; written to the JSON, where "
                         "`radar gnn detect --points` picks it up)")
+    d.add_argument("--detect", choices=("host", "fpga"), default="host",
+                   help="host: the FPGA sends the radar cube and the host runs the CFAR "
+                        "(default); fpga: the chain detects on chip (OUTPUT_MODE = 1: NCI, "
+                        "2-D CFAR, snapshot records) and the host goes on from the records "
+                        "(--backend model or rtl)")
+    d.add_argument("--fpga-cfar", choices=KINDS, default="ca",
+                   help="--detect fpga: the on-chip CFAR kind, cell averaging or greatest/"
+                        "smallest of the two Doppler halves (default ca)")
+    d.add_argument("--max-detections", type=int, default=DEFAULT_MAX_DETECTIONS,
+                   help=f"--detect fpga: MAX_DETECTIONS, records per frame, 1.."
+                        f"{MAX_FPGA_DETECTIONS} (default {DEFAULT_MAX_DETECTIONS}; more "
+                        f"detections set the trailer's truncated flag)")
     add_detection_options(d)
     d.set_defaults(func=cmd_detect)

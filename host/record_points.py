@@ -1,0 +1,103 @@
+"""Host processing of the FPGA's detection records (``OUTPUT_MODE = 1``) into the same point
+cloud as :func:`host.pipeline.process_cube` makes from a cube.
+
+The FPGA already ran NCI and the 2-D CFAR; a record carries the cell's NCI power, the CFAR's
+noise estimate and the NUM_TX x NUM_RX snapshot. The host then does what it does after its
+own CFAR (``host.pipeline`` module docstring), on the records alone:
+
+1. keep cells inside ``RadarConfig.detection_bins``;
+2. peak grouping: a record is kept when no detected cell of its 3x3 neighbourhood (both
+   axes circular) is stronger (``host.cfar.local_peaks`` on the map of detected powers;
+   the host's own CFAR compares against every neighbour, detected or not, which differs
+   only when an undetected neighbour is stronger than a detected cell);
+3. sidelobe masking against stronger *detected* cells in the same row and column
+   (``host.cfar.sidelobe_masked``; a cell strong enough to throw sidelobes above the
+   threshold is always detected itself);
+4. peak offsets: Gaussian interpolation over the 3 log powers as on the cube when both
+   neighbours along an axis were detected; with one detected neighbour the window's
+   two-bin amplitude ratio (Hann: delta = (2a - 1) / (a + 1), rectangular:
+   a / (1 + a), a = |X_neighbour| / |X_peak|); with none, 0 (the cell centre);
+5. TDM compensation, velocity unfolding, angle estimation and the point cloud:
+   :func:`host.pipeline.points_from_cells`, the same code as the cube path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from host.cfar import detection_mask, local_peaks, sidelobe_masked
+from host.pipeline import DetectionParams, gaussian_offset, points_from_cells
+from host.pointcloud import PointCloud
+from host.records import RecordArrays
+from model.config import RadarConfig
+
+
+def _two_bin_offset(ratio: np.ndarray, windowed: bool) -> np.ndarray:
+    """Offset (bins, towards the neighbour) of a tone from its peak bin, float (n,), from the
+    amplitude ratio neighbour / peak (float (n,) in [0, 1])."""
+    a = np.clip(ratio, 0.0, 1.0)
+    d = (2 * a - 1) / (a + 1) if windowed else a / (1 + a)
+    return np.clip(d, 0.0, 0.5)
+
+
+def record_offsets(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool]
+                   ) -> np.ndarray:
+    """Fractional (range, Doppler) peak offsets, float (n, 2), from the detected powers
+    around each cell (step 4 of the module docstring). pmap: float (n_range, n_doppler),
+    detected cells' NCI power, 0 elsewhere; cells: int (n, 2) (range_bin, doppler_bin)."""
+    nr, nd = pmap.shape
+    out = np.zeros((len(cells), 2))
+    if not len(cells):
+        return out
+    r, d = cells[:, 0], cells[:, 1]
+    c = pmap[r, d]
+    ok_r = (r > 0) & (r < nr - 1)
+    neighbours = (
+        (np.where(ok_r, pmap[np.clip(r - 1, 0, nr - 1), d], 0.0),
+         np.where(ok_r, pmap[np.clip(r + 1, 0, nr - 1), d], 0.0)),
+        (pmap[r, (d - 1) % nd], pmap[r, (d + 1) % nd]),
+    )
+    for axis, (lm, lp) in enumerate(neighbours):
+        both = (lm > 0) & (lp > 0)
+        for i in np.flatnonzero(both):
+            out[i, axis] = gaussian_offset(np.log(lm[i]), np.log(c[i]), np.log(lp[i]))
+        only_p = (lp > 0) & ~both
+        only_m = (lm > 0) & ~both
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[only_p, axis] = _two_bin_offset(np.sqrt(lp[only_p] / c[only_p]),
+                                                windowed[axis])
+            out[only_m, axis] = -_two_bin_offset(np.sqrt(lm[only_m] / c[only_m]),
+                                                 windowed[axis])
+    return out
+
+
+def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Indices (int (m,)) of the records that become points (steps 1 to 3) and the map of
+    detected powers, float (n_range, n_doppler) (0 where nothing was detected)."""
+    nr, nd = cfg.n_range, cfg.n_doppler
+    pmap = np.zeros((nr, nd))
+    index = np.full((nr, nd), -1, np.int64)
+    pmap[arr.range_bin, arr.doppler_bin] = arr.power
+    index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
+    mask = (pmap > 0) & detection_mask(nr, nd, cfg.detection_bins)
+    cells = local_peaks(pmap, mask)
+    windowed = (params.range_window, params.doppler_window)
+    if params.sidelobe_margin_db is not None and len(cells):
+        cells = cells[~sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db)]
+    return index[cells[:, 0], cells[:, 1]], pmap
+
+
+def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
+                    frame: int = 0) -> PointCloud:
+    """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
+    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``."""
+    params = params or DetectionParams()
+    if arr.snapshot.shape[1:] != (cfg.n_virtual,):
+        raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
+                         f"{cfg.n_virtual} virtual channels")
+    idx, pmap = select_records(arr, cfg, params)
+    cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
+    offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
+    return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
+                             offsets, cfg, params, frame)
