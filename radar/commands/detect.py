@@ -92,7 +92,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
             dcfg = fpga_config(args, cfg, params)
             gain = chain_gain(cfg, get_source(args.backend).chain)
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
-            for k, f in enumerate(frames):
+            for f in frames:
+                k = f.frame_id          # a damaged frame closes late: ids, not arrival
                 arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
                 cloud = process_records(arr, cfg, params, frame=k)
                 clouds.append(cloud)
