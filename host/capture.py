@@ -8,6 +8,10 @@ File layout (little-endian)::
     u32          num_tx, u32 n_range, u32 n_doppler   (frame geometry)
     then per packet: u32 length in bytes, the packet's bytes (header word + payload)
 
+A capture of the detection-record stream (``OUTPUT_MODE = 1``, ``host.records``) starts with
+b"RDMAREC1" instead and has one more u32 after n_doppler: MAX_DETECTIONS (which fixes the
+record frame's length); the packets follow as above.
+
 ``radar replay`` sends a capture over UDP one packet per datagram; ``radar receive`` decodes
 datagrams with :class:`host.stream.StreamDecoder`.
 """
@@ -26,7 +30,9 @@ from model.config import RadarConfig
 from model.reference import cube_to_dma_order
 
 MAGIC = b"RDMACAP1"
+MAGIC_RECORDS = b"RDMAREC1"
 _HEAD = struct.Struct("<8s5I")
+_MAX_DET = struct.Struct("<I")
 
 
 @dataclass(frozen=True)
@@ -38,6 +44,13 @@ class CaptureInfo:
     num_tx: int
     n_range: int
     n_doppler: int
+    max_detections: int = 0
+    """MAX_DETECTIONS of a record-stream capture; 0 for a radar-cube capture."""
+
+    @property
+    def records(self) -> bool:
+        """True for a detection-record stream (OUTPUT_MODE = 1)."""
+        return self.max_detections > 0
 
     def matches(self, cfg: RadarConfig) -> bool:
         return (self.num_rx, self.num_tx, self.n_range, self.n_doppler) == (
@@ -67,8 +80,10 @@ def write_capture(path: Path, info: CaptureInfo, packets: Iterable[bytes]) -> in
     """Write packets to ``path``; returns the number written."""
     n = 0
     with open(path, "wb") as f:
-        f.write(_HEAD.pack(MAGIC, info.num_rx, info.packet_words, info.num_tx, info.n_range,
-                           info.n_doppler))
+        f.write(_HEAD.pack(MAGIC_RECORDS if info.records else MAGIC, info.num_rx,
+                           info.packet_words, info.num_tx, info.n_range, info.n_doppler))
+        if info.records:
+            f.write(_MAX_DET.pack(info.max_detections))
         for p in packets:
             f.write(struct.pack("<I", len(p)))
             f.write(p)
@@ -82,11 +97,19 @@ def read_capture(path: Path) -> tuple[CaptureInfo, Iterator[bytes]]:
     raising ValueError."""
     f = open(path, "rb")  # noqa: SIM115 - closed by the generator
     head = f.read(_HEAD.size)
-    if len(head) < _HEAD.size or head[:8] != MAGIC:
+    if len(head) < _HEAD.size or head[:8] not in (MAGIC, MAGIC_RECORDS):
         f.close()
-        raise ValueError(f"{path}: not a DMA capture (missing {MAGIC!r} header)")
+        raise ValueError(f"{path}: not a DMA capture (missing {MAGIC!r} or {MAGIC_RECORDS!r} "
+                         f"header)")
     _, num_rx, packet_words, num_tx, n_range, n_doppler = _HEAD.unpack(head)
-    info = CaptureInfo(num_rx, packet_words, num_tx, n_range, n_doppler)
+    max_det = 0
+    if head[:8] == MAGIC_RECORDS:
+        more = f.read(_MAX_DET.size)
+        if len(more) < _MAX_DET.size or not _MAX_DET.unpack(more)[0]:
+            f.close()
+            raise ValueError(f"{path}: record capture header truncated or MAX_DETECTIONS 0")
+        (max_det,) = _MAX_DET.unpack(more)
+    info = CaptureInfo(num_rx, packet_words, num_tx, n_range, n_doppler, max_det)
 
     def packets() -> Iterator[bytes]:
         with f:

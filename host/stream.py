@@ -17,7 +17,7 @@ damaged: lost, repeated, truncated, reordered or corrupt packets) or in the deco
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Generic, Protocol, TypeVar
 
@@ -36,12 +36,19 @@ MAX_STREAM_PROBLEMS = 1000
 """Stream-level problem messages kept (counters keep counting past it)."""
 
 
-def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig]
+def cube_frame_words(cfg: RadarConfig) -> int:
+    """Payload words of one radar-cube frame, num_tx * n_range * n_doppler."""
+    return cfg.num_tx * cfg.n_range * cfg.n_doppler
+
+
+def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
+                         frame_words_of: Callable[[RadarConfig], int] = cube_frame_words
                          ) -> tuple[RadarConfig, int]:
     """The radar configuration and PACKET_WORDS a DMA packet belongs to, from its header
     alone: the datagram length and header lane 1 (payload words) give the word width, hence
     num_rx; lane 3 gives the packets per frame, which with the payload length fixes
-    PACKET_WORDS for a preset's frame size. ValueError when no configuration fits."""
+    PACKET_WORDS for a preset's frame size (``frame_words_of(cfg)``: the cube's by default,
+    a record stream's for ``host.records``). ValueError when no configuration fits."""
     tried = []
     for cfg in configs:
         wb = 4 * cfg.num_rx
@@ -54,7 +61,7 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig]
         except ValueError:
             tried.append(cfg.name)
             continue
-        frame_words = cfg.num_tx * cfg.n_range * cfg.n_doppler
+        frame_words = frame_words_of(cfg)
         if hdr.length != len(words) - 1 or not hdr.n_packets:
             tried.append(cfg.name)
             continue

@@ -111,12 +111,12 @@ class ModelSource(FrameSource):
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
         # the chain in mode 1: Doppler-FFT words in (r, t, d) order -> detect_chain ->
-        # packetizer (model.detect_chain, docs/detect.md), one frame at a time
-        for k, adc in enumerate(adc_frames):
-            payload = run_chain(adc, cfg, self.chain).payload       # (tx, r, d, rx)
-            words = pack_iq(payload.transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
-            stream = detect_stream([words], dcfg)
-            yield from packetize_stream(stream, self.chain.packet_words, first_frame_id=k)
+        # packetizer (model.detect_chain, docs/detect.md); frame ids and the sticky
+        # truncation flag run over the whole stream, as after one reset
+        words = (pack_iq(run_chain(adc, cfg, self.chain).payload            # (tx, r, d, rx)
+                         .transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
+                 for adc in adc_frames)
+        yield from packetize_stream(detect_stream(words, dcfg), self.chain.packet_words)
 
 
 class FloatSource(FrameSource):

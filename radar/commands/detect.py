@@ -56,7 +56,7 @@ def fpga_config(args: argparse.Namespace, cfg: RadarConfig, params: DetectionPar
     if args.detector != "ca":
         raise CliError(f"--detect fpga: the FPGA runs a CA/GO/SO CFAR (--fpga-cfar), not "
                        f"--detector {args.detector}")
-    if args.plots:
+    if getattr(args, "plots", None):
         raise CliError("--plots: needs the radar cube, which --detect fpga does not send "
                        "(use --detect host)")
     count(args.max_detections, "--max-detections", MAX_FPGA_DETECTIONS)
@@ -145,6 +145,17 @@ def cmd_detect(args: argparse.Namespace) -> int:
     return 0
 
 
+def add_fpga_options(p: argparse.ArgumentParser) -> None:
+    """Options of the on-chip detector (``--detect fpga``)."""
+    p.add_argument("--fpga-cfar", choices=KINDS, default="ca",
+                   help="--detect fpga: the on-chip CFAR kind, cell averaging or greatest/"
+                        "smallest of the two Doppler halves (default ca)")
+    p.add_argument("--max-detections", type=int, default=DEFAULT_MAX_DETECTIONS,
+                   help=f"--detect fpga: MAX_DETECTIONS, records per frame, 1.."
+                        f"{MAX_FPGA_DETECTIONS} (default {DEFAULT_MAX_DETECTIONS}; more "
+                        f"detections set the trailer's truncated flag)")
+
+
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     d = sub.add_parser(
         "detect", help="scene -> point cloud JSON",
@@ -173,12 +184,6 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(default); fpga: the chain detects on chip (OUTPUT_MODE = 1: NCI, "
                         "2-D CFAR, snapshot records) and the host goes on from the records "
                         "(--backend model or rtl)")
-    d.add_argument("--fpga-cfar", choices=KINDS, default="ca",
-                   help="--detect fpga: the on-chip CFAR kind, cell averaging or greatest/"
-                        "smallest of the two Doppler halves (default ca)")
-    d.add_argument("--max-detections", type=int, default=DEFAULT_MAX_DETECTIONS,
-                   help=f"--detect fpga: MAX_DETECTIONS, records per frame, 1.."
-                        f"{MAX_FPGA_DETECTIONS} (default {DEFAULT_MAX_DETECTIONS}; more "
-                        f"detections set the trailer's truncated flag)")
+    add_fpga_options(d)
     add_detection_options(d)
     d.set_defaults(func=cmd_detect)

@@ -1,6 +1,13 @@
 """The link commands: ``radar capture`` (DMA packets of simulated frames to a .dmacap file),
 ``radar replay`` (send a capture over UDP as the board would) and ``radar receive`` (decode
-UDP packets -> point cloud JSON)."""
+UDP packets -> point cloud JSON).
+
+With ``--detect fpga`` the stream is the on-chip detector's record stream (``OUTPUT_MODE =
+1``) instead of the radar cube: ``capture`` writes it (a record capture, ``host.capture``),
+``replay`` sends either kind unchanged, and ``receive --detect fpga`` decodes records
+(``host.records.RecordDecoder``) and goes on from them (``host.record_points``). The kind is
+chosen by the flag, not guessed: ``receive`` without it names the record stream in its error
+when the first datagram fits a record stream but no cube."""
 
 from __future__ import annotations
 
@@ -13,10 +20,13 @@ from typing import Any
 from host.capture import CaptureInfo, read_capture, write_capture
 from host.pipeline import process_cube
 from host.pointcloud import PointCloud
+from host.record_points import process_records
+from host.records import RecordDecoder, record_arrays
 from model.axis_packetizer import words_to_bytes
-from model.config import PRESETS, get_preset
+from model.config import PRESETS, RadarConfig, get_preset
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.simulate import simulate_scene
+from radar.commands.detect import add_fpga_options, fpga_config
 from radar.common import (
     CliError,
     add_detection_options,
@@ -28,6 +38,7 @@ from radar.common import (
     scene_of,
     warn,
 )
+from radar.sources import get_source
 
 MAX_CAPTURE_FRAMES = 1000
 """Largest --frames of a capture (17 GB on full: more is a mistake)."""
@@ -54,13 +65,23 @@ def cmd_capture(args: argparse.Namespace) -> int:
                        f"bytes per packet does not fit a UDP datagram (at most {fit} for "
                        f"{cfg.num_rx} lanes), so radar replay could not send it")
     packets: list[bytes] = []
-    for k in progress(range(args.frames), "frames"):
-        adc = simulate_scene(scene, frame_index=k).samples
-        packets.extend(words_to_bytes(p) for p in dma_packets([adc], cfg, chain, k))
-    info = CaptureInfo(cfg.num_rx, pw, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+    adcs = (simulate_scene(scene, frame_index=k).samples
+            for k in progress(range(args.frames), "frames"))
+    if args.detect == "fpga":
+        dcfg = fpga_config(args, cfg, detection_params(args, scene.tx_beamforming, cfg))
+        source = get_source("model", chain)
+        packets.extend(p if isinstance(p, bytes) else words_to_bytes(p)
+                       for p in source.record_packets(adcs, cfg, dcfg))
+        max_det = dcfg.max_detections
+    else:
+        for k, adc in enumerate(adcs):
+            packets.extend(words_to_bytes(p) for p in dma_packets([adc], cfg, chain, k))
+        max_det = 0
+    info = CaptureInfo(cfg.num_rx, pw, cfg.num_tx, cfg.n_range, cfg.n_doppler, max_det)
     n = write_capture(out, info, packets)
+    what = (f"detection records, MAX_DETECTIONS {max_det}" if max_det else "radar cube")
     print(f"wrote {out}: {args.frames} frame(s), {n} packets of {pw} payload words (preset "
-          f"{cfg.name}; bit-accurate model of the FPGA chain, cube gain "
+          f"{cfg.name}, {what}; bit-accurate model of the FPGA chain, cube gain "
           f"{chain_gain(cfg, chain):g} over 1/N per FFT)")
     return 0
 
@@ -81,14 +102,28 @@ def cmd_replay(args: argparse.Namespace) -> int:
             log = tx.send(packets)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
-    print(f"sent {log.sent} datagrams ({cfg.name}, {info.packet_words} payload words each) to "
+    kind = f"records, MAX_DETECTIONS {info.max_detections}" if info.records else "cube"
+    print(f"sent {log.sent} datagrams ({cfg.name} {kind}, {info.packet_words} payload words "
+          f"each) to "
           f"{args.host}:{args.port} ({len(log.dropped)} dropped, {len(log.duplicated)} "
           f"duplicated, {len(log.reordered)} reordered on purpose)")
     return 0
 
 
+def _record_decoder(args: argparse.Namespace, cfg: RadarConfig,
+                    packet_words: int | None, first: bytes | None = None) -> RecordDecoder:
+    """The record decoder for ``cfg`` (PACKET_WORDS given, or learnt from ``first``)."""
+    from host.stream import geometry_from_packet
+
+    dcfg = fpga_config(args, cfg, detection_params(args, cfg=cfg))
+    if packet_words is None:
+        assert first is not None
+        _, packet_words = geometry_from_packet(first, [cfg], lambda _: dcfg.frame_words)
+    return RecordDecoder(dcfg, packet_words)
+
+
 def cmd_receive(args: argparse.Namespace) -> int:
-    from host.stream import StreamDecoder, geometry_from_packet
+    from host.stream import PacketDecoder, StreamDecoder, geometry_from_packet
     from host.udp import UdpReceiver, check_seconds
 
     out = out_file(args.json, ".json", "--json")
@@ -101,15 +136,43 @@ def cmd_receive(args: argparse.Namespace) -> int:
     fixed = get_preset(args.preset) if args.preset else None
     params = detection_params(args, cfg=fixed)
 
-    def make_decoder(first: bytes) -> StreamDecoder:
+    records = args.detect == "fpga"
+    configs = [fixed] if fixed else list(PRESETS.values())
+
+    def make_decoder(first: bytes) -> PacketDecoder[Any]:
         """Geometry from the options if given, else learnt from the first datagram."""
-        configs = [fixed] if fixed else list(PRESETS.values())
-        cfg, pw = geometry_from_packet(first, configs)
+        if records:
+            errors = []
+            for cfg in configs:
+                try:
+                    return _record_decoder(args, cfg, args.packet_words, first)
+                except (ValueError, CliError) as exc:
+                    errors.append(f"{cfg.name}: {exc}")
+            raise ValueError("not a record-stream packet of "
+                             + "; ".join(errors) + " (check --max-detections)")
+        try:
+            cfg, pw = geometry_from_packet(first, configs)
+        except ValueError as exc:
+            for cfg in configs:   # say so when it is a record stream
+                try:
+                    _record_decoder(args, cfg, args.packet_words, first)
+                except (ValueError, CliError):
+                    continue
+                raise ValueError(f"{exc}; it fits a detection-record stream of {cfg.name}: "
+                                 f"use --detect fpga") from None
+            raise
         return StreamDecoder(cfg, args.packet_words or pw)
 
     try:
+        if records:
+            for cfg in configs:   # check the detector options before listening
+                fpga_config(args, cfg, detection_params(args, cfg=cfg))
         if fixed and args.packet_words:
-            StreamDecoder(fixed, args.packet_words)  # check the geometry before listening
+            # check the geometry before listening
+            if records:
+                _record_decoder(args, fixed, args.packet_words)
+            else:
+                StreamDecoder(fixed, args.packet_words)
         rx = UdpReceiver(args.host, args.port)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
@@ -118,17 +181,23 @@ def cmd_receive(args: argparse.Namespace) -> int:
         frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
                             total_timeout_s=args.timeout, make_decoder=make_decoder)
     decoder = rx.decoder
-    cfg = decoder.cfg if decoder else fixed
-    if decoder:
-        params = detection_params(args, cfg=decoder.cfg)  # CFAR window vs the learnt map
+    cfg = _decoder_config(decoder, configs) if decoder else fixed
+    if decoder and cfg:
+        params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
     try:
         for f in frames:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
                                      "problems": f.problems}
-            if decoder and (f.complete or args.use_damaged):
-                gain = chain_gain(decoder.cfg, PipelineParams(packet_words=decoder.packet_words))
-                cloud = process_cube(f.cube / gain, decoder.cfg, params, frame=f.frame_id)
+            if decoder and cfg and (f.complete or args.use_damaged):
+                gain = chain_gain(cfg, PipelineParams(packet_words=decoder.packet_words))
+                if records:
+                    arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
+                    cloud = process_records(arr, cfg, params, frame=f.frame_id)
+                    entry.update({"records": len(f.records), "detections": f.detections,
+                                  "truncated": f.truncated})
+                else:
+                    cloud = process_cube(f.cube / gain, cfg, params, frame=f.frame_id)
                 clouds.append(cloud)
                 entry["points"] = len(cloud)
             frames_doc.append(entry)
@@ -136,7 +205,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
         rx.interrupted = True
     cloud = PointCloud.concat(clouds)
     doc = cloud.to_json_dict(cfg.name if cfg else "unknown", len(frames))
-    doc.update({"backend": "udp", "packet_words": decoder.packet_words if decoder else None,
+    doc.update({"backend": "udp", "detect": args.detect,
+                "packet_words": decoder.packet_words if decoder else None,
                 "datagrams": rx.datagrams, "interrupted": rx.interrupted,
                 "frame_info": frames_doc,
                 "stream_problems": (decoder.stream_problems if decoder else []) + rx.unusable,
@@ -162,6 +232,15 @@ def cmd_receive(args: argparse.Namespace) -> int:
     return 0
 
 
+def _decoder_config(decoder: Any, configs: list[RadarConfig]) -> RadarConfig | None:
+    """The radar configuration a decoder was built for."""
+    if isinstance(decoder, RecordDecoder):
+        d = decoder.dcfg
+        return next((c for c in configs if (c.num_tx, c.num_rx, c.n_range, c.n_doppler)
+                     == (d.num_tx, d.num_rx, d.n_range, d.n_doppler)), None)
+    return decoder.cfg
+
+
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     c = sub.add_parser(
         "capture", help="write the DMA packets of simulated frames to a capture file",
@@ -177,6 +256,11 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "one UDP datagram of 65507 bytes with the header word: 1022 for the "
                         "16 lanes of full, 4093 for the 4 of paper-fpga)")
     c.add_argument("--preset", choices=presets, default=None, help="override the preset")
+    c.add_argument("--detect", choices=("host", "fpga"), default="host",
+                   help="host: capture the radar cube stream (default); fpga: the on-chip "
+                        "detector's record stream (OUTPUT_MODE = 1), a record capture")
+    add_fpga_options(c)
+    add_detection_options(c)
     c.set_defaults(func=cmd_capture)
 
     r = sub.add_parser(
@@ -220,5 +304,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v.add_argument("--use-damaged", action="store_true",
                    help="also process frames with missing packets (zeros where missing)")
     v.add_argument("--json", required=True, help="output point cloud .json")
+    v.add_argument("--detect", choices=("host", "fpga"), default="host",
+                   help="host: the stream is the radar cube, the host runs the CFAR "
+                        "(default); fpga: the stream is the on-chip detector's records "
+                        "(radar capture --detect fpga), decoded with the same --max-detections")
+    add_fpga_options(v)
     add_detection_options(v)
     v.set_defaults(func=cmd_receive)
