@@ -83,6 +83,63 @@ def peak_power(x: np.ndarray, n_fft: int) -> float:
     return float(np.max(np.abs(spec) ** 2))
 
 
+def peak_sin_batch(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_sin` of every row of ``x``, complex (n, n_channels): (sin(az) float (n,),
+    |peak|^2 float (n,)), one batched FFT."""
+    spec, _ = angle_spectrum(x, n_fft=n_fft)
+    mag = np.abs(spec)
+    k = np.argmax(mag, axis=-1)
+    rows = np.arange(len(k))
+    a, b, c = mag[rows, (k - 1) % n_fft], mag[rows, k], mag[rows, (k + 1) % n_fft]
+    den = a - 2 * b + c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, 1.0), 0.0)
+    s = 2.0 * (k + delta - n_fft // 2) / n_fft
+    return (s + 1.0) % 2.0 - 1.0, b * b
+
+
+def peak_power_batch(x: np.ndarray, n_fft: int) -> np.ndarray:
+    """:func:`peak_power` over the last axis of ``x``, complex (..., n_channels): float (...)."""
+    spec, _ = angle_spectrum(x, n_fft=n_fft)
+    return np.max(np.abs(spec) ** 2, axis=-1)
+
+
+def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
+                          ) -> list[list[AngleComponent]]:
+    """:func:`estimate_angles` of every row of ``x``, complex (n, n_channels), with
+    ``noise_per_channel`` float (n,): the first component of all rows and the test for a
+    second one in two batched FFTs; only the rows that hold a second component (several
+    targets in one cell, rare) go through :func:`estimate_angles` one by one."""
+    xs = np.asarray(x, dtype=np.complex128)
+    n_rows, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if not n_rows:
+        return []
+    ch = np.arange(n)
+    s1, _ = peak_sin_batch(xs, params.n_fft)
+    st1 = np.exp(-1j * np.pi * s1[:, None] * ch[None, :])
+    a1 = np.sum(np.conj(st1) * xs, axis=1) / n
+    p1 = np.abs(a1) ** 2
+    more = np.zeros(n_rows, bool)
+    if params.max_targets > 1:
+        res = xs - a1[:, None] * st1
+        s2, _ = peak_sin_batch(res, params.n_fft)
+        st2 = np.exp(-1j * np.pi * s2[:, None] * ch[None, :])
+        p2 = np.abs(np.sum(np.conj(st2) * res, axis=1) / n) ** 2
+        with np.errstate(divide="ignore"):
+            snr2 = 10 * np.log10(p2 * n / noise)
+            more = (snr2 >= params.min_snr_db) & (
+                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+    snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
+    out: list[list[AngleComponent]] = []
+    for i in range(n_rows):
+        if more[i]:
+            out.append(estimate_angles(xs[i], float(noise[i]), params))
+        else:
+            out.append([AngleComponent(float(s1[i]), complex(a1[i]), float(snr1[i]))])
+    return out
+
+
 def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
                     ) -> list[AngleComponent]:
     """Components (targets) in one cell's TDM-compensated channel vector x, complex (n,).

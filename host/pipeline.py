@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from host.angle import AngleParams, estimate_angles, peak_power
+from host.angle import AngleParams, estimate_angles_batch, peak_power_batch
 from host.cfar import (
     CfarParams,
     cfar_threshold,
@@ -112,18 +112,24 @@ class DetectionParams:
             check_window(self.cfar, (cfg.n_range, cfg.n_doppler))
 
 
-def _window_response(n: int, offset: float, windowed: bool) -> float:
-    """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins off a bin centre."""
+def _window_response(n: int, offset: np.ndarray | float, windowed: bool) -> np.ndarray:
+    """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
+    a bin centre, float (m,) or scalar."""
     w = hann_periodic(n) if windowed else np.ones(n)
-    return float(abs(np.sum(w * np.exp(-2j * np.pi * offset * np.arange(n) / n))) / w.sum())
+    off = np.asarray(offset, dtype=float)
+    ph = np.exp(-2j * np.pi * np.multiply.outer(off, np.arange(n)) / n)
+    return np.abs(ph @ w) / w.sum()
 
 
-def gaussian_offset(lm: float, c: float, lp: float) -> float:
-    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation)."""
+def gaussian_offset(lm: np.ndarray | float, c: np.ndarray | float, lp: np.ndarray | float
+                    ) -> np.ndarray:
+    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation);
+    element-wise over arrays, 0 where the samples do not curve down."""
+    lm, c, lp = (np.asarray(v, dtype=float) for v in (lm, c, lp))
     den = lm - 2 * c + lp
-    if den >= 0:
-        return 0.0
-    return float(np.clip(0.5 * (lm - lp) / den, -0.5, 0.5))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        off = np.clip(0.5 * (lm - lp) / np.where(den < 0, den, -1.0), -0.5, 0.5)
+    return np.where(den < 0, off, 0.0)
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
@@ -155,13 +161,14 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     return cells, noise_map[cells[:, 0], cells[:, 1]], nci
 
 
-def _tdm_comp(cfg: RadarConfig, k: int) -> np.ndarray:
-    """TDM compensation phasors, complex (n_virtual,), for the *unfolded* signed Doppler bin
-    ``k`` (any integer). ``tdm_phase_compensation`` takes natural-order bins and maps
-    k >= n_doppler/2 back to k - n_doppler, which would undo an unfolding by +1; its phase
-    has period num_tx * n_doppler in k, so k is shifted by that period instead."""
-    if k >= cfg.n_doppler // 2:
-        k -= cfg.num_tx * cfg.n_doppler
+def _tdm_comp(cfg: RadarConfig, k: np.ndarray | int) -> np.ndarray:
+    """TDM compensation phasors, complex (..., n_virtual), for the *unfolded* signed Doppler
+    bins ``k`` (any integers, int or int (...)). ``tdm_phase_compensation`` takes
+    natural-order bins and maps k >= n_doppler/2 back to k - n_doppler, which would undo an
+    unfolding by +1; its phase has period num_tx * n_doppler in k, so k is shifted by that
+    period instead."""
+    k = np.asarray(k)
+    k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     return tdm_phase_compensation(cfg, k)
 
 
@@ -174,29 +181,36 @@ def velocity_hypotheses(cfg: RadarConfig, velocity_mps: float, max_speed_mps: fl
     return list(range(lo, hi + 1)) or [0]
 
 
-def _choose_fold(x: np.ndarray, cfg: RadarConfig, d: int, velocity_mps: float, snr_db: float,
-                 params: DetectionParams) -> tuple[int, bool]:
+def _choose_fold(power: dict[int, float], cfg: RadarConfig, velocity_mps: float,
+                 snr_db: float, params: DetectionParams) -> tuple[int, bool]:
     """Alias order m of a cell's velocity and whether it is ambiguous (module docstring,
-    step 3). ``x``: the cell's channel vector; ``velocity_mps``: measured (aliased)."""
+    step 3). ``power``: peak angle-spectrum power of the cell's channel vector compensated
+    for each alias class c = m mod num_tx (``_class_powers``; empty when the TDM test does
+    not run); ``velocity_mps``: measured (aliased)."""
     hyps = velocity_hypotheses(cfg, velocity_mps, params.max_speed_mps)
     if cfg.num_tx > 1 and params.unfold_velocity and len(hyps) > 1:
-        n_fft = params.angle.n_fft
-        k = int(signed_bins(cfg.n_doppler)[d])
         classes = sorted({m % cfg.num_tx for m in hyps})
-        power = {c: peak_power(x * _tdm_comp(cfg, k + c * cfg.n_doppler), n_fft)
-                 for c in classes}
         best = max(classes, key=power.__getitem__)
         margin = 10 ** (params.unfold_margin_db / 10)
         others = [power[c] for c in classes if c != best]
         beats_all = not others or power[best] >= margin * max(others)
         if best != 0 and not (beats_all and snr_db >= params.unfold_min_snr_db):
-            best = 0 if 0 in power else best
+            best = 0 if 0 in classes else best
             beats_all = not others or power[best] >= margin * max(
                 power[c] for c in classes if c != best)
         if beats_all:
             hyps = [m for m in hyps if m % cfg.num_tx == best] or hyps
     m = min(hyps, key=lambda h: abs(velocity_mps + 2.0 * h * cfg.max_velocity_mps))
     return m, len(hyps) > 1 or m != 0
+
+
+def _class_powers(x: np.ndarray, cfg: RadarConfig, k: np.ndarray, n_fft: int) -> np.ndarray:
+    """Peak angle-spectrum power of each cell compensated for alias class c, float
+    (n, num_tx): x complex (n, n_virtual), k int (n,) signed Doppler bins (one batched FFT
+    of all cells and classes)."""
+    c = np.arange(cfg.num_tx)
+    comp = _tdm_comp(cfg, k[:, None] + c[None, :] * cfg.n_doppler)      # (n, num_tx, n_v)
+    return peak_power_batch(x[:, None, :] * comp, n_fft)
 
 
 def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.ndarray,
@@ -218,12 +232,12 @@ def peak_offsets(logp: np.ndarray, cells: np.ndarray) -> np.ndarray:
     (Doppler circular; 0 at the range ends). logp: float (n_range, n_doppler) log power;
     cells: int (n, 2) of (range_bin, doppler_bin)."""
     nr, nd = logp.shape
-    out = np.zeros((len(cells), 2))
-    for i, (r, d) in enumerate(cells):
-        if 0 < r < nr - 1:
-            out[i, 0] = gaussian_offset(logp[r - 1, d], logp[r, d], logp[r + 1, d])
-        out[i, 1] = gaussian_offset(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
-    return out
+    r, d = cells[:, 0], cells[:, 1]
+    inner = (r > 0) & (r < nr - 1)
+    rm, rp = np.clip(r - 1, 0, nr - 1), np.clip(r + 1, 0, nr - 1)
+    dr = np.where(inner, gaussian_offset(logp[rm, d], logp[r, d], logp[rp, d]), 0.0)
+    dd = gaussian_offset(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
+    return np.stack([dr, dd], axis=1).reshape(len(cells), 2)
 
 
 def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
@@ -231,7 +245,8 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
                       params: DetectionParams, frame: int = 0) -> PointCloud:
     """Point cloud of detected cells (steps 3 to 5 of the module docstring), whether they
     come from a cube (:func:`process_cube`) or from the FPGA's records
-    (``host.record_points``).
+    (``host.record_points``). Vectorised over the cells: the angle FFTs of all cells and
+    TDM hypotheses run as batches.
 
     cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
@@ -239,46 +254,47 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
     per cell of the non-coherent map; offsets: float (n, 2) fractional (range, Doppler)
     offsets of the peak from the cell centre, bins.
     """
-    nr, nd = cfg.n_range, cfg.n_doppler
-    sbins = signed_bins(nd)
-    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
-    rows: dict[str, list[float]] = {k: [] for k in (
-        "range_m", "azimuth_deg", "radial_velocity_mps", "power_db", "snr_db", "amp_adc",
-        "range_bin", "doppler_bin", "ambiguous")}
-    for (r, d), x, p_cell, noise_cell, (dr, dd) in zip(cells, snapshots, power, noise,
-                                                       offsets, strict=True):
-        noise_ch = noise_cell / cfg.n_virtual
-        cell_snr_db = 10 * np.log10(max(p_cell - noise_cell, 1e-30) / noise_cell) \
-            + 10 * np.log10(cfg.n_virtual)
-        fold, ambiguous = _choose_fold(x, cfg, d, (int(sbins[d]) + dd) * cfg.velocity_bin_mps,
-                                       cell_snr_db, params)
-        k = int(sbins[d]) + fold * nd
-        comps = estimate_angles(x * _tdm_comp(cfg, k), noise_ch, params.angle)
-        velocity = (k + dd) * cfg.velocity_bin_mps
-        # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
-        coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
-        range_m = (r + dr - coupling) * cfg.range_bin_m
-        scallop = _window_response(nr, dr, params.range_window) * _window_response(
-            nd, dd, params.doppler_window)
-        for c in comps:
-            rows["range_m"].append(range_m)
-            rows["azimuth_deg"].append(c.azimuth_deg)
-            rows["radial_velocity_mps"].append(velocity)
-            rows["power_db"].append(20 * np.log10(max(abs(c.amplitude), 1e-30)))
-            rows["snr_db"].append(c.snr_db)
-            rows["amp_adc"].append(abs(c.amplitude) / (cg * scallop))
-            rows["range_bin"].append(r)
-            rows["doppler_bin"].append(k)
-            rows["ambiguous"].append(ambiguous)
-    a = {k: np.asarray(v) for k, v in rows.items()}
-    if not len(a["range_m"]):
+    n = len(cells)
+    if not n:
         return PointCloud.empty()
-    rcs = rcs_estimate_dbsm(cfg, a["amp_adc"], a["range_m"], a["azimuth_deg"],
-                            params.tx_beamforming)
+    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
+    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
+    x = np.asarray(snapshots)
+    noise = np.asarray(noise, dtype=float)
+    dr, dd = offsets[:, 0], offsets[:, 1]
+    sb = signed_bins(nd)[d].astype(np.int64)
+    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    measured = (sb + dd) * cfg.velocity_bin_mps
+    # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
+    class_power = (_class_powers(x, cfg, sb, params.angle.n_fft)
+                   if cfg.num_tx > 1 and params.unfold_velocity else np.zeros((n, 0)))
+    fold = np.zeros(n, np.int64)
+    ambiguous = np.zeros(n, bool)
+    for i in range(n):
+        powers = {c: float(p) for c, p in enumerate(class_power[i])}
+        fold[i], ambiguous[i] = _choose_fold(powers, cfg, float(measured[i]),
+                                             float(cell_snr_db[i]), params)
+    k = sb + fold * nd
+    # step 4: angles of the TDM-compensated channel vectors
+    comps = estimate_angles_batch(x * _tdm_comp(cfg, k), noise / nv, params.angle)
+    velocity = (k + dd) * cfg.velocity_bin_mps
+    # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
+    coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
+    range_m = (r + dr - coupling) * cfg.range_bin_m
+    scallop = _window_response(nr, dr, params.range_window) * _window_response(
+        nd, dd, params.doppler_window)
+    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
+    # step 5: one point per angle component
+    cell = np.array([i for i, cs in enumerate(comps) for _ in cs], dtype=np.int64)
+    flat = [c for cs in comps for c in cs]
+    az = np.array([c.azimuth_deg for c in flat])
+    amp = np.abs(np.array([c.amplitude for c in flat], dtype=complex))
+    snr = np.array([c.snr_db for c in flat])
+    amp_adc = amp / (cg * scallop[cell])
+    rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
     return PointCloud.from_polar(
-        a["range_m"], a["azimuth_deg"], a["radial_velocity_mps"], a["power_db"], a["snr_db"],
-        rcs, a["range_bin"].astype(int), a["doppler_bin"].astype(int),
-        a["ambiguous"].astype(bool), frame=frame)
+        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr, rcs,
+        r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
 
 
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
