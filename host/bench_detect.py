@@ -1,0 +1,263 @@
+"""Benchmark of the on-chip detection path (``OUTPUT_MODE = 1``, issue 14): the FPGA's CFAR
+and records (bit-accurate model) against the host CFAR on the cube, and what the records
+cost on the link and on the host. Prints four tables:
+
+1. detection: true targets found through ``--detect fpga`` and ``--detect host`` on the
+   Table I scene (``full``) and on random point-target scenes (both presets), and their
+   agreement (targets the host path finds that the FPGA path finds too; goal >= 99 %);
+2. false alarms on noise-only frames (thermal noise through the fixed-point chain) against
+   the configured Pfa: CFAR detections per reportable cell (records) and points per cell
+   for both paths (goal: within 2x);
+3. link: bytes per frame and Mbit/s at 111 frames/s of the record stream for ``full`` with
+   10, 100, 1000 detections (measured on encoded, packetized frames) vs the radar cube
+   (goal: fits the paper's measured 766 Mbit/s);
+4. host time per frame for 1000 detections on one core: DMA bytes -> records (decoder) and
+   records -> point cloud (goal <= 5 ms).
+
+    python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
+
+Uses the bit-accurate model of the chain (mode 0 cube, mode 1 records). Reported, never
+asserted in tests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from host.cfar import CfarParams
+from host.evaluate import match_targets
+from host.pipeline import DetectionParams, process_cube
+from host.pointcloud import PointCloud
+from host.record_points import process_records
+from host.records import RecordDecoder, fpga_detect_config, record_arrays
+from model.axis_packetizer import pack_iq, packetize, packetize_stream, words_to_bytes
+from model.config import RadarConfig, get_preset
+from model.detect_chain import DetectConfig, detect_stream
+from model.detect_records import Record, encode_frame
+from model.radar_pipeline import PipelineParams, chain_gain, run_chain
+from model.reference import tdm_phase_compensation
+from model.scene import PointTarget, Scene, table1_scene
+from model.simulate import simulate_scene, thermal_noise
+
+FRAME_RATE_HZ = 111.0
+"""The radar's frame rate (the paper's 111 frames/s)."""
+LINK_MBPS = 766.0
+"""The paper's measured Gigabit Ethernet throughput, Mbit/s."""
+UDP_PACKET_WORDS = {"full": 1022, "paper-fpga": 4093}
+"""PACKET_WORDS that fill one UDP datagram (``host.udp.max_packet_words``)."""
+
+
+def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
+                dcfg: DetectConfig) -> tuple[PointCloud, PointCloud, int]:
+    """Point clouds of one ADC frame through the host CFAR (cube) and the on-chip detector
+    (records, as bytes through the decoder), and the FPGA's detection count."""
+    chain = PipelineParams()
+    payload = run_chain(adc, cfg, chain).payload                   # (tx, r, d, rx)
+    gain = chain_gain(cfg, chain)
+    cube = payload.transpose(0, 3, 1, 2).reshape(cfg.cube_shape).astype(np.complex64) / gain
+    host = process_cube(cube, cfg, params)
+    words = pack_iq(payload.transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
+    dec = RecordDecoder(dcfg, chain.packet_words)
+    frames = [f for p in packetize_stream(detect_stream([words], dcfg), chain.packet_words)
+              for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
+    f = frames[0]
+    fpga = process_records(record_arrays(f.records, cfg.n_virtual, gain), cfg, params)
+    return host, fpga, f.detections
+
+
+def random_scene(preset: str, seed: int) -> Scene:
+    """1..5 point targets: range uniform in [5 m, 85 % of the largest reportable range],
+    azimuth +-45 deg, radial velocity within +-90 % of vmax (no aliasing), RCS
+    log-uniform 5..100 m^2."""
+    cfg = get_preset(preset)
+    rng = np.random.default_rng([14, seed])
+    targets = tuple(PointTarget(
+        range_m=float(rng.uniform(5.0, 0.85 * cfg.max_detection_range_m)),
+        azimuth_deg=float(rng.uniform(-45, 45)),
+        radial_velocity_mps=float(rng.uniform(-0.9, 0.9) * cfg.max_velocity_mps),
+        rcs_m2=float(10 ** rng.uniform(math.log10(5), 2)))
+        for _ in range(int(rng.integers(1, 6))))
+    return Scene(preset=preset, seed=seed, targets=targets, name=f"random-{seed}")
+
+
+def detection_rows(scenes: list[Scene]) -> dict[str, float]:
+    """Targets found by each path over ``scenes`` and their agreement."""
+    n = host_found = fpga_found = both = fpga_only = 0
+    err_host: list[float] = []
+    err_fpga: list[float] = []
+    for sc in scenes:
+        cfg = sc.config
+        params = DetectionParams()
+        dcfg = fpga_detect_config(cfg, params.cfar)
+        host, fpga, _ = _both_paths(simulate_scene(sc).samples, cfg, params, dcfg)
+        mh, _ = match_targets(host, sc.targets, cfg)
+        mf, _ = match_targets(fpga, sc.targets, cfg)
+        for a, b in zip(mh, mf, strict=True):
+            n += 1
+            host_found += a.index >= 0
+            fpga_found += b.index >= 0
+            both += a.index >= 0 and b.index >= 0
+            fpga_only += b.index >= 0 and a.index < 0
+            if a.index >= 0 and b.index >= 0:
+                err_host.append(abs(a.range_err_m))
+                err_fpga.append(abs(b.range_err_m))
+    return {"targets": n, "host": host_found, "fpga": fpga_found,
+            "agree": 100.0 * both / max(host_found, 1), "fpga_only": fpga_only,
+            "rerr_host": float(np.mean(err_host)) if err_host else float("nan"),
+            "rerr_fpga": float(np.mean(err_fpga)) if err_fpga else float("nan")}
+
+
+def false_alarm_rows(preset: str, frames: int, pfas: tuple[float, ...]
+                     ) -> list[tuple[float, float, float, float]]:
+    """(Pfa, FPGA CFAR detections per cell, FPGA-path points per cell, host points per
+    cell) on noise-only frames through the fixed-point chain."""
+    cfg = get_preset(preset)
+    rng = np.random.default_rng(5)
+    adcs = [np.round(thermal_noise(cfg, (cfg.n_chirps, cfg.num_rx, cfg.n_range), rng))
+            for _ in range(frames)]
+    lo, hi = cfg.detection_bins
+    cells = (hi - lo) * cfg.n_doppler * frames
+    out = []
+    for pfa in pfas:
+        params = DetectionParams(cfar=CfarParams(pfa=pfa))
+        dcfg = fpga_detect_config(cfg, params.cfar, max_detections=4096)
+        det = pts_f = pts_h = 0
+        for adc in adcs:
+            host, fpga, n = _both_paths(adc.astype(np.complex64), cfg, params, dcfg)
+            det += n
+            pts_f += len(fpga)
+            pts_h += len(host)
+        out.append((pfa, det / cells, pts_f / cells, pts_h / cells))
+    return out
+
+
+def synthetic_records(cfg: RadarConfig, n: int, seed: int = 0) -> list[Record]:
+    """``n`` records of isolated point targets (worst case for the host: no two in one 3x3
+    neighbourhood is not guaranteed, but each is a peak of its own): a TDM-phased plane wave
+    at a random angle, 40 dB over unit-variance noise per channel, the CFAR noise estimate
+    of that noise, in fixed-point LSB."""
+    rng = np.random.default_rng(seed)
+    cells = rng.choice(cfg.n_range * cfg.n_doppler, n, replace=False)
+    sigma = 3.0
+    out = []
+    v = np.arange(cfg.n_virtual)
+    for k, c in enumerate(np.sort(cells)):
+        r, d = divmod(int(c), cfg.n_doppler)
+        s = rng.uniform(-0.9, 0.9)
+        x = 100 * sigma * np.exp(-1j * np.pi * v * s) * np.conj(tdm_phase_compensation(cfg, d))
+        x = x + rng.normal(0, sigma / math.sqrt(2), (cfg.n_virtual, 2)) @ np.array([1, 1j])
+        x = np.round(x.real) + 1j * np.round(x.imag)
+        out.append(Record(range_bin=r, doppler_bin=d, power=int(np.sum(np.abs(x) ** 2)),
+                          noise_sum=int(round(100 * cfg.n_virtual * sigma**2)), cells=100,
+                          snapshot=pack_iq(x).reshape(cfg.num_tx, cfg.num_rx), index=k))
+    return out
+
+
+def link_rows(preset: str, counts: tuple[int, ...]) -> list[tuple[str, int, float]]:
+    """(what, bytes per frame, Mbit/s at FRAME_RATE_HZ) of the cube and of record frames
+    with MAX_DETECTIONS = n detections, measured on packetized frames."""
+    cfg = get_preset(preset)
+    pw = UDP_PACKET_WORDS[preset]
+    wb = 4 * cfg.num_rx
+    frame_words = cfg.num_tx * cfg.n_range * cfg.n_doppler
+    n_pk = -(-frame_words // pw)
+    cube_bytes = (frame_words + n_pk) * wb       # every packet carries one header word
+    rows = [("radar cube (mode 0)", cube_bytes, cube_bytes * 8 * FRAME_RATE_HZ / 1e6)]
+    for n in counts:
+        frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)
+        b = sum(len(words_to_bytes(p)) for p in packetize(frame, pw))
+        rows.append((f"records, {n} detections", b, b * 8 * FRAME_RATE_HZ / 1e6))
+    return rows
+
+
+def _best_ms(fn: Callable[[], object], repeat: int) -> float:
+    best = math.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best * 1e3
+
+
+def host_time_rows(preset: str, n: int, repeat: int) -> tuple[float, float, int]:
+    """(decode ms, records -> point cloud ms, points) for one frame of ``n`` records."""
+    cfg = get_preset(preset)
+    params = DetectionParams()
+    dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
+    frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)
+    packets = [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[preset])]
+    gain = chain_gain(cfg, PipelineParams())
+
+    def decode() -> object:
+        dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[preset])
+        got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
+        return record_arrays(got[0].records, cfg.n_virtual, gain)
+
+    arr = decode()
+    t_dec = _best_ms(decode, repeat)
+    t_pc = _best_ms(lambda: process_records(arr, cfg, params), repeat)  # type: ignore[arg-type]
+    return t_dec, t_pc, len(process_records(arr, cfg, params))  # type: ignore[arg-type]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenes", type=int, default=100, help="random paper-fpga scenes")
+    ap.add_argument("--full-scenes", type=int, default=20,
+                    help="random full scenes (about 6 s each on this machine)")
+    ap.add_argument("--noise-frames", type=int, default=40, help="noise-only paper-fpga frames")
+    ap.add_argument("--repeat", type=int, default=5, help="timing runs; best is reported")
+    args = ap.parse_args()
+    try:
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})   # one core
+    except (AttributeError, OSError):
+        pass
+
+    print("## Detection: --detect fpga (on-chip CFAR, records) vs --detect host (cube)")
+    print("| scenes | true targets | found, host | found, fpga | fpga finds of host's | "
+          "fpga only | mean range err host / fpga (m) |")
+    print("|---|---|---|---|---|---|---|")
+    groups = [("Table I, full", [table1_scene("full")]),
+              (f"{args.scenes} random, paper-fpga",
+               [random_scene("paper-fpga", s) for s in range(args.scenes)]),
+              (f"{args.full_scenes} random, full",
+               [random_scene("full", s) for s in range(args.full_scenes)])]
+    for name, scenes in groups:
+        if not scenes:
+            continue
+        r = detection_rows(scenes)
+        print(f"| {name} | {r['targets']} | {r['host']} | {r['fpga']} | {r['agree']:.1f} % | "
+              f"{r['fpga_only']} | {r['rerr_host']:.2f} / {r['rerr_fpga']:.2f} |")
+
+    print(f"\n## False alarms, {args.noise_frames} noise-only paper-fpga frames (fixed-point "
+          f"chain; per reportable cell)")
+    print("| configured Pfa | FPGA CFAR detections | ratio | points, fpga path | "
+          "points, host path |")
+    print("|---|---|---|---|---|")
+    for pfa, det, pf, ph in false_alarm_rows("paper-fpga", args.noise_frames, (1e-3, 1e-4)):
+        print(f"| {pfa:.0e} | {det:.2e} | {det / pfa:.2f} | {pf:.2e} | {ph:.2e} |")
+
+    print(f"\n## Link, full, {UDP_PACKET_WORDS['full']}-word packets, {FRAME_RATE_HZ:g} "
+          f"frames/s (paper's link: {LINK_MBPS:g} Mbit/s)")
+    print("| stream | bytes/frame | Mbit/s | fits |")
+    print("|---|---|---|---|")
+    for what, b, mbps in link_rows("full", (10, 100, 1000)):
+        print(f"| {what} | {b:,} | {mbps:,.1f} | {'yes' if mbps <= LINK_MBPS else 'no'} |")
+
+    print("\n## Host time per full frame, 1000 detections, one core (best of "
+          f"{args.repeat})")
+    print("| step | ms |")
+    print("|---|---|")
+    t_dec, t_pc, pts = host_time_rows("full", 1000, args.repeat)
+    print(f"| DMA bytes -> records (decoder) | {t_dec:.1f} |")
+    print(f"| records -> point cloud ({pts} points) | {t_pc:.1f} |")
+    print(f"| total | {t_dec + t_pc:.1f} |")
+
+
+if __name__ == "__main__":
+    main()
