@@ -83,14 +83,21 @@ def peak_power(x: np.ndarray, n_fft: int) -> float:
     return float(np.max(np.abs(spec) ** 2))
 
 
+def _spectrum_unshifted(x: np.ndarray, n_fft: int) -> np.ndarray:
+    """The angle spectrum of ``model.reference.angle_spectrum`` over the last axis of x,
+    complex (..., n_fft), *without* its fftshift (a permutation: bin k here is bin
+    (k + n_fft/2) mod n_fft there), which costs as much as the FFT on large batches."""
+    return np.fft.ifft(x, n=n_fft, axis=-1) * n_fft
+
+
 def peak_sin_batch(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`peak_sin` of every row of ``x``, complex (n, n_channels): (sin(az) float (n,),
     |peak|^2 float (n,)), one batched FFT."""
-    spec, _ = angle_spectrum(x, n_fft=n_fft)
-    mag = np.abs(spec)
-    k = np.argmax(mag, axis=-1)
-    rows = np.arange(len(k))
-    a, b, c = mag[rows, (k - 1) % n_fft], mag[rows, k], mag[rows, (k + 1) % n_fft]
+    mag = np.abs(_spectrum_unshifted(x, n_fft))
+    k0 = np.argmax(mag, axis=-1)
+    rows = np.arange(len(k0))
+    a, b, c = mag[rows, (k0 - 1) % n_fft], mag[rows, k0], mag[rows, (k0 + 1) % n_fft]
+    k = (k0 + n_fft // 2) % n_fft                  # index in the fftshift order
     den = a - 2 * b + c
     with np.errstate(divide="ignore", invalid="ignore"):
         delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, 1.0), 0.0)
@@ -100,8 +107,7 @@ def peak_sin_batch(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
 
 def peak_power_batch(x: np.ndarray, n_fft: int) -> np.ndarray:
     """:func:`peak_power` over the last axis of ``x``, complex (..., n_channels): float (...)."""
-    spec, _ = angle_spectrum(x, n_fft=n_fft)
-    return np.max(np.abs(spec) ** 2, axis=-1)
+    return np.max(np.abs(_spectrum_unshifted(x, n_fft)) ** 2, axis=-1)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams

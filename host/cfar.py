@@ -215,9 +215,15 @@ def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: tuple[bool, 
     away, which a CFAR window a few cells wide cannot tell from targets."""
     env_r = sidelobe_envelope(power.shape[0], windowed[0]) * 10 ** (margin_db / 10)
     env_d = sidelobe_envelope(power.shape[1], windowed[1]) * 10 ** (margin_db / 10)
+    cells = np.asarray(cells).reshape(-1, 2)
     out = np.zeros(len(cells), bool)
-    for i, (r, d) in enumerate(cells):
-        col = power[:, d] * np.roll(env_r[::-1], r + 1)   # env_r[(r - r') mod n] per r'
-        row = power[r, :] * np.roll(env_d[::-1], d + 1)
-        out[i] = col.max() > power[r, d] or row.max() > power[r, d]
+    nr, nd = power.shape
+    # all cells at once, in chunks that keep the (n_range, chunk) gathers small:
+    # column sidelobes env_r[(r - r') mod n_range] * power[r', d] over r', rows likewise
+    for lo in range(0, len(cells), 512):
+        r, d = cells[lo:lo + 512, 0], cells[lo:lo + 512, 1]
+        col = power[:, d] * env_r[(r[None, :] - np.arange(nr)[:, None]) % nr]
+        row = power[r, :] * env_d[(d[:, None] - np.arange(nd)[None, :]) % nd]
+        p = power[r, d]
+        out[lo:lo + 512] = (col.max(axis=0) > p) | (row.max(axis=1) > p)
     return out

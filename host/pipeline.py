@@ -46,7 +46,6 @@ from host.cfar import (
 from host.pointcloud import PointCloud
 from model.config import RadarConfig, dbm_to_w
 from model.reference import (
-    hann_periodic,
     radar_cube,
     range_doppler_power,
     signed_bins,
@@ -112,13 +111,24 @@ class DetectionParams:
             check_window(self.cfar, (cfg.n_range, cfg.n_doppler))
 
 
+def _dirichlet(x: np.ndarray, n: int) -> np.ndarray:
+    """sum_{t<n} exp(-j 2 pi x t / n) for real x with |x| < n, complex like x."""
+    den = np.sin(np.pi * x / n)
+    small = np.abs(den) < 1e-12
+    ratio = np.where(small, n, np.sin(np.pi * x) / np.where(small, 1.0, den))
+    return np.exp(-1j * np.pi * x * (n - 1) / n) * ratio
+
+
 def _window_response(n: int, offset: np.ndarray | float, windowed: bool) -> np.ndarray:
     """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
-    a bin centre, float (m,) or scalar."""
-    w = hann_periodic(n) if windowed else np.ones(n)
-    off = np.asarray(offset, dtype=float)
-    ph = np.exp(-2j * np.pi * np.multiply.outer(off, np.arange(n)) / n)
-    return np.abs(ph @ w) / w.sum()
+    a bin centre, float (m,) or scalar; W is the DFT of the periodic Hann window
+    (``model.reference.hann_periodic``: 0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the
+    Dirichlet kernel D) or of the rectangular one (D)."""
+    x = np.asarray(offset, dtype=float)
+    if windowed:
+        w = 0.5 * _dirichlet(x, n) - 0.25 * _dirichlet(x - 1, n) - 0.25 * _dirichlet(x + 1, n)
+        return np.abs(w) / (n / 2)
+    return np.abs(_dirichlet(x, n)) / n
 
 
 def gaussian_offset(lm: np.ndarray | float, c: np.ndarray | float, lp: np.ndarray | float
