@@ -96,15 +96,18 @@ def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
 
 
 def detect_stream(frames: Iterable[np.ndarray], cfg: DetectConfig,
-                  scale: np.ndarray | None = None) -> list[np.ndarray]:
+                  scale: np.ndarray | None = None, first_frame_id: int = 0
+                  ) -> list[np.ndarray]:
     """Record streams of consecutive frames after reset: list of uint32
-    ``(frame_words, num_rx)``, one per frame (frame ids from 0, sticky truncation)."""
+    ``(frame_words, num_rx)``, one per frame (frame ids from ``first_frame_id``, sticky
+    truncation from the first frame on)."""
     sc = cfg.scale() if scale is None else scale
     out = []
     sticky = False
     for k, f in enumerate(frames):
         recs, _ = detections(f, cfg, sc)
         out.append(detect_records.encode_frame(recs, len(recs), cfg.num_tx, cfg.num_rx,
-                                               cfg.max_detections, frame_id=k, sticky=sticky))
+                                               cfg.max_detections, frame_id=first_frame_id + k,
+                                               sticky=sticky))
         sticky = sticky or len(recs) > cfg.max_detections
     return out

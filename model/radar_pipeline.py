@@ -7,6 +7,11 @@ the block models: ADC frame in, DMA packets out, identical to the RTL for loss-f
     -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
     -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.axis_packetizer
 
+``output_mode = 1`` (on-chip detection, DESIGN 3.4, docs/detect.md): the corner turn reads
+(r, t, d) (``read_order = 1``), the Doppler FFT output goes through the detector
+(``model.detect_chain``: NCI, 2-D CFAR, records) and the record stream, a fixed
+``DetectConfig.frame_words`` per frame, through the same packetizer framing.
+
 Scaling: the range FFT keeps the IP's default 1/N (a full-scale ADC tone cannot overflow);
 the Doppler FFT divides only every other radix-2 stage (``0x555``: 1/sqrt(N) for even
 log2 N). With 1/N in both, thermal noise after the chain is ~0.1 LSB on the ``full`` preset
@@ -28,8 +33,10 @@ from model.axis_packetizer import (
     packetize,
     unpack_iq,
 )
+from model.cfar_2d import pack_scale
 from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
+from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, fft_fixed_reference, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
 
@@ -46,7 +53,9 @@ class PipelineParams:
     ``packet_words``: PACKET_WORDS; ``window``: WINDOW (periodic Hann before both FFTs);
     ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER;
     ``frame_store``: FRAME_STORE (corner turn in external memory over AXI4, same payload),
-    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R.
+    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R; ``output_mode``:
+    OUTPUT_MODE (0: radar cube, 1: detection records); ``detect``: the detector settings in
+    mode 1 (None: :meth:`detect_config` derives them from the RadarConfig).
     """
 
     packet_words: int = 1024
@@ -57,6 +66,23 @@ class PipelineParams:
     frame_store: bool = False
     axi_data_w: int = 128
     fs_tile_r: int = 16
+    output_mode: int = 0
+    detect: DetectConfig | None = None
+
+    def detect_config(self, cfg: RadarConfig) -> DetectConfig:
+        """The detector of mode 1: ``detect`` (its sizes checked against ``cfg``) or the
+        defaults of :class:`model.detect_chain.DetectConfig` sized for ``cfg``, windows as
+        ``window``, reporting only ``cfg.detection_bins`` (the host CFAR's rule)."""
+        if self.detect is None:
+            return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+                                n_doppler=cfg.n_doppler, windowed=(self.window, self.window))
+        d = self.detect
+        got = (d.num_tx, d.num_rx, d.n_range, d.n_doppler)
+        want = (cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler)
+        if got != want:
+            raise ValueError(f"detect: sizes (num_tx, num_rx, n_range, n_doppler) {got} do not "
+                             f"match the radar configuration's {want}")
+        return d
 
     def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
         """The external frame store's geometry (FRAME_STORE = 1)."""
@@ -65,23 +91,50 @@ class PipelineParams:
                              axi_data_w=self.axi_data_w)
 
     def frame_words(self, cfg: RadarConfig) -> int:
-        """Payload words per frame, num_tx * n_range * n_doppler."""
+        """Payload words per frame: num_tx * n_range * n_doppler (mode 0), the record
+        stream's fixed ``DetectConfig.frame_words`` (mode 1)."""
+        if self.output_mode == 1:
+            return self.detect_config(cfg).frame_words
         return cfg.num_tx * cfg.n_range * cfg.n_doppler
 
     def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
         (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
-        schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``)."""
+        schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``;
+        OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1)."""
         store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w, "FS_TILE_R": self.fs_tile_r}
                  if self.frame_store else {})
+        if self.output_mode == 1:
+            d = self.detect_config(cfg).hdl_parameters()
+            store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
+                         TRAIN_R=d["TRAIN_R"], TRAIN_D=d["TRAIN_D"], CFAR_KIND=d["KIND"],
+                         BLANK_TOP=d["BLANK_TOP"], SCALE_W=d["SCALE_W"],
+                         SCALE_FRAC=d["SCALE_FRAC"], MAX_DETECTIONS=d["MAX_DETECTIONS"])
         return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
                               RANGE_SCALE_SCH=self.range_scale_sch,
                               DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),
                               **store)
 
+    def cfar_scale(self, cfg: RadarConfig) -> int:
+        """Value of the top's quasi-static ``cfg_cfar_scale`` input in mode 1 (the threshold
+        scale table for the detector's Pfa, ``model.cfar_2d.pack_scale``)."""
+        d = self.detect_config(cfg)
+        return pack_scale(d.scale(), d.cfar)
+
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a combination the RTL refuses at elaboration."""
+        self.check_mode(cfg)
         check_geometry(self.frame_words(cfg), self.packet_words)
+
+    def check_mode(self, cfg: RadarConfig) -> None:
+        """ValueError for an OUTPUT_MODE / detector setting the RTL refuses."""
+        if self.output_mode not in (0, 1):
+            raise ValueError(f"output_mode={self.output_mode} not 0 or 1")
+        if self.output_mode == 1 and self.frame_store and cfg.num_tx > 1:
+            raise ValueError("output_mode=1 with frame_store needs num_tx=1: the external "
+                             "frame store reads only the (t, r, d) order")
+        if self.output_mode == 1:
+            self.detect_config(cfg)
 
 
 def _stage_gain(n: int, sch: int) -> float:
@@ -102,12 +155,15 @@ class ChainOutput:
 
     ``payload``: complex (num_tx, n_range, n_doppler, num_rx) integer-valued, DMA order;
     ``range_overflow`` / ``doppler_overflow``: output beats of each FFT whose computation
-    saturated (the RTL's event_overflow pulses).
+    saturated (the RTL's event_overflow pulses); ``records`` (mode 1 only, else None): the
+    detector's record stream of this frame as the first frame after reset, uint32
+    ``(DetectConfig.frame_words, num_rx)``.
     """
 
     payload: np.ndarray
     range_overflow: int
     doppler_overflow: int
+    records: np.ndarray | None = None
 
     def cube(self) -> np.ndarray:
         """Radar cube complex (n_virtual, n_range, n_doppler), integer-valued."""
@@ -117,13 +173,31 @@ class ChainOutput:
 
 def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None,
               reference: bool = False) -> ChainOutput:
-    """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube.
+    """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube (and, in
+    mode 1, the record stream of the frame as the first after reset).
 
     ``reference``: use the stage-by-stage int64 FFT (``fft_fixed_reference``, slow) instead
     of the fast path; the results are identical (checked by tests/test_model_fast.py).
     """
     params = params or PipelineParams()
+    params.check_mode(cfg)
+    dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params, reference)
+    if params.output_mode == 0:
+        return ChainOutput(dop.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx),
+                           rng_ov, dop_ov)
+    words = pack_iq(dop)
+    payload = dop.reshape(cfg.n_range, cfg.num_tx, cfg.n_doppler, cfg.num_rx)
+    records = detect_stream([words], params.detect_config(cfg))[0]
+    return ChainOutput(payload.transpose(1, 0, 2, 3), rng_ov, dop_ov, records)
+
+
+def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams, reference: bool
+                 ) -> tuple[np.ndarray, int, int]:
+    """Doppler-FFT output words, integer-valued complex ``(frame words, num_rx)`` in the
+    corner turn's read order (mode 0: (t, r, d); mode 1: (r, t, d)), and the overflow beats
+    of the range and Doppler FFTs."""
     cfg.check_adc(adc)
+    order = params.output_mode
     if reference:
         rng = fft_fixed_reference(np.transpose(adc, (0, 2, 1)), window=params.window,
                                   scale_sch=params.range_scale_sch)
@@ -131,8 +205,7 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
         turned = _turn(words, cfg, params)
         dop = fft_fixed_reference(turned.reshape(-1, cfg.n_doppler, cfg.num_rx),
                                   window=params.window, scale_sch=params.doppler_scale_sch)
-        payload = dop.y.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
-        return ChainOutput(payload, int(rng.overflow.sum()), int(dop.overflow.sum()))
+        return dop.y.reshape(-1, cfg.num_rx), int(rng.overflow.sum()), int(dop.overflow.sum())
     # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values
     planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_range, rx, 2)
     rng_p, rng_ov = fft_fixed_planar(planar, window=params.window,
@@ -142,21 +215,22 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
         turned = to_planar(_turn(words, cfg, params)).astype(rng_p.dtype)
     else:
         turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
-                             cfg.n_doppler)
+                             cfg.n_doppler, read_order=order)
     dop_p, dop_ov = fft_fixed_planar(turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2),
                                      window=params.window, scale_sch=params.doppler_scale_sch)
-    payload = from_planar(dop_p).reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
-    return ChainOutput(payload, int(rng_ov.sum()), int(dop_ov.sum()))
+    return from_planar(dop_p).reshape(-1, cfg.num_rx), int(rng_ov.sum()), int(dop_ov.sum())
 
 
 def _turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndarray:
     """Range-FFT words complex (num_tx * n_doppler * n_range, num_rx), chirp-major input
-    order -> Doppler-vector order (tx, r, d), through the on-chip corner turn or, with
-    ``params.frame_store``, through the external store's bursts and strip buffer (the same
-    payload: tests/test_frame_store_chain.py)."""
+    order -> Doppler-vector order ((t, r, d) in mode 0, (r, t, d) in mode 1), through the
+    on-chip corner turn or, with ``params.frame_store``, through the external store's bursts
+    and strip buffer (the same payload: tests/test_frame_store_chain.py; mode 1 only with
+    num_tx = 1, where both orders are equal)."""
     if params.frame_store:
         return unpack_iq(store_frames([pack_iq(words)], params.store_geometry(cfg))[0])
-    return corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler)
+    return corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler,
+                       read_order=params.output_mode)
 
 
 def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
@@ -168,16 +242,34 @@ def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None
     return run_chain(adc, cfg, params).cube().astype(np.complex64) / chain_gain(cfg, params)
 
 
+def record_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
+                  params: PipelineParams | None = None, first_frame_id: int = 0
+                  ) -> list[np.ndarray]:
+    """Mode 1: the detector's record streams of consecutive frames after reset (frame ids
+    from ``first_frame_id``, sticky truncation across them), uint32
+    ``(DetectConfig.frame_words, num_rx)`` each (``model.detect_chain.detect_stream``)."""
+    params = params or PipelineParams(output_mode=1)
+    if params.output_mode != 1:
+        raise ValueError("record_frames needs output_mode=1")
+    params.check(cfg)
+    words = (pack_iq(_doppler_out(adc, cfg, params, False)[0]) for adc in adc_frames)
+    return detect_stream(words, params.detect_config(cfg), first_frame_id=first_frame_id)
+
+
 def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,
                 params: PipelineParams | None = None, first_frame_id: int = 0
                 ) -> list[np.ndarray]:
     """DMA packets of consecutive frames exactly as ``radar_pipeline`` sends them: uint32
-    arrays (words, num_rx), one per TLAST-closed packet, header word first."""
+    arrays (words, num_rx), one per TLAST-closed packet, header word first. Mode 0: the
+    cube; mode 1: the record streams (:func:`record_frames`), same framing."""
     params = params or PipelineParams()
     params.check(cfg)
+    if params.output_mode == 1:
+        payloads = record_frames(adc_frames, cfg, params, first_frame_id)
+    else:
+        payloads = [cube_to_payload(run_chain(adc, cfg, params).payload) for adc in adc_frames]
     out: list[np.ndarray] = []
-    for k, adc in enumerate(adc_frames):
-        payload = cube_to_payload(run_chain(adc, cfg, params).payload)
+    for k, payload in enumerate(payloads):
         out.extend(packetize(payload, params.packet_words, first_frame_id + k,
                              header=params.header))
     return out
