@@ -38,7 +38,7 @@ from host.record_points import process_records
 from host.records import RecordDecoder, fpga_detect_config, record_arrays
 from model.axis_packetizer import pack_iq, packetize, packetize_stream, words_to_bytes
 from model.config import RadarConfig, get_preset
-from model.detect_chain import DetectConfig, detect_stream
+from model.detect_chain import DetectConfig
 from model.detect_records import Record, encode_frame
 from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.reference import tdm_phase_compensation
@@ -57,14 +57,12 @@ def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
                 dcfg: DetectConfig) -> tuple[PointCloud, PointCloud, int]:
     """Point clouds of one ADC frame through the host CFAR (cube) and the on-chip detector
     (records, as bytes through the decoder), and the FPGA's detection count."""
-    chain = PipelineParams()
-    payload = run_chain(adc, cfg, chain).payload                   # (tx, r, d, rx)
+    chain = PipelineParams(output_mode=1, detect=dcfg)
+    out = run_chain(adc, cfg, chain)                   # mode 1: the cube and the records
     gain = chain_gain(cfg, chain)
-    cube = payload.transpose(0, 3, 1, 2).reshape(cfg.cube_shape).astype(np.complex64) / gain
-    host = process_cube(cube, cfg, params)
-    words = pack_iq(payload.transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
+    host = process_cube(out.cube().astype(np.complex64) / gain, cfg, params)
     dec = RecordDecoder(dcfg, chain.packet_words)
-    frames = [f for p in packetize_stream(detect_stream([words], dcfg), chain.packet_words)
+    frames = [f for p in packetize_stream([out.records], chain.packet_words)
               for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
     f = frames[0]
     fpga = process_records(record_arrays(f.records, cfg.n_virtual, gain), cfg, params)

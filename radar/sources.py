@@ -23,16 +23,16 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Iterator
-from dataclasses import fields, replace
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
 
 from host.records import DetectionFrame, RecordDecoder
-from model.axis_packetizer import pack_iq, packetize_stream, words_to_bytes
+from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import RadarConfig
-from model.detect_chain import DetectConfig, detect_stream
-from model.radar_pipeline import PipelineParams, chain_gain, run_chain, scaled_cube
+from model.detect_chain import DetectConfig
+from model.radar_pipeline import PipelineParams, chain_gain, record_frames, scaled_cube
 from model.reference import radar_cube
 
 SOURCES: dict[str, type[FrameSource]] = {}
@@ -110,13 +110,15 @@ class ModelSource(FrameSource):
 
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
-        # the chain in mode 1: Doppler-FFT words in (r, t, d) order -> detect_chain ->
-        # packetizer (model.detect_chain, docs/detect.md); frame ids and the sticky
-        # truncation flag run over the whole stream, as after one reset
-        words = (pack_iq(run_chain(adc, cfg, self.chain).payload            # (tx, r, d, rx)
-                         .transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
-                 for adc in adc_frames)
-        yield from packetize_stream(detect_stream(words, dcfg), self.chain.packet_words)
+        # the chain in mode 1 (model.radar_pipeline.record_frames: corner turn in (r, t, d)
+        # order, detect_chain), frame ids and sticky truncation over the whole stream as
+        # after one reset, then the packetizer framing
+        chain = replace(self.chain, output_mode=1, detect=dcfg)
+        try:
+            streams = record_frames(adc_frames, cfg, chain)  # type: ignore[arg-type]
+        except ValueError as exc:
+            raise SourceError(str(exc)) from None
+        yield from packetize_stream(streams, chain.packet_words)
 
 
 class FloatSource(FrameSource):
@@ -161,7 +163,7 @@ class RtlSource(FrameSource):
         try:
             return run_pipeline(adcs, cfg, chain, adc_gap=adc_gap, chirp_gap=chirp_gap,
                                 frame_store=chain.frame_store)
-        except (RuntimeError, FileNotFoundError, ImportError, TypeError) as exc:
+        except (RuntimeError, FileNotFoundError, ImportError, TypeError, ValueError) as exc:
             raise SourceError(str(exc)) from None
 
     def cubes(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig) -> Iterator[np.ndarray]:
@@ -184,10 +186,11 @@ class RtlSource(FrameSource):
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
         """All frames through the Verilated top in OUTPUT_MODE = 1 (one simulation)."""
-        if "output_mode" not in {f.name for f in fields(PipelineParams)}:
-            raise SourceError("the RTL top has no OUTPUT_MODE = 1 (on-chip detection) on "
-                              "this branch yet: use --backend model")
-        chain = replace(self._chain(cfg), output_mode=1, detect=dcfg)  # type: ignore[call-arg]
+        chain = replace(self._chain(cfg), output_mode=1, detect=dcfg)
+        try:
+            chain.check(cfg)
+        except ValueError as exc:
+            raise SourceError(f"OUTPUT_MODE = 1 on {cfg.name}: {exc}") from None
         packets, _ = self._run(list(adc_frames), cfg, chain)
         yield from packets
 

@@ -130,14 +130,12 @@ def test_records_give_the_cube_points_paper_fpga():
     cfg = scene.config
     adc = simulate_scene(scene).samples
     params = DetectionParams()
-    payload = run_chain(adc, cfg).payload
-    gain = chain_gain(cfg, PipelineParams())
-    cube_cloud = process_cube(payload.transpose(0, 3, 1, 2).reshape(cfg.cube_shape) / gain,
-                              cfg, params)
     dcfg = fpga_detect_config(cfg, params.cfar)
-    words = pack_iq(payload.transpose(1, 0, 2, 3).reshape(-1, cfg.num_rx))
+    out = run_chain(adc, cfg, PipelineParams(output_mode=1, detect=dcfg))
+    gain = chain_gain(cfg, PipelineParams())
+    cube_cloud = process_cube(out.cube() / gain, cfg, params)
     dec = RecordDecoder(dcfg, 1024)
-    frames = [f for p in packetize_stream(detect_stream([words], dcfg), 1024)
+    frames = [f for p in packetize_stream([out.records], 1024)
               for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
     assert len(frames) == 1 and frames[0].complete
     cloud = process_records(record_arrays(frames[0].records, cfg.n_virtual, gain), cfg, params)
