@@ -49,6 +49,9 @@ FRAME_RATE_HZ = 111.0
 """The radar's frame rate (the paper's 111 frames/s)."""
 LINK_MBPS = 766.0
 """The paper's measured Gigabit Ethernet throughput, Mbit/s."""
+MAX_SCENE_RANGE_M = 150.0
+"""Farthest random target, m (full reports up to 435 m, where 5..100 m^2 targets are below
+the noise of either path)."""
 UDP_PACKET_WORDS = {"full": 1022, "paper-fpga": 4093}
 """PACKET_WORDS that fill one UDP datagram (``host.udp.max_packet_words``)."""
 
@@ -70,13 +73,15 @@ def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
 
 
 def random_scene(preset: str, seed: int) -> Scene:
-    """1..5 point targets: range uniform in [5 m, 85 % of the largest reportable range],
+    """1..5 point targets: range uniform in [5 m, min(85 % of the largest reportable range,
+    MAX_SCENE_RANGE_M)],
     azimuth +-45 deg, radial velocity within +-90 % of vmax (no aliasing), RCS
     log-uniform 5..100 m^2."""
     cfg = get_preset(preset)
     rng = np.random.default_rng([14, seed])
     targets = tuple(PointTarget(
-        range_m=float(rng.uniform(5.0, 0.85 * cfg.max_detection_range_m)),
+        range_m=float(rng.uniform(5.0, min(0.85 * cfg.max_detection_range_m,
+                                           MAX_SCENE_RANGE_M))),
         azimuth_deg=float(rng.uniform(-45, 45)),
         radial_velocity_mps=float(rng.uniform(-0.9, 0.9) * cfg.max_velocity_mps),
         rcs_m2=float(10 ** rng.uniform(math.log10(5), 2)))
