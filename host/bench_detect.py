@@ -30,6 +30,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from host.angle import AngleParams
 from host.cfar import CfarParams
 from host.evaluate import match_targets
 from host.pipeline import DetectionParams, process_cube
@@ -188,10 +189,12 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> float:
     return best * 1e3
 
 
-def host_time_rows(preset: str, n: int, repeat: int) -> tuple[float, float, int]:
-    """(decode ms, records -> point cloud ms, points) for one frame of ``n`` records."""
+def host_time_rows(preset: str, n: int, repeat: int, n_fft: int = AngleParams.n_fft
+                   ) -> tuple[float, float, int]:
+    """(decode ms, records -> point cloud ms, points) for one frame of ``n`` records, angle
+    FFTs of ``n_fft`` points (the default, or coarser to show what they cost)."""
     cfg = get_preset(preset)
-    params = DetectionParams()
+    params = DetectionParams(angle=AngleParams(n_fft=n_fft))
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
     frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)
     packets = [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[preset])]
@@ -260,6 +263,9 @@ def main() -> None:
     print(f"| DMA bytes -> records (decoder) | {t_dec:.1f} |")
     print(f"| records -> point cloud ({pts} points) | {t_pc:.1f} |")
     print(f"| total | {t_dec + t_pc:.1f} |")
+    _, t_256, pts = host_time_rows("full", 1000, args.repeat, n_fft=256)
+    print(f"| records -> point cloud, 256-point angle FFTs instead of "
+          f"{AngleParams.n_fft} ({pts} points) | {t_256:.1f} |")
 
 
 if __name__ == "__main__":
