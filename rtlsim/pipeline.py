@@ -11,6 +11,7 @@ import numpy as np
 
 from model.axis_packetizer import packets_per_frame
 from model.chirp_pingpong import adc_frame_to_stream
+from model.detect_records import frame_words as record_frame_words
 from rtlsim.axis import AxisTB
 from rtlsim.toolchain import param
 
@@ -18,7 +19,7 @@ STATUS_SIGNALS = ("status_adc_overflow", "status_dma_overflow", "status_fft_over
                   "status_framing_error", "adc_chirps_dropped", "dma_words_dropped",
                   "fft_overflow_count", "framing_error_count", "chirps_in", "frames_damaged",
                   "chirps_filled", "chirps_discarded", "frames_turned", "frames_out",
-                  "packets_out")
+                  "packets_out", "status_truncated", "detections", "record_frames")
 
 
 class PipelineTB(AxisTB):
@@ -33,12 +34,22 @@ class PipelineTB(AxisTB):
         self.n_doppler = param("N_DOPPLER")
         self.packet_words = param("PACKET_WORDS")
         self.header = bool(param("HEADER", 1))
-        self.frame_words = self.num_tx * self.n_range * self.n_doppler
+        self.output_mode = param("OUTPUT_MODE", 0)
+        self.max_detections = param("MAX_DETECTIONS", 256)
+        self.frame_words = (record_frame_words(self.num_tx, self.num_rx, self.max_detections)
+                            if self.output_mode == 1
+                            else self.num_tx * self.n_range * self.n_doppler)
+        self.dut.cfg_cfar_scale.value = 0
         self.packets_per_frame = packets_per_frame(self.frame_words, self.packet_words)
 
     async def reset(self, cycles: int = 8) -> None:
         """Synchronous active-high reset."""
         await super().reset(cycles)
+
+    def set_cfar_scale(self, value: int) -> None:
+        """Drive the quasi-static ``cfg_cfar_scale`` input (OUTPUT_MODE = 1), e.g.
+        ``PipelineParams.cfar_scale(cfg)``; call before the first frame."""
+        self.dut.cfg_cfar_scale.value = int(value)
 
     async def send_frame(self, adc: np.ndarray) -> None:
         """Queue one ADC frame, complex (n_chirps, num_rx, n_range) of int16 I/Q, one AXI

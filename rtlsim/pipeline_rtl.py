@@ -19,7 +19,12 @@ from model.config import RadarConfig
 from model.radar_pipeline import PipelineParams
 from rtlsim.toolchain import build_and_test, rtl_sources
 
-PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "top/*.sv")
+PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "detect/*.sv", "top/*.sv")
+
+
+def _cfar_scale(cfg: RadarConfig, chain: PipelineParams) -> int:
+    """Value of the top's ``cfg_cfar_scale`` input: the detector's scale table in mode 1."""
+    return chain.cfar_scale(cfg) if chain.output_mode == 1 else 0
 
 
 def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
@@ -36,7 +41,8 @@ def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
                        "rtlsim.pipeline_test", chain.hdl_parameters(cfg),
                        extra_env={"RADAR_RTL_ADC": str(d / "adc.npy"),
                                   "RADAR_RTL_DMA": str(d / "dma.npz"),
-                                  "RADAR_RTL_STATUS": str(d / "status.json")},
+                                  "RADAR_RTL_STATUS": str(d / "status.json"),
+                                  "RADAR_RTL_CFAR_SCALE": hex(_cfar_scale(cfg, chain))},
                        testcase="stream_frames")
         if not (d / "dma.npz").exists():
             raise RuntimeError("the RTL simulation produced no DMA stream (see its log)")

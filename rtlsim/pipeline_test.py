@@ -2,7 +2,8 @@
 (``RADAR_RTL_ADC``: .npy of shape (frames, n_chirps, num_rx, n_range)) through
 ``radar_pipeline`` back to back, write the DMA packets to ``RADAR_RTL_DMA`` (.npz: ``words``
 uint32 (total words, num_rx) and ``lengths``, words per packet) and the status to
-``RADAR_RTL_STATUS`` (JSON)."""
+``RADAR_RTL_STATUS`` (JSON). ``RADAR_RTL_CFAR_SCALE``: value of ``cfg_cfar_scale``
+(OUTPUT_MODE = 1)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from rtlsim.pipeline import PipelineTB
 async def stream_frames(dut) -> None:
     tb = PipelineTB(dut)
     frames = np.load(os.environ["RADAR_RTL_ADC"])
+    tb.set_cfar_scale(int(os.environ.get("RADAR_RTL_CFAR_SCALE", "0"), 0))
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)

@@ -11,6 +11,12 @@
 // on the next frame start, so the corner turn never loses alignment; the frame's packets
 // carry the DAMAGED header flag, the counters say how many chirps were lost and filled, and
 // the next frame is clean.
+//
+// OUTPUT_MODE = 1 (on-chip detection, DESIGN 3.4, docs/detect.md): the corner turn reads
+// (r, t, d), the Doppler FFT output goes through detect_chain (NCI, 2-D CFAR, records) and
+// the fixed-length record stream through the same packetizer (header, sequence numbers,
+// DAMAGED/OVERFLOW flags). With FRAME_STORE = 1 only for NUM_TX = 1 (the external store
+// reads the (t, r, d) order, which then equals (r, t, d)).
 `default_nettype none
 
 module radar_pipeline #(
@@ -51,7 +57,21 @@ module radar_pipeline #(
   parameter longint unsigned MEM_BASE = 0,
   /* verilator lint_on WIDTHEXPAND */
   // Range bins per strip of the external layout (frame_store_axi TILE_R).
-  parameter int FS_TILE_R = 16
+  parameter int FS_TILE_R = 16,
+  // 0: the radar cube to the DMA (DESIGN 3.2); 1: detection records (DESIGN 3.4).
+  parameter int OUTPUT_MODE = 0,
+  // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
+  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,
+  // threshold-scale fixed point, records per frame at most.
+  parameter int GUARD_R = 2,
+  parameter int GUARD_D = 2,
+  parameter int TRAIN_R = 4,
+  parameter int TRAIN_D = 8,
+  parameter int CFAR_KIND = 0,
+  parameter int BLANK_TOP = 0,
+  parameter int SCALE_W = 32,
+  parameter int SCALE_FRAC = 20,
+  parameter int MAX_DETECTIONS = 256
 ) (
   input  wire logic                       clk,
   input  wire logic                       rst,
@@ -62,6 +82,10 @@ module radar_pipeline #(
   output logic                            s_axis_adc_tready,
   input  wire logic                       s_axis_adc_tlast,
   input  wire logic [0:0]                 s_axis_adc_tuser,
+  // CFAR threshold scale per range-edge index e = 0..2*(GUARD_R+TRAIN_R), SCALE_W bits each,
+  // entry e at bits e*SCALE_W (model.cfar_2d.scale_table / pack_scale). A quasi-static
+  // configuration register: change it only between frames. Unused in OUTPUT_MODE = 0.
+  input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_cfar_scale,
   // DMA stream: per packet [header] + payload (for tx, range bin, Doppler bin: one word of
   // NUM_RX lanes), TLAST on the last word of every packet.
   output logic      [NUM_RX*32-1:0]       m_axis_dma_tdata,
@@ -86,6 +110,11 @@ module radar_pipeline #(
   output logic      [31:0]                frames_turned,         // frames through the corner turn
   output logic      [31:0]                frames_out,            // frames packetized
   output logic      [31:0]                packets_out,
+  // On-chip detection (OUTPUT_MODE = 1; constant 0 when OUTPUT_MODE = 0)
+  output logic                            status_truncated,      // sticky: a frame had more
+                                                                 // than MAX_DETECTIONS
+  output logic      [31:0]                detections,            // CFAR detections (saturating)
+  output logic      [31:0]                record_frames,         // record frames sent
   // External frame store (FRAME_STORE = 1; outputs constant 0 when FRAME_STORE = 0)
   output logic                            status_mem_error,      // sticky: SLVERR/DECERR
   output logic      [31:0]                mem_error_count,
@@ -128,7 +157,11 @@ module radar_pipeline #(
 
   localparam int LANE_W      = 2 * DATA_W;
   localparam int WORD_W      = NUM_RX * LANE_W;
-  localparam int FRAME_WORDS = NUM_TX * N_RANGE * N_DOPPLER;
+  localparam int CUBE_WORDS  = NUM_TX * N_RANGE * N_DOPPLER;
+  localparam int HDR_WORDS   = (8 + NUM_RX - 1) / NUM_RX;        // detect_records header
+  localparam int REC_WORDS   = MAX_DETECTIONS * (HDR_WORDS + NUM_TX) + HDR_WORDS;
+  // words per frame into the packetizer: the cube (mode 0) or the record stream (mode 1)
+  localparam int FRAME_WORDS = (OUTPUT_MODE == 1) ? REC_WORDS : CUBE_WORDS;
 
   // ---- parameter checks -----------------------------------------------------------------
   if (DATA_W != 16) begin : g_bad_data_w
@@ -148,6 +181,21 @@ module radar_pipeline #(
   begin : g_bad_n_doppler
     $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 16..4096", N_DOPPLER);
   end
+  if (OUTPUT_MODE < 0 || OUTPUT_MODE > 1) begin : g_bad_output_mode
+    $fatal(1, "%m: OUTPUT_MODE=%0d not 0 (cube) or 1 (detection records)", OUTPUT_MODE);
+  end
+  if (OUTPUT_MODE == 1 && FRAME_STORE && NUM_TX > 1) begin : g_bad_frame_store
+    $fatal(1, "%m: FRAME_STORE=1 with OUTPUT_MODE=1 needs NUM_TX=1 (got %0d): the external frame store reads only the (t, r, d) order",
+           NUM_TX);
+  end
+  if (OUTPUT_MODE == 1 && (MAX_DETECTIONS < 1 || MAX_DETECTIONS > 65535))
+  begin : g_bad_max_detections
+    $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535", MAX_DETECTIONS);
+  end
+  if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 2)) begin : g_bad_cfar_kind
+    $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", CFAR_KIND);
+  end
+  // guard/training/BLANK_TOP/SCALE_* ranges are checked by cfar_2d (g_bad_* there)
 
   // ---- ADC chirp ping-pong ----------------------------------------------------------------
   logic [WORD_W-1:0] pp_tdata;
@@ -219,7 +267,7 @@ module radar_pipeline #(
   if (!FRAME_STORE) begin : g_ct_onchip
     corner_turn #(
       .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
-      .DATA_W(DATA_W)
+      .DATA_W(DATA_W), .READ_ORDER(OUTPUT_MODE)
     ) u_corner_turn (
       .clk, .rst,
       .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
@@ -307,17 +355,59 @@ module radar_pipeline #(
     .event_overflow(df_ev_ovf)
   );
 
+  // ---- packetizer input: the cube (mode 0) or the detector's records (mode 1) ------------
+  logic [WORD_W-1:0] pk_tdata;
+  logic              pk_tvalid, pk_tready, pk_tlast, pk_frame_end;
+  logic              det_framing_error;   // sticky, detector input TLAST misplaced
+  logic              df_frame_end;        // last Doppler word of a frame (below)
+
+  if (OUTPUT_MODE == 1) begin : g_detect
+    logic        det_framing;
+    detect_chain #(
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+      .GUARD_R(GUARD_R), .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D),
+      .KIND(CFAR_KIND), .BLANK_TOP(BLANK_TOP), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
+      .MAX_DETECTIONS(MAX_DETECTIONS)
+    ) u_detect (
+      .clk, .rst, .cfg_scale(cfg_cfar_scale),
+      .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
+      .s_axis_tlast(df_tlast),
+      .m_axis_tdata(pk_tdata), .m_axis_tvalid(pk_tvalid), .m_axis_tready(pk_tready),
+      .m_axis_tlast(pk_tlast),
+      .status_framing_error(det_framing), .status_truncated(status_truncated),
+      .detection_count(detections), .frame_count(record_frames)
+    );
+    assign det_framing_error = det_framing;
+    // the record stream has TLAST only on the last word of a frame
+    assign pk_frame_end = pk_tvalid && pk_tready && pk_tlast;
+  end else begin : g_cube
+    assign pk_tdata          = df_tdata;
+    assign pk_tvalid         = df_tvalid;
+    assign df_tready         = pk_tready;
+    assign pk_tlast          = df_tlast;
+    assign pk_frame_end      = df_frame_end;
+    assign det_framing_error = 1'b0;
+    assign status_truncated  = 1'b0;
+    assign detections        = '0;
+    assign record_frames     = '0;
+    /* verilator lint_off UNUSEDSIGNAL */
+    logic unused_scale;
+    assign unused_scale = ^cfg_cfar_scale;
+    /* verilator lint_on UNUSEDSIGNAL */
+  end
+
   // ---- per-frame damage marks, frame_align -> packetizer input ---------------------------
   // Frames leave in order; between the two points the corner turn holds one frame and
-  // fills the next, so at most DMG_DEPTH-1 marks wait here.
-  localparam int DMG_DEPTH = 4;
-  localparam int FWORD_W   = $clog2(FRAME_WORDS + 1);
+  // fills the next (mode 1: and the detector holds part of one more), so at most
+  // DMG_DEPTH-1 marks wait here.
+  localparam int DMG_DEPTH = (OUTPUT_MODE == 1) ? 8 : 4;
+  localparam int FWORD_W   = $clog2(CUBE_WORDS + 1);
   logic [FWORD_W-1:0]         df_word_q;    // Doppler output word within its frame
-  logic                       df_beat, df_frame_end, df_damaged;
+  logic                       df_beat, df_damaged;
   logic                       dmg_empty, dmg_full, dmg_overflow, dmg_underflow;
   logic [$clog2(DMG_DEPTH):0] dmg_count;
   assign df_beat      = df_tvalid && df_tready;
-  assign df_frame_end = df_beat && (df_word_q == FWORD_W'(FRAME_WORDS - 1));
+  assign df_frame_end = df_beat && (df_word_q == FWORD_W'(CUBE_WORDS - 1));
 
   always_ff @(posedge clk) begin
     if (rst) df_word_q <= '0;
@@ -327,7 +417,7 @@ module radar_pipeline #(
   mark_fifo #(.DEPTH(DMG_DEPTH), .WIDTH(1)) u_damage_marks (
     .clk, .rst,
     .push(fa_frame_done), .push_data(fa_frame_damaged),
-    .pop(df_frame_end), .head(df_damaged),
+    .pop(pk_frame_end), .head(df_damaged),
     .empty(dmg_empty), .full(dmg_full), .count(dmg_count),
     .overflow(dmg_overflow), .underflow(dmg_underflow)
   );
@@ -335,7 +425,7 @@ module radar_pipeline #(
 `ifndef SYNTHESIS
   always_ff @(posedge clk) begin
     if (!rst) begin
-      assert (!(fa_frame_done && dmg_full && !df_frame_end))
+      assert (!(fa_frame_done && dmg_full && !pk_frame_end))
         else $error("%m: damage-mark FIFO overflow");
       assert (!(df_beat && dmg_empty))
         else $error("%m: Doppler output of a frame frame_align never sent");
@@ -350,11 +440,11 @@ module radar_pipeline #(
   axis_packetizer #(
     .NUM_RX(NUM_RX), .DATA_W(DATA_W), .PACKET_WORDS(PACKET_WORDS), .FRAME_WORDS(FRAME_WORDS),
     .NUM_BANKS(OUT_BANKS), .HEADER(HEADER), .INPUT_BACKPRESSURE(1'b1),
-    .TLAST_PERIOD(N_DOPPLER)
+    .TLAST_PERIOD((OUTPUT_MODE == 1) ? REC_WORDS : N_DOPPLER)
   ) u_packetizer (
     .clk, .rst,
-    .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
-    .s_axis_tlast(df_tlast), .s_axis_tuser(df_damaged),
+    .s_axis_tdata(pk_tdata), .s_axis_tvalid(pk_tvalid), .s_axis_tready(pk_tready),
+    .s_axis_tlast(pk_tlast), .s_axis_tuser(df_damaged),
     .m_axis_tdata(m_axis_dma_tdata), .m_axis_tvalid(m_axis_dma_tvalid),
     .m_axis_tready(m_axis_dma_tready), .m_axis_tlast(m_axis_dma_tlast),
     .status_overflow(status_dma_overflow), .status_framing_error(pk_framing),
@@ -388,7 +478,8 @@ module radar_pipeline #(
   end
   assign status_fft_overflow = fft_ovf_q;
   assign fft_overflow_count  = fft_ovf_count_q;
-  assign status_framing_error = pp_framing | ct_framing | pk_framing | fft_framing_q;
+  assign status_framing_error = pp_framing | ct_framing | pk_framing | fft_framing_q
+                              | det_framing_error;
 
   // Sum of the blocks' framing counters (each saturates; the sum is clamped).
   logic [33:0] framing_sum;

@@ -172,7 +172,8 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
             raise ValueError(f"adc: expected shape {expected} (chirps, rx, samples), got "
                              f"{adc.shape}")
     exe = build_harness(cfg, chain, frame_store)
-    ppf = packets_per_frame(cfg.num_tx * cfg.n_range * cfg.n_doppler, chain.packet_words)
+    ppf = packets_per_frame(chain.frame_words(cfg), chain.packet_words)
+    scale = chain.cfar_scale(cfg) if chain.output_mode == 1 else 0
     if timeout is None:
         timeout = default_timeout(cfg, adc_gap, chirp_gap)
     with tempfile.TemporaryDirectory(prefix="radar_harness_") as tmp:
@@ -184,7 +185,8 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
                "--packets-per-frame", str(ppf), "--seed", str(seed),
                "--adc-gap", repr(float(adc_gap)), "--dma-stall", repr(float(dma_stall)),
                "--chirp-gap", str(chirp_gap), "--timeout", str(timeout), "--quiet", str(quiet),
-               "--mem-latency", str(mem_latency), "--mem-stall", repr(float(mem_stall))]
+               "--mem-latency", str(mem_latency), "--mem-stall", repr(float(mem_stall)),
+               "--cfar-scale", hex(scale)]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
             msg = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]

@@ -17,7 +17,8 @@
 // segment). Random ADC gaps (TVALID low with probability --adc-gap per cycle, plus
 // --chirp-gap idle cycles after each chirp), DMA backpressure (TREADY low with probability
 // --dma-stall) and memory stalls come from one seed (--seed): the same arguments give the
-// same cycles. --quiet N: a segment also ends once its input is sent and no DMA word came
+// same cycles. --cfar-scale HEX drives the quasi-static cfg_cfar_scale input (OUTPUT_MODE = 1:
+// the CFAR threshold scale table, model.radar_pipeline.PipelineParams.cfar_scale). --quiet N: a segment also ends once its input is sent and no DMA word came
 // for N cycles (for runs that lose frames on purpose; 0: every packet must arrive). Exit status: 0 ok, 2 bad arguments or files, 3 timeout (no DMA word for
 // --timeout cycles while packets are missing).
 #include <verilated.h>
@@ -56,7 +57,23 @@ struct Args {
   uint64_t quiet = 0;
   int mem_latency = 20;
   double mem_stall = 0.0;
+  std::vector<uint32_t> cfar_scale;  // 32-bit words, word 0 = bits 31:0
 };
+
+// Hex string (optional 0x) -> 32-bit words, least significant first.
+std::vector<uint32_t> parse_hex_words(const std::string& v) {
+  std::string h = (v.rfind("0x", 0) == 0 || v.rfind("0X", 0) == 0) ? v.substr(2) : v;
+  std::vector<uint32_t> out;
+  for (size_t end = h.size(); end > 0;) {
+    size_t begin = end >= 8 ? end - 8 : 0;
+    std::string chunk = h.substr(begin, end - begin);
+    if (chunk.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+      return {};
+    out.push_back(static_cast<uint32_t>(std::strtoul(chunk.c_str(), nullptr, 16)));
+    end = begin;
+  }
+  return out;
+}
 
 [[noreturn]] void fail(int code, const std::string& msg) {
   std::fprintf(stderr, "radar_harness: %s\n", msg.c_str());
@@ -85,6 +102,10 @@ Args parse(int argc, char** argv) {
     else if (k == "--quiet") a.quiet = std::strtoull(v.c_str(), nullptr, 0);
     else if (k == "--mem-latency") a.mem_latency = std::atoi(v.c_str());
     else if (k == "--mem-stall") a.mem_stall = std::atof(v.c_str());
+    else if (k == "--cfar-scale") {
+      a.cfar_scale = parse_hex_words(v);
+      if (a.cfar_scale.empty()) fail(2, "--cfar-scale must be a hex number");
+    }
     else fail(2, "unknown option " + k);
   }
   if (a.adc.empty() || a.dma.empty() || a.status.empty()) fail(2, "need --adc, --dma, --status");
@@ -111,6 +132,13 @@ class Harness {
         static_cast<int>(sizeof(std::declval<Top>().m_axi_mem_wdata))));
 #endif
     load_adc();
+    const size_t scale_words = (sizeof(top_->cfg_cfar_scale) + 3) / 4;
+    std::vector<uint32_t> scale(scale_words, 0u);
+    for (size_t i = 0; i < a.cfar_scale.size(); ++i) {
+      if (i < scale_words) scale[i] = a.cfar_scale[i];
+      else if (a.cfar_scale[i]) fail(2, "--cfar-scale wider than cfg_cfar_scale");
+    }
+    harness::put_words(top_->cfg_cfar_scale, scale.data(), static_cast<int>(scale_words));
   }
 
   int run() {

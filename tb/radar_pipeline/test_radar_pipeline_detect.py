@@ -1,0 +1,160 @@
+"""End-to-end cocotb regression of ``radar_pipeline`` with ``OUTPUT_MODE = 1`` (on-chip
+detection, DESIGN 3.4): ADC frames in, detection-record packets out, bit-exact against
+``model.radar_pipeline.dma_packets`` (the corner turn's (r, t, d) read order, NCI, 2-D CFAR,
+records, packet framing), with random ADC gaps and DMA backpressure, frames back to back, a
+frame with more detections than MAX_DETECTIONS (sticky ``truncated``) and a mid-stream reset.
+
+Parameter sets (one Verilator build each): ``paper-fpga`` (Table I scene, 1 TX x 4 RX,
+64 x 256, MAX_DETECTIONS 256) and ``small4`` (4 TX x 4 RX, 32 x 32, MAX_DETECTIONS 24: the
+Scene of ``test_radar_pipeline`` gives 19 detections per frame, the crowded frame 31).
+``DETECT_LONG=1`` adds a GO-CFAR ``small4`` set with a smaller window.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.triggers import RisingEdge, SimTimeoutError
+from test_radar_pipeline import (
+    SMALL4,
+    adc_frames,
+    assert_packets_equal,
+    chirp_bursts,
+)
+
+from model.axis_packetizer import depacketize
+from model.config import RadarConfig, get_preset
+from model.detect_chain import DetectConfig
+from model.detect_records import decode_frame
+from model.radar_pipeline import PipelineParams, dma_packets
+from model.scene import PointTarget, Scene
+from model.simulate import simulate_frame
+from rtlsim.axis import random_pause
+from rtlsim.pipeline import PipelineTB
+from rtlsim.pipeline_rtl import PIPELINE_SOURCES
+from rtlsim.toolchain import rtl_sources, run_cocotb, seed
+
+SETS: dict[str, tuple[RadarConfig, PipelineParams]] = {
+    "paper-fpga": (get_preset("paper-fpga"), PipelineParams(packet_words=256, output_mode=1)),
+    "small4": (SMALL4, PipelineParams(packet_words=64, output_mode=1, detect=DetectConfig(
+        num_tx=4, num_rx=4, n_range=32, n_doppler=32, max_detections=24))),
+}
+LONG_SETS = {  # make test-detect-long (DETECT_LONG=1)
+    "small4-go": (SMALL4, PipelineParams(packet_words=100, output_mode=1, detect=DetectConfig(
+        num_tx=4, num_rx=4, n_range=32, n_doppler=32, guard=(1, 1), train=(2, 3), kind="go",
+        max_detections=40, pfa=1e-4))),
+}
+ALL_SETS = {**SETS, **LONG_SETS}
+
+
+def crowded_frame(cfg: RadarConfig, k: int) -> np.ndarray:
+    """A frame with ten strong targets: more detections than small4's MAX_DETECTIONS."""
+    targets = tuple(PointTarget(5.0 + 3 * i, -30.0 + 7 * i, -15.0 + 3 * i, 20.0)
+                    for i in range(10))
+    sc = Scene(preset="full", targets=targets).scatterers()
+    return simulate_frame(cfg, sc, rng=np.random.default_rng([9, k]), frame_index=k).samples
+
+
+def setup(dut) -> tuple[PipelineTB, str, RadarConfig, PipelineParams]:
+    tb = PipelineTB(dut)
+    name = os.environ["RP_DETECT_SET"]
+    cfg, chain = ALL_SETS[name]
+    assert tb.output_mode == 1 and tb.frame_words == chain.frame_words(cfg)
+    tb.set_cfar_scale(chain.cfar_scale(cfg))
+    return tb, name, cfg, chain
+
+
+def trailers(cfg: RadarConfig, chain: PipelineParams, packets: list[np.ndarray]) -> list:
+    frames = depacketize(packets, chain.frame_words(cfg), chain.packet_words, cfg.num_rx)
+    assert all(f.complete for f in frames), [f.errors for f in frames]
+    out = []
+    for f in frames:
+        rf = decode_frame(f.words, cfg.num_tx)
+        assert not rf.errors, rf.errors
+        out.append(rf.trailer)
+    return out
+
+
+@cocotb.test()
+async def records_bit_exact_with_gaps_and_stalls(dut) -> None:
+    """Frames back to back (small4: the third one crowded, more detections than
+    MAX_DETECTIONS), random ADC gaps, 30 % DMA stalls: packets bit-exact with the model,
+    detections counted, ``truncated`` set on the crowded frame and sticky after it."""
+    tb, name, cfg, chain = setup(dut)
+    s = seed()
+    if name == "paper-fpga":
+        frames = adc_frames(name, cfg, 3, seed=s)
+        tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range // 2))
+    else:
+        frames = adc_frames("small4", cfg, 4, seed=s)
+        frames[2] = crowded_frame(cfg, 2)
+        tb.set_idle_generator(random_pause(0.3, s))
+    tb.set_backpressure_generator(random_pause(0.3, s + 1))
+    await tb.reset()
+    for adc in frames:
+        await tb.send_frame(adc)
+    got = await tb.recv_frames(len(frames), 2 * tb.frame_timeout_cycles())
+    want = dma_packets(frames, cfg, chain)
+    assert_packets_equal(got, want, f"{name} mode 1")
+    status = tb.status()
+    tr = trailers(cfg, chain, got)
+    assert status["record_frames"] == status["frames_out"] == len(frames), status
+    assert status["detections"] == sum(t.detections for t in tr), status
+    for flag in ("status_adc_overflow", "status_dma_overflow", "status_fft_overflow",
+                 "status_framing_error"):
+        assert status[flag] == 0, (flag, status)
+    if name == "paper-fpga":
+        assert status["status_truncated"] == 0 and min(t.records for t in tr) >= 3
+    else:
+        assert [t.truncated for t in tr] == [False, False, True, False], tr
+        assert [t.truncated_sticky for t in tr] == [False, False, True, True], tr
+        assert tr[2].records == chain.detect_config(cfg).max_detections < tr[2].detections
+        assert status["status_truncated"] == 1, status
+    tb.dut._log.info("%s: %d frames bit-exact, records per frame %s, status %s", name,
+                     len(frames), [t.records for t in tr], status)
+
+
+@cocotb.test()
+async def reset_mid_stream(dut) -> None:
+    """A reset half way through frame 0 (the ADC keeps streaming): the detector, the sticky
+    ``truncated`` flag and the frame ids restart; frames 1 and 2 come out bit-exact."""
+    tb, name, cfg, chain = setup(dut)
+    if name == "paper-fpga":
+        return
+    frames = adc_frames("small4", cfg, 3, seed=11)
+    frames[0] = crowded_frame(cfg, 0)
+    await tb.reset()
+    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
+    tb.set_backpressure_generator(random_pause(0.2, 5))
+    for adc in frames:
+        await tb.send_frame(adc)
+    for _ in range(cfg.n_chirps * cfg.n_range):  # half way through frame 0
+        await RisingEdge(tb.dut.clk)
+    tb.dut.rst.value = 1
+    for _ in range(8):
+        await RisingEdge(tb.dut.clk)
+    tb.dut.rst.value = 0
+    tb.sink.clear()
+    try:
+        got = await tb.recv_frames(2, 2 * tb.frame_timeout_cycles())
+    except SimTimeoutError:
+        raise AssertionError(f"no output after reset, status {tb.status()}") from None
+    assert_packets_equal(got, dma_packets(frames[1:], cfg, chain), "mode 1 after reset")
+    status = tb.status()
+    assert status["record_frames"] == 2 and status["status_truncated"] == 0, status
+
+
+# ---- pytest: one Verilator build per parameter set -----------------------------------------
+LONG = os.environ.get("DETECT_LONG", "0") not in ("", "0")
+
+
+@pytest.mark.parametrize("name", list(ALL_SETS) if LONG else list(SETS))
+def test_radar_pipeline_detect(name: str) -> None:
+    cfg, chain = ALL_SETS[name]
+    run_cocotb("radar_pipeline", rtl_sources(*PIPELINE_SOURCES), "test_radar_pipeline_detect",
+               Path(__file__).parent, chain.hdl_parameters(cfg),
+               extra_env={"SEED": os.environ.get("SEED", "1"), "RP_DETECT_SET": name})
