@@ -142,4 +142,5 @@ bench-view: $(STAMP)
 # On-chip detection blocks at every parameter set (make test runs a quick subset)
 .PHONY: test-detect-long
 test-detect-long: $(STAMP)
-	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain
+	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain \
+	    tests/test_detect_fpga.py

@@ -2,6 +2,9 @@
 model) -> record bytes -> host decoder -> point cloud, on the Table I scene (full)."""
 
 import json
+import os
+
+import pytest
 
 from host.evaluate import match_targets
 from host.pointcloud import PointCloud
@@ -48,3 +51,16 @@ def test_rtl_backend_fails_in_one_line_or_runs(tmp_path, capsys):
                "fpga", "--backend", "rtl"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "--backend rtl" in err[0], err
+
+
+@pytest.mark.skipif(not os.environ.get("DETECT_LONG"),
+                    reason="builds the mode-1 top (minutes): make test-detect-long")
+def test_rtl_backend_same_points_as_model_paper_fpga(tmp_path):
+    docs = []
+    for backend in ("rtl", "model"):
+        out = tmp_path / f"{backend}.json"
+        assert main(["detect", "--scene", "table1", "--preset", "paper-fpga", "--detect",
+                     "fpga", "--backend", backend, "--json", str(out)]) == 0
+        docs.append(json.loads(out.read_text()))
+    assert docs[0]["points"] == docs[1]["points"] and len(docs[0]["points"]) >= 3
+    assert docs[0]["frame_info"][0]["complete"]
