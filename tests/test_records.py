@@ -102,6 +102,15 @@ def test_truncated_frame_is_flagged_not_damaged():
     assert decoded[1].trailer.truncated_sticky
 
 
+def test_frame_id_mismatch_is_reported():
+    """Records and trailer stamped with another frame id than their packets: damaged."""
+    stream = detect_stream(_frames(1), DCFG, first_frame_id=5)
+    got, _ = _decode([words_to_bytes(p) for p in packetize_stream(stream, PW)])
+    assert len(got) == 1 and not got[0].complete
+    assert any("trailer carries frame id 5" in p for p in got[0].problems)
+    assert any("records carry frame id" in p for p in got[0].problems)
+
+
 def test_wrong_max_detections_is_reported():
     packets = _packets(_frames(1))
     other = DetectConfig(**{**DCFG.__dict__, "max_detections": 9})
@@ -118,6 +127,10 @@ def test_offsets_from_neighbour_records():
     pmap[10, 5], pmap[11, 5] = hann(0.3) ** 2, hann(0.7) ** 2
     off = record_offsets(pmap, np.array([[10, 5]]), (True, True))
     assert off[0, 0] == pytest.approx(0.3, abs=1e-6) and off[0, 1] == 0.0
+    below = np.zeros((32, 32))        # the same tone 0.3 bins below: neighbour under it
+    below[10, 5], below[9, 5] = pmap[10, 5], pmap[11, 5]
+    assert record_offsets(below, np.array([[10, 5]]), (True, True))[0, 0] == pytest.approx(
+        -0.3, abs=1e-6)
     pmap[9, 5] = hann(1.3) ** 2     # both neighbours: the cube path's Gaussian fit
     off = record_offsets(pmap, np.array([[10, 5]]), (True, True))
     assert 0.2 < off[0, 0] < 0.4
@@ -139,7 +152,7 @@ def test_records_give_the_cube_points_paper_fpga():
               for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
     assert len(frames) == 1 and frames[0].complete
     cloud = process_records(record_arrays(frames[0].records, cfg.n_virtual, gain), cfg, params)
-    assert len(cube_cloud) >= 3
+    assert len(cube_cloud) >= 3 and len(cloud) == len(cube_cloud)
     for i in range(len(cube_cloud)):
         j = np.flatnonzero((cloud.range_bin == cube_cloud.range_bin[i])
                            & (cloud.doppler_bin == cube_cloud.doppler_bin[i]))
