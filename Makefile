@@ -141,4 +141,5 @@ bench-view: $(STAMP)
 # On-chip detection blocks at every parameter set (make test runs a quick subset)
 .PHONY: test-detect-long
 test-detect-long: $(STAMP)
-	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain
+	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain \
+	  tb/radar_pipeline/test_radar_pipeline_detect.py
