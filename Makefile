@@ -143,4 +143,4 @@ bench-view: $(STAMP)
 .PHONY: test-detect-long
 test-detect-long: $(STAMP)
 	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain \
-	    tests/test_detect_fpga.py
+	  tb/radar_pipeline/test_radar_pipeline_detect.py tests/test_detect_fpga.py

@@ -34,14 +34,15 @@ def fpga_detect_config(cfg: RadarConfig, cfar: CfarParams, kind: str = "ca",
                        windowed: tuple[bool, bool] = (True, True)) -> DetectConfig:
     """The on-chip detector's settings for ``cfg`` from the host CFAR options: same guard
     and training cells, same Pfa (the scale table is derived from it with the host CFAR's
-    statistics), CFAR ``kind`` ca/go/so. The top range bins outside
-    ``RadarConfig.detection_bins`` (negative beat frequencies) are blanked (``blank_top``),
-    as the host never reports them. ValueError on settings the detector refuses."""
+    statistics), CFAR ``kind`` ca/go/so; only ``RadarConfig.detection_bins`` may report
+    (``report``: REPORT_LO/REPORT_HI, the host's rule; the other rows stay training cells,
+    as in the host CFAR, and as ``PipelineParams.detect_config``'s default). ValueError on
+    settings the detector refuses."""
     return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
                         n_doppler=cfg.n_doppler, guard=tuple(cfar.guard),
                         train=tuple(cfar.train), kind=kind,
-                        blank_top=cfg.n_range - cfg.detection_bins[1],
-                        max_detections=max_detections, pfa=cfar.pfa, windowed=windowed)
+                        max_detections=max_detections, pfa=cfar.pfa, windowed=windowed,
+                        report=cfg.detection_bins)
 
 
 @dataclass

@@ -12,7 +12,9 @@ not tested); the window is cut there and the threshold scale is recomputed for t
 that remain, the same rule as the host CFAR. The scale of a row depends only on its edge
 index ``e`` (0..PR-1: PR-e rows cut below; PR: interior; PR+1..2PR: e-PR rows cut above).
 The top ``blank_top`` range bins are the negative beat frequencies of a complex-IF range FFT
-(host fix pending): blanked rows never detect and never train.
+(host fix pending): blanked rows never detect and never train. ``report`` = (lo, hi): only
+rows lo <= r < hi may detect (``RadarConfig.detection_bins``, the host's reporting rule);
+the others still train.
 
 Kinds: ``ca`` sums all training cells; ``go``/``so`` take the greater/smaller of the two
 Doppler halves (column offsets < 0 and > 0; the CUT's own column is in neither half).
@@ -51,8 +53,12 @@ class Cfar2dConfig:
     blank_top: int = 0
     scale_w: int = 32
     scale_frac: int = 20
+    report: tuple[int, int] | None = None
 
     def __post_init__(self) -> None:
+        if self.report is not None and not 0 <= self.report[0] < self.report[1] <= \
+                self.n_range:
+            raise ValueError(f"report={self.report}: need 0 <= lo < hi <= n_range")
         for name, n in (("n_range", self.n_range), ("n_doppler", self.n_doppler)):
             if n < 4 or n > 4096 or n & (n - 1):
                 raise ValueError(f"{name}={n} must be a power of two in 4..4096")
@@ -105,11 +111,13 @@ class Cfar2dConfig:
 
     def hdl_parameters(self) -> dict[str, int]:
         """HDL parameters of ``cfar_2d`` for this configuration."""
+        rep = ({} if self.report is None
+               else dict(REPORT_LO=self.report[0], REPORT_HI=self.report[1]))
         return dict(N_RANGE=self.n_range, N_DOPPLER=self.n_doppler, POW_W=self.pow_w,
                     GUARD_R=self.guard[0], GUARD_D=self.guard[1], TRAIN_R=self.train[0],
                     TRAIN_D=self.train[1], KIND=KINDS.index(self.kind),
                     BLANK_TOP=self.blank_top, SCALE_W=self.scale_w,
-                    SCALE_FRAC=self.scale_frac)
+                    SCALE_FRAC=self.scale_frac, **rep)
 
 
 @dataclass
@@ -206,6 +214,7 @@ def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCell
     count = np.zeros_like(p)
     detect = np.zeros(p.shape, dtype=bool)
     frac = 1 << cfg.scale_frac
+    lo, hi = cfg.report or (0, cfg.n_range)
     for q in range(cfg.n_range):
         rowv = window_rows(q, cfg)
         rows = q - pr + np.nonzero(rowv)[0]
@@ -226,7 +235,7 @@ def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCell
             s = np.maximum(left, right) if cfg.kind == "go" else np.minimum(left, right)
             count[q] = n_out * pd - n_in * gd
         train_sum[q] = s
-        if q < cfg.rows:
+        if q < cfg.rows and lo <= q < hi:
             sc = int(scale[edge_index(q, cfg)])
             detect[q] = [int(c) * frac > int(t) * sc for c, t in zip(p[q], s, strict=True)]
     return CfarCells(p, train_sum, count, detect)

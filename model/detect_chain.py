@@ -21,7 +21,8 @@ class DetectConfig:
     """Detector settings (RTL parameters of ``detect_chain`` plus the Pfa the scale table
     is derived from). guard/train: cells per side along (range, Doppler); ``windowed``:
     Hann windows before the (range, Doppler) FFTs (cell correlation in the Pfa arithmetic);
-    ``blank_top``: top range bins blanked (negative beat frequencies)."""
+    ``blank_top``: top range bins blanked (negative beat frequencies); ``report``: (lo, hi),
+    only range bins lo <= r < hi may detect (``RadarConfig.detection_bins``; None: all)."""
 
     num_tx: int
     num_rx: int
@@ -36,6 +37,7 @@ class DetectConfig:
     windowed: tuple[bool, bool] = (True, True)
     scale_w: int = 32
     scale_frac: int = 20
+    report: tuple[int, int] | None = None
 
     def __post_init__(self) -> None:
         if self.num_tx < 1 or self.num_tx > 16 or self.num_tx & (self.num_tx - 1):
@@ -55,7 +57,7 @@ class DetectConfig:
         return cfar_2d.Cfar2dConfig(
             n_range=self.n_range, n_doppler=self.n_doppler, pow_w=self.pow_w, guard=self.guard,
             train=self.train, kind=self.kind, blank_top=self.blank_top, scale_w=self.scale_w,
-            scale_frac=self.scale_frac)
+            scale_frac=self.scale_frac, report=self.report)
 
     @property
     def frame_words(self) -> int:
@@ -72,7 +74,9 @@ class DetectConfig:
                     N_DOPPLER=self.n_doppler, GUARD_R=self.guard[0], GUARD_D=self.guard[1],
                     TRAIN_R=self.train[0], TRAIN_D=self.train[1], KIND=KIND_CODES[self.kind],
                     BLANK_TOP=self.blank_top, SCALE_W=self.scale_w, SCALE_FRAC=self.scale_frac,
-                    MAX_DETECTIONS=self.max_detections)
+                    MAX_DETECTIONS=self.max_detections,
+                    **({} if self.report is None
+                       else dict(REPORT_LO=self.report[0], REPORT_HI=self.report[1])))
 
 
 def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray

@@ -75,7 +75,8 @@ class PipelineParams:
         ``window``, reporting only ``cfg.detection_bins`` (the host CFAR's rule)."""
         if self.detect is None:
             return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
-                                n_doppler=cfg.n_doppler, windowed=(self.window, self.window))
+                                n_doppler=cfg.n_doppler, windowed=(self.window, self.window),
+                                report=cfg.detection_bins)
         d = self.detect
         got = (d.num_tx, d.num_rx, d.n_range, d.n_doppler)
         want = (cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler)
@@ -109,7 +110,9 @@ class PipelineParams:
             store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
                          TRAIN_R=d["TRAIN_R"], TRAIN_D=d["TRAIN_D"], CFAR_KIND=d["KIND"],
                          BLANK_TOP=d["BLANK_TOP"], SCALE_W=d["SCALE_W"],
-                         SCALE_FRAC=d["SCALE_FRAC"], MAX_DETECTIONS=d["MAX_DETECTIONS"])
+                         SCALE_FRAC=d["SCALE_FRAC"], MAX_DETECTIONS=d["MAX_DETECTIONS"],
+                         REPORT_LO=d.get("REPORT_LO", 0),
+                         REPORT_HI=d.get("REPORT_HI", cfg.n_range))
         return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
                               RANGE_SCALE_SCH=self.range_scale_sch,
                               DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),

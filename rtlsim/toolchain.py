@@ -71,10 +71,16 @@ def rtl_sources(*globs: str) -> list[Path]:
 
 
 def param_tag(parameters: Mapping[str, object]) -> str:
-    """Stable folder name for one HDL parameter set, e.g. ``N64_NUM_CH4``."""
+    """Stable folder name for one HDL parameter set, e.g. ``N64_NUM_CH4``; names longer
+    than 200 characters (a file name may have 255) end in a hash of the whole set."""
     if not parameters:
         return "default"
-    return "_".join(f"{k}{v}" for k, v in sorted(parameters.items()))
+    tag = "_".join(f"{k}{v}" for k, v in sorted(parameters.items()))
+    if len(tag) <= 200:
+        return tag
+    import hashlib
+
+    return f"{tag[:180]}_{hashlib.sha1(tag.encode()).hexdigest()[:16]}"
 
 
 def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,

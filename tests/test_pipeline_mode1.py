@@ -116,3 +116,23 @@ def test_truncation_is_counted_and_sticky() -> None:
     trailers = [decode_frame(f.words, 4).trailer for f in dec]
     assert all(t.detections > 1 and t.records == 1 for t in trailers)
     assert all(t.truncated and t.truncated_sticky for t in trailers)
+
+
+def test_report_rows_only_mask_the_decision() -> None:
+    """REPORT_LO/HI (``Cfar2dConfig.report``): rows outside never detect but still train;
+    inside, the decisions equal the unrestricted CFAR's."""
+    from dataclasses import replace
+
+    from model import cfar_2d as cm
+
+    rng = np.random.default_rng(3)
+    p = rng.gamma(4, 1000.0, (32, 32)).astype(np.int64)
+    p[[0, 1, 10, 30, 31], [3, 9, 20, 5, 7]] *= 200
+    full = cm.Cfar2dConfig(n_range=32, n_doppler=32, pow_w=34, guard=(1, 1), train=(2, 4))
+    part = replace(full, report=(1, 28))
+    a = cm.cfar_2d(p, full, cm.scale_table(full, 1e-3, 4))
+    b = cm.cfar_2d(p, part, cm.scale_table(part, 1e-3, 4))
+    assert a.detect[[0, 30, 31]].any() and not b.detect[[0, 28, 29, 30, 31]].any()
+    np.testing.assert_array_equal(b.detect[1:28], a.detect[1:28])
+    np.testing.assert_array_equal(b.train_sum, a.train_sum)
+    assert part.hdl_parameters()["REPORT_HI"] == 28 and "REPORT_LO" not in full.hdl_parameters()

@@ -40,6 +40,11 @@ module cfar_2d #(
   // rows N_RANGE-BLANK_TOP..N_RANGE-1 are not tested and not used as training cells,
   // 0..N_RANGE-2*(GUARD_R+TRAIN_R)-1.
   parameter int BLANK_TOP = 0,
+  // Range rows that may report a detection: REPORT_LO <= r < REPORT_HI (model.config
+  // RadarConfig.detection_bins, the host's rule). Rows outside are still training cells
+  // (unlike BLANK_TOP) but their detect bit is 0 and they are not counted.
+  parameter int REPORT_LO = 0,
+  parameter int REPORT_HI = N_RANGE,
   // Threshold scale: unsigned fixed point, SCALE_W bits with SCALE_FRAC fraction bits.
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
@@ -112,6 +117,10 @@ module cfar_2d #(
   if (BLANK_TOP < 0 || N_EFF < 2 * PR + 1) begin : g_bad_blank_top
     $fatal(1, "%m: BLANK_TOP=%0d leaves %0d rows, need >= %0d",
            BLANK_TOP, N_EFF, 2 * PR + 1);
+  end
+  if (REPORT_LO < 0 || REPORT_HI > N_RANGE || REPORT_LO >= REPORT_HI) begin : g_bad_report
+    $fatal(1, "%m: REPORT_LO=%0d/REPORT_HI=%0d: need 0 <= LO < HI <= N_RANGE=%0d",
+           REPORT_LO, REPORT_HI, N_RANGE);
   end
   if (SCALE_W < 2 || SCALE_W > 48 || SCALE_FRAC < 0 || SCALE_FRAC >= SCALE_W)
   begin : g_bad_scale_w
@@ -212,7 +221,7 @@ module cfar_2d #(
     n_out1_q  <= n_out;
     n_in1_q   <= n_in;
     e1_q      <= e_idx;
-    cut_ok1_q <= (q < N_EFF);
+    cut_ok1_q <= (q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI);
     r1_q      <= BR'(q);
     d1_q      <= BD'(s_q - S_W'(PD));   // centre column (mod N_DOPPLER)
   end

@@ -24,6 +24,9 @@ module detect_chain #(
   parameter int KIND = 0,
   // Top range bins blanked (negative beat frequencies), see cfar_2d.
   parameter int BLANK_TOP = 0,
+  // Range rows that may report detections, REPORT_LO <= r < REPORT_HI (cfar_2d).
+  parameter int REPORT_LO = 0,
+  parameter int REPORT_HI = N_RANGE,
   // Threshold scale fixed point (cfar_2d).
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
@@ -99,7 +102,7 @@ module detect_chain #(
 
   cfar_2d #(.N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .POW_W(POW_W), .GUARD_R(GUARD_R),
             .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D), .KIND(KIND),
-            .BLANK_TOP(BLANK_TOP), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC)) u_cfar (
+            .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC)) u_cfar (
     .clk(clk), .rst(rst), .cfg_scale(cfg_scale),
     .s_axis_tdata(nci_tdata), .s_axis_tvalid(nci_tvalid), .s_axis_tready(nci_tready),
     .s_axis_tlast(nci_tlast),

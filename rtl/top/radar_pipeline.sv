@@ -69,6 +69,10 @@ module radar_pipeline #(
   parameter int TRAIN_D = 8,
   parameter int CFAR_KIND = 0,
   parameter int BLANK_TOP = 0,
+  // Range rows that may report detections, REPORT_LO <= r < REPORT_HI: the host's
+  // RadarConfig.detection_bins (PipelineParams sets them; docs/detect.md, range edges).
+  parameter int REPORT_LO = 0,
+  parameter int REPORT_HI = N_RANGE,
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
   parameter int MAX_DETECTIONS = 256
@@ -366,7 +370,8 @@ module radar_pipeline #(
     detect_chain #(
       .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
       .GUARD_R(GUARD_R), .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D),
-      .KIND(CFAR_KIND), .BLANK_TOP(BLANK_TOP), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
+      .KIND(CFAR_KIND), .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI),
+      .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
       .MAX_DETECTIONS(MAX_DETECTIONS)
     ) u_detect (
       .clk, .rst, .cfg_scale(cfg_cfar_scale),

@@ -4,6 +4,10 @@ read-out, resets between segments), Python only writes the ADC beats and reads t
 
     packets, status = run_pipeline(adc_frames, cfg, seed=1, adc_gap=0.5, dma_stall=0.3)
 
+With ``chain=PipelineParams(output_mode=1, ...)`` the top is built with OUTPUT_MODE = 1 and
+the packets are the detection-record stream (``model.radar_pipeline.dma_packets`` gives the
+same bytes); the harness drives ``cfg_cfar_scale`` with ``chain.cfar_scale(cfg)``.
+
 The executable is built once per HDL parameter set by Verilator (``--cc --exe --build``)
 under ``sim_build/radar_pipeline_native/<tag>/``, with the project's toolchain environment
 and options (:mod:`rtlsim.toolchain`). The cocotb testbench (``tb/radar_pipeline``)

@@ -29,7 +29,8 @@ class TB(AxisTB):
         self.cfg = cm.Cfar2dConfig(
             n_range=param("N_RANGE"), n_doppler=param("N_DOPPLER"), pow_w=param("POW_W"),
             guard=(param("GUARD_R"), param("GUARD_D")), train=(param("TRAIN_R"), param("TRAIN_D")),
-            kind=KIND_NAMES[param("KIND")], blank_top=param("BLANK_TOP"))
+            kind=KIND_NAMES[param("KIND")], blank_top=param("BLANK_TOP"),
+            report=(param("REPORT_LO", 0), param("REPORT_HI", param("N_RANGE"))))
         self.scale = cm.scale_table(self.cfg, PFA, N_CHANNELS)
         dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg)
         self.in_bytes = (self.cfg.pow_w + 7) // 8
@@ -176,9 +177,9 @@ async def test_reset_recovery(dut):
 # ------------------------------------------------------------------------------------------
 # pytest: one Verilator build per HDL parameter set
 PARAMS = [
-    # GO with top range bins blanked, asymmetric window
+    # GO with top range bins blanked, asymmetric window, rows 0, 1, 11, 12 never report
     dict(N_RANGE=16, N_DOPPLER=32, POW_W=34, GUARD_R=1, GUARD_D=2, TRAIN_R=2, TRAIN_D=3, KIND=1,
-         BLANK_TOP=3),
+         BLANK_TOP=3, REPORT_LO=2, REPORT_HI=11),
 ]
 LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
     # smallest: 4 x 4 map, no guard, one training cell per side, CA

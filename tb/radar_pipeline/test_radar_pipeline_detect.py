@@ -41,12 +41,13 @@ from rtlsim.toolchain import rtl_sources, run_cocotb, seed
 SETS: dict[str, tuple[RadarConfig, PipelineParams]] = {
     "paper-fpga": (get_preset("paper-fpga"), PipelineParams(packet_words=256, output_mode=1)),
     "small4": (SMALL4, PipelineParams(packet_words=64, output_mode=1, detect=DetectConfig(
-        num_tx=4, num_rx=4, n_range=32, n_doppler=32, max_detections=24))),
+        num_tx=4, num_rx=4, n_range=32, n_doppler=32, max_detections=24,
+        report=SMALL4.detection_bins))),
 }
 LONG_SETS = {  # make test-detect-long (DETECT_LONG=1)
     "small4-go": (SMALL4, PipelineParams(packet_words=100, output_mode=1, detect=DetectConfig(
         num_tx=4, num_rx=4, n_range=32, n_doppler=32, guard=(1, 1), train=(2, 3), kind="go",
-        max_detections=40, pfa=1e-4))),
+        max_detections=16, pfa=1e-4))),
 }
 ALL_SETS = {**SETS, **LONG_SETS}
 
