@@ -107,6 +107,30 @@ def test_sender_restart_without_pause(frames):
     assert s["frames_complete"] >= 10
 
 
+@pytest.mark.parametrize("packet_words", [1023, 4093, 500])
+def test_packet_words_learnt_from_the_header(packet_words):
+    """No --packet-words: the stream's PACKET_WORDS comes from the first packet's header
+    (``radar capture`` writes the most that fit a datagram, 4093 on paper-fpga); a sender that
+    restarts with another PACKET_WORDS is learnt again."""
+    health = LinkHealth()
+    rec = _Recorder(health)
+    ingest = PacketIngest(CFG, None, health, rec, gain=1.0)
+    for k in range(3):
+        for p in frame_packets(_cube(k), CFG, packet_words, k):
+            ingest.push(p)
+    assert ingest.packet_words == packet_words
+    ingest.idle()
+    for k in range(2):
+        for p in frame_packets(_cube(k), CFG, 1023, k):
+            ingest.push(p)
+    ingest.idle()
+    s = health.snapshot()
+    assert ingest.packet_words == 1023
+    assert rec.got == [0, 1, 2, 0, 1]
+    assert (s["frames_complete"], s["frames_damaged"], s["packets_lost"], s["malformed"],
+            s["late_packets"]) == (5, 0, 0, 0, 0)
+
+
 def test_reordered_frame_is_not_lost(frames):
     ingest, health, _ = _ingest()
     for k in (0, 2, 1, 3):  # whole frame 1 arrives after frame 2

@@ -121,7 +121,7 @@ def build(args: argparse.Namespace, stop: threading.Event
                                         args=(make_cube, args.frames, processor, health,
                                               stop, args.fps)))
         return feed, health, threads, desc
-    gain = chain_gain(cfg, PipelineParams(packet_words=packet_words))
+    gain = chain_gain(cfg, PipelineParams())  # the FFT scaling only, not PACKET_WORDS
     try:
         ingest = PacketIngest(cfg, packet_words, health, processor, gain)
     except ValueError as exc:
@@ -197,8 +197,9 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: the capture's geometry, the scene's preset, "
                         "or full for UDP)")
-    v.add_argument("--packet-words", type=int, default=1023,
-                   help="PACKET_WORDS of a UDP stream (default 1023)")
+    v.add_argument("--packet-words", type=int, default=None,
+                   help="PACKET_WORDS of a UDP stream (default: learnt from the packet "
+                        "headers, as radar receive does)")
     v.add_argument("--host", default="127.0.0.1",
                    help="address the web page is served on (default 127.0.0.1)")
     v.add_argument("--port", type=int, default=DEFAULT_PORT,

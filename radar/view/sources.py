@@ -25,8 +25,8 @@ import numpy as np
 
 from host.capture import read_capture
 from host.pipeline import DetectionParams, process_cube
-from host.stream import Frame, StreamDecoder
-from host.udp import UDP_MAX_PAYLOAD
+from host.stream import Frame, StreamDecoder, geometry_from_packet
+from host.udp import UDP_MAX_PAYLOAD, max_packet_words
 from model.config import RadarConfig
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
@@ -116,27 +116,54 @@ class PacketIngest:
     of packets in a row belonging to frames already closed; then, or after
     :data:`IDLE_RESTART_S` without datagrams (:meth:`idle`), a fresh decoder takes over.
     ``gain``: the chain's cube gain (decoded cubes are divided by it).
+    ``packet_words``: the stream's PACKET_WORDS, or None to learn it (as ``radar receive``
+    does) from the header of the first datagram after each (re)start; the decoder waiting
+    for that datagram assumes the most that fit a UDP datagram.
     """
 
-    def __init__(self, cfg: RadarConfig, packet_words: int, health: LinkHealth,
+    def __init__(self, cfg: RadarConfig, packet_words: int | None, health: LinkHealth,
                  processor: Processor, gain: float, use_damaged: bool = True) -> None:
         self.cfg = cfg
-        self.packet_words = packet_words
+        self.fixed_packet_words = packet_words
         self.health = health
         self.processor = processor
         self.gain = gain
         self.use_damaged = use_damaged
-        self.decoder = StreamDecoder(cfg, packet_words)  # ValueError on a bad geometry
+        self.decoder = self._new_decoder()  # ValueError on a bad geometry
+        self._learn = packet_words is None
         self._late_run: list[bytes] = []
         self._late_msgs: list[str] = []
         self._last_id: int | None = None
         self._presumed_lost: set[int] = set()
         self._dirty = False
 
+    @property
+    def packet_words(self) -> int:
+        """PACKET_WORDS the current decoder expects."""
+        return self.decoder.packet_words
+
+    def _new_decoder(self, packet_words: int | None = None) -> StreamDecoder:
+        pw = packet_words or self.fixed_packet_words or max_packet_words(self.cfg.num_rx)
+        return StreamDecoder(self.cfg, pw)
+
+    def _learn_geometry(self, data: bytes) -> None:
+        """PACKET_WORDS from this datagram's header, when it is a packet of the preset; a
+        datagram that is not stays with the decoder (which counts it as malformed)."""
+        try:
+            _, pw = geometry_from_packet(data, [self.cfg])
+        except ValueError:
+            return
+        self._learn = False
+        if pw != self.decoder.packet_words:
+            self.health.retire_decoder(self.decoder.stats)
+            self.decoder = self._new_decoder(pw)
+
     def push(self, data: bytes) -> None:
         """One datagram (one DMA packet)."""
         self.health.on_datagram(len(data))
         self._dirty = True
+        if self._learn:
+            self._learn_geometry(data)
         dec = self.decoder
         late = dec.stats.late_packets
         try:
@@ -165,6 +192,8 @@ class PacketIngest:
             self.restart()
             with self.health.lock:
                 self.health.problems.append("sender restarted (frame ids started again)")
+            if self._learn:
+                self._learn_geometry(replay[0])
             for p in replay:
                 frames += self.decoder.push_packet(p)
         for f in frames:
@@ -183,7 +212,8 @@ class PacketIngest:
             self._frame(f)
         self._sync()
         self.health.retire_decoder(self.decoder.stats)
-        self.decoder = StreamDecoder(self.cfg, self.packet_words)
+        self.decoder = self._new_decoder(self.decoder.packet_words)
+        self._learn = self.fixed_packet_words is None
         self._late_run, self._late_msgs = [], []
         self._last_id = None
         self._presumed_lost.clear()
