@@ -14,6 +14,7 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from host.capture import read_capture
@@ -171,4 +172,84 @@ def test_view_in_browser(capture, tmp_path):
     base = view.url.rstrip("/").removeprefix("http://")
     outside = [u for u in requests if base not in u]
     assert not outside, f"page loaded from outside the server: {outside[:3]}"
+    assert not errors, f"the page logged errors: {errors[:3]}"
+
+
+def test_record_frames_in_browser(tmp_path):
+    """A detection-record stream's frame (points only, no cube, no map) renders: the
+    detections in range-Doppler, the point cloud with a GNN box, SNR over range; and a cube
+    frame after it brings the heat maps back."""
+    from playwright.sync_api import sync_playwright
+
+    from host.pointcloud import PointCloud
+    from model.config import get_preset
+    from radar.view.feed import Feed, ViewFrame
+    from radar.view.health import LinkHealth
+    from radar.view.server import ViewServer
+
+    cfg = get_preset("paper-fpga")
+    n = 5
+    cloud = PointCloud.from_polar(
+        np.linspace(10, 80, n), np.linspace(-20, 20, n), np.linspace(-15, 15, n),
+        np.full(n, 50.0), np.linspace(12, 30, n), np.zeros(n), np.arange(n) + 5,
+        np.arange(n) + 60, np.zeros(n, bool))
+    obj = {"class": "car", "score": 0.9, "x_m": 30.0, "y_m": 2.0, "length_m": 4.5,
+           "width_m": 1.8, "heading_deg": 10.0}
+    feed, health = Feed(), LinkHealth()
+    server = ViewServer(feed, health)
+    port = server.start_in_thread()
+    errors: list[str] = []
+    stop = threading.Event()
+
+    def publish(cube: bool) -> None:
+        rng = np.random.default_rng(0)
+        shape = (cfg.n_virtual, cfg.n_range, cfg.n_doppler)
+        c = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(
+            np.complex64) if cube else None
+        while not stop.is_set():
+            feed.publish(ViewFrame(seq=feed.next_seq(), frame_id=feed.next_seq(), cfg=cfg,
+                                   cloud=cloud, objects=[obj], cube=c,
+                                   nci=None if c is None else np.sum(np.abs(c) ** 2, axis=0),
+                                   source="records"))
+            stop.wait(0.1)
+
+    producer = threading.Thread(target=publish, args=(False,), daemon=True)
+    try:
+        producer.start()
+        with sync_playwright() as pw:
+            ctx = launch(pw, tmp_path / "profile")
+            page = ctx.new_page()
+            page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
+            page.on("console", lambda m: errors.append(f"console: {m.text}")
+                    if m.type == "error" else None)
+            page.goto(f"http://127.0.0.1:{port}/")
+            _wait(page, "window.radarView.frames >= 3", 60_000, errors)
+            drawn = page.evaluate("""() => {
+                const el = id => document.getElementById(id);
+                const heat = el('plot-nci').heat;
+                return {detections: el('plot-nci').data[0].y.length,
+                        cloud: el('plot-cloud').data.map(t => t.x.length),
+                        snr: el('plot-profile').data[0].y.length,
+                        note: el('plot-rd').textContent.includes('no per-channel map'),
+                        canvas: heat ? !heat.canvas.hidden : false};
+            }""")
+            assert drawn == {"detections": n, "cloud": [n, 5, 1], "snr": n, "note": True,
+                             "canvas": False}, drawn
+            # the stream turns into a cube stream: the heat maps come back
+            stop.set()
+            producer.join(5)
+            stop.clear()
+            producer = threading.Thread(target=publish, args=(True,), daemon=True)
+            producer.start()
+            frames = page.evaluate("window.radarView.frames")
+            _wait(page, f"window.radarView.frames > {frames + 2}", 60_000, errors)
+            shown = page.evaluate("""() => ['plot-rd', 'plot-nci'].map(id => {
+                const h = document.getElementById(id).heat;
+                return [h.canvas.width, h.canvas.height, !h.canvas.hidden];
+            })""")
+            assert shown == [[128, 64, True], [128, 64, True]], shown
+            ctx.close()
+    finally:
+        stop.set()
+        server.stop()
     assert not errors, f"the page logged errors: {errors[:3]}"

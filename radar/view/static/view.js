@@ -107,18 +107,19 @@ function placeHeat(div) {
                                   width: `${size.w}px`, height: `${size.h}px` });
 }
 
-async function heatmap(div, m, title) {
+async function heatmap(div, m, title, msg) {
   const el = document.getElementById(div);
-  if (!m) {
+  if (!m) {  // a detection-record stream: no maps, the detections in their place
+    if (el.heat) Object.assign(el.heat, { key: null, m: null, codes: null });
     if (el.heat) el.heat.canvas.hidden = true;
-    Plotly.purge(el);
-    return;
+    return div === "plot-nci" ? detectionMap(div, msg) : noMap(div, title);
   }
   const h = heatCanvas(el);
   const key = JSON.stringify([title, m.lo, m.hi, m.rows, m.cols, m.range_m[0],
                               m.range_m[m.rows - 1], m.velocity_mps[0],
                               m.velocity_mps[m.cols - 1]]);
   if (key !== h.key) {
+    el.figureKey = null;
     await heatFrame(el, m, title);
     if (!h.lut) h.lut = lookupTable(el._fullData[0].colorscale);
     if (!h.bound) { el.on("plotly_afterplot", () => placeHeat(el)); h.bound = true; }
@@ -153,10 +154,37 @@ function update(id, traces, layout, key) {
   const div = document.getElementById(id);
   key = JSON.stringify([traces.length, key]);
   if (div.figureKey === key) {
+    if (!traces.length) return Promise.resolve();
     return Plotly.animate(div, { data: traces, traces: traces.map((_, i) => i) }, ANIMATE);
   }
   div.figureKey = key;
   return Plotly.react(div, traces, layout, CONFIG);
+}
+
+function noMap(div, title) {
+  return update(div, [], {
+    title: { text: title, font: { size: 13 } }, margin: MARGIN,
+    xaxis: { visible: false }, yaxis: { visible: false },
+    annotations: [{ text: "no per-channel map in a detection-record stream", showarrow: false,
+                    xref: "paper", yref: "paper", x: 0.5, y: 0.5 }],
+  }, "no map");
+}
+
+function detectionMap(div, msg) {
+  // the cells the FPGA's CFAR passed on the integrated map, coloured by SNR
+  const p = msg.points, vmax = msg.limits.max_velocity_mps, r = msg.limits.max_range_m;
+  return update(div, [{
+    type: "scatter", mode: "markers", x: p.v, y: p.range, name: "detections",
+    marker: { size: 8, color: p.snr, cmin: 0, cmax: 40, colorscale: "Viridis",
+              line: { width: 1, color: "#222" },
+              colorbar: { title: { text: "SNR dB" }, ticklabeloverflow: "allow" } },
+    hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>SNR %{marker.color:.1f} dB<extra></extra>",
+  }], {
+    title: { text: "range-Doppler detections (record stream: no map)", font: { size: 13 } },
+    margin: MARGIN, showlegend: false,
+    xaxis: axis("radial velocity (m/s)", { range: [-vmax, vmax] }),
+    yaxis: axis("range (m)", { range: [0, r] }),
+  }, ["detections", r, vmax]);
 }
 
 function pointCloud(div, msg) {
@@ -191,10 +219,17 @@ function pointCloud(div, msg) {
 
 function profile(div, msg) {
   const pr = msg.profile;
-  if (!pr) {
-    document.getElementById(div).figureKey = null;
-    Plotly.purge(div);
-    return Promise.resolve();
+  if (!pr) {  // a detection-record stream: each detection's SNR over its range
+    const p = msg.points, r = msg.limits.max_range_m;
+    const top = 10 * Math.ceil(Math.max(10, ...p.snr) / 10) + 5;
+    return update(div, [{ type: "scatter", mode: "markers", x: p.range, y: p.snr,
+                          name: "detections",
+                          marker: { color: "#c62828", size: 7, symbol: "x" } }], {
+      title: { text: "detections: SNR over range (record stream: no profile)",
+               font: { size: 13 } },
+      margin: MARGIN, showlegend: false,
+      xaxis: axis("range (m)", { range: [0, r] }), yaxis: axis("SNR (dB)", { range: [0, top] }),
+    }, ["records", r, top]);
   }
   // y range on a 10 dB grid: the axes stay put from frame to frame
   let lo = Infinity, hi = -Infinity;
@@ -256,9 +291,9 @@ async function draw(msg) {
     const input = document.getElementById("channel");
     input.max = msg.n_virtual - 1;
     await timed("rd", () => heatmap("plot-rd", msg.rd,
-                                      `range-Doppler, virtual channel ${msg.channel}`));
+                                      `range-Doppler, virtual channel ${msg.channel}`, msg));
     await timed("nci", () => heatmap("plot-nci", msg.nci,
-                                     "range-Doppler, integrated over channels"));
+                                     "range-Doppler, integrated over channels", msg));
     await timed("cloud", () => pointCloud("plot-cloud", msg));
     await timed("profile", () => profile("plot-profile", msg));
     state.frames += 1;
