@@ -124,6 +124,13 @@ def draw_cpu_ms(page: Any, cdp: Any, fn: str, repeats: int = DRAW_REPEATS) -> fl
     return 1e3 * (_thread_time_s(cdp) - t0) / repeats
 
 
+def _heap_mib(page: Any, cdp: Any) -> float:
+    """The page's live JS heap after a garbage collection, MiB (without it the figure is
+    mostly how long ago the collector last ran)."""
+    cdp.send("HeapProfiler.collectGarbage")
+    return float(page.evaluate("performance.memory.usedJSHeapSize")) / 2**20
+
+
 def _thread_time_s(cdp: Any) -> float:
     """CPU time of the page's main thread so far, s (Chrome DevTools ``ThreadTime``)."""
     metrics = cdp.send("Performance.getMetrics")["metrics"]
@@ -151,14 +158,14 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
                                    "h: window.radarView.lastHealth})")
             thread0, cpu0 = _thread_time_s(cdp), view.cpu_s()
             rss = [view.rss_kib()]
-            heap0 = page.evaluate("performance.memory.usedJSHeapSize")
+            heap0 = _heap_mib(page, cdp)
             t_end = time.monotonic() + duration_s
             while time.monotonic() < t_end:
                 time.sleep(min(1.0, max(0.0, t_end - time.monotonic())))
                 rss.append(view.rss_kib())
             state1 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
                                    "h: window.radarView.lastHealth, ms: window.radarView.drawMs})")
-            heap1 = page.evaluate("performance.memory.usedJSHeapSize")
+            heap1 = _heap_mib(page, cdp)
             thread1, cpu1 = _thread_time_s(cdp), view.cpu_s()
             if screenshot is not None:
                 screenshot.parent.mkdir(parents=True, exist_ok=True)
@@ -182,7 +189,7 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
             "host_cpu_ms": 1e3 * (cpu1 - cpu0) / max(1, decoded),
             "not_shown": h1["frames_not_shown"] - h0["frames_not_shown"],
             "rss0": rss[0] / 1024, "rss1": rss[-1] / 1024, "rss_max": max(rss) / 1024,
-            "heap0": heap0 / 2**20, "heap1": heap1 / 2**20, "seconds": dt,
+            "heap0": heap0, "heap1": heap1, "seconds": dt,
             "draw_ms": sum(state1["ms"].values()),
             "draw_new_ms": draw_new, "draw_old_ms": draw_old,
             **server_costs(cap, get_preset(preset)),
