@@ -17,7 +17,7 @@ draw and, for comparison in the same browser on the same message, the reference 
 ea510a1 (one full Plotly.react per plot, ``bench_reference.js``).
 
     python -m radar.view.bench_view [--duration 20 | --minutes 10] [--presets paper-fpga full]
-                                    [--screenshot docs/img/radar_view.png] [--gnn]
+                                    [--screenshot docs/img/view_table1.png] [--gnn]
                                     [--capture out/table1_paper-fpga.dmacap]
 """
 
