@@ -93,7 +93,7 @@ def test_view_in_browser(capture, tmp_path):
 
     _, it = read_capture(capture)
     packets = list(it)
-    view = start_view(["--udp-port", "0", "--preset", "paper-fpga"])
+    view = start_view(["--udp-port", "0"])  # preset and PACKET_WORDS learnt from the headers
     sender = Sender(packets, view.udp_port)
     requests: list[str] = []
     errors: list[str] = []

@@ -46,7 +46,8 @@ class _Recorder(Processor):
         super().__init__(CFG, Feed(), health)
         self.got: list[int] = []
 
-    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0) -> None:
+    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0,
+               cfg: object = None) -> None:
         self.got.append(frame_id)
 
 
@@ -129,6 +130,33 @@ def test_packet_words_learnt_from_the_header(packet_words):
     assert rec.got == [0, 1, 2, 0, 1]
     assert (s["frames_complete"], s["frames_damaged"], s["packets_lost"], s["malformed"],
             s["late_packets"]) == (5, 0, 0, 0, 0)
+
+
+def test_preset_learnt_from_the_header():
+    """A UDP stream without --preset: the view starts on ``full`` and learns paper-fpga
+    (and its PACKET_WORDS) from the first packet; cubes reach the processor with that
+    preset's shape and gain."""
+    from model.config import PRESETS
+    from model.radar_pipeline import PipelineParams, chain_gain
+
+    full = get_preset("full")
+    health = LinkHealth()
+    got: list[tuple[int, tuple[int, ...], float, str]] = []
+
+    class Rec(Processor):
+        def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:
+            got.append((frame_id, cube.shape, scale, cfg.name))
+
+    ingest = PacketIngest(full, None, health, Rec(full, Feed(), health), gain=1.0,
+                          configs=list(PRESETS.values()))
+    for k in range(2):
+        for p in frame_packets(_cube(k), CFG, 4093, k):
+            ingest.push(p)
+    ingest.idle()
+    gain = chain_gain(CFG, PipelineParams())
+    assert got == [(k, CFG.cube_shape, pytest.approx(1 / gain), "paper-fpga") for k in (0, 1)]
+    s = health.snapshot()
+    assert (s["frames_complete"], s["malformed"], s["packets_lost"]) == (2, 0, 0)
 
 
 def test_reordered_frame_is_not_lost(frames):
