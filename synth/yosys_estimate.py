@@ -199,6 +199,8 @@ class Result:
     cells: dict[str, int] = field(default_factory=dict)
     skipped: str = ""
     error: str = ""
+    # peak resident memory of the Yosys run (MB; the WebAssembly build stops at 4 GiB)
+    peak_mb: float = 0.0
 
     def count(self, *types: str) -> int:
         """Sum of the cells of the given types."""
@@ -229,12 +231,13 @@ class Result:
         job = known.get(rec["name"]) or Job(rec["name"], rec["top"], dict(rec["params"]),
                                              uram=bool(rec["uram"]))
         return cls(job, float(rec["seconds"]), dict(rec["cells"]), rec["skipped"],
-                   rec["error"])
+                   rec["error"], float(rec.get("peak_mb", 0)))
 
     def to_json(self) -> dict[str, object]:
         """JSON-ready record of the job and its counts."""
         return {"name": self.job.name, "top": self.job.top, "params": self.job.params,
                 "uram": self.job.uram, "seconds": round(self.seconds, 1),
+                "peak_mb": round(self.peak_mb),
                 "cells": self.cells, "columns": self.columns if self.cells else {},
                 "skipped": self.skipped, "error": self.error}
 
@@ -292,8 +295,27 @@ def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     ])
 
 
-def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result:
-    """Synthesize one job; the Yosys log is kept in ``work/<name>.log``."""
+def _wait(proc: subprocess.Popen, timeout: float | None) -> tuple[int | None, int]:
+    """Wait for ``proc`` (killing it after ``timeout`` s); (exit code or None on timeout,
+    its peak resident memory in KiB from ``wait4``)."""
+    t_end = None if timeout is None else time.monotonic() + timeout
+    while True:
+        pid, status, ru = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            return proc.returncode, ru.ru_maxrss
+        if t_end is not None and time.monotonic() > t_end:
+            proc.kill()
+            _, _, ru = os.wait4(proc.pid, 0)
+            proc.returncode = -9
+            return None, ru.ru_maxrss
+        time.sleep(0.5)
+
+
+def run_job(job: Job, files: list[Path], work: Path, yosys: list[str],
+            timeout: float | None = None) -> Result:
+    """Synthesize one job (killed after ``timeout`` seconds if given); the Yosys log is kept
+    in ``work/<name>.log``."""
     res = Result(job)
     if job.top == "radar_pipeline" and not TOP_FILE.exists():
         res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
@@ -309,12 +331,20 @@ def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result
     stat_json.unlink(missing_ok=True)
     nice = ["nice", "-n", "10"] if shutil.which("nice") else []
     t0 = time.monotonic()
-    proc = subprocess.run([*nice, *yosys, "-q", "-l", log.name, ys.name], cwd=work,
-                          capture_output=True, text=True, check=False)
+    out_txt = work / f"{tag}.out"
+    with out_txt.open("w") as fh:
+        proc = subprocess.Popen([*nice, *yosys, "-q", "-l", log.name, ys.name], cwd=work,
+                                stdout=fh, stderr=subprocess.STDOUT)
+        rc, peak_kb = _wait(proc, timeout)
     res.seconds = time.monotonic() - t0
-    if proc.returncode != 0 or not stat_json.exists():
-        lines = [ln for ln in (proc.stderr + proc.stdout).splitlines() if "ERROR" in ln]
-        res.error = (lines[-1] if lines else f"yosys exit {proc.returncode}") + f" (log: {log})"
+    res.peak_mb = peak_kb / 1024.0   # peak resident memory (nice execs Yosys: same process)
+    output = out_txt.read_text(errors="replace")
+    if rc is None:
+        res.error = f"timeout after {res.seconds:.0f} s (log: {log})"
+        return res
+    if rc != 0 or not stat_json.exists():
+        lines = [ln for ln in output.splitlines() if "ERROR" in ln or "exception" in ln]
+        res.error = (lines[-1] if lines else f"yosys exit {rc}") + f" (log: {log})"
         return res
     stat = json.loads(stat_json.read_text())
     design = stat.get("design", {})
@@ -369,25 +399,27 @@ def markdown(results: Iterable[Result]) -> str:
     """The estimate table (one row per job) and Table II of the paper."""
     results = list(results)
     cols = _COLS
-    head = ("| block | parameters | " + " | ".join(cols) + " | Yosys s |\n"
-            "|---|---|" + "---:|" * (len(cols) + 1) + "\n")
+    head = ("| block | parameters | " + " | ".join(cols) + " | Yosys s | Yosys MB |\n"
+            "|---|---|" + "---:|" * (len(cols) + 2) + "\n")
     rows = []
     for r in results:
         if r.cells:
             c = r.columns
             name = r.job.name + (f" (x{r.job.instances})" if r.job.instances > 1 else "")
             rows.append(f"| {name} | {r.job.label} | "
-                        + " | ".join(_fmt(c[k]) for k in cols) + f" | {r.seconds:.0f} |")
+                        + " | ".join(_fmt(c[k]) for k in cols)
+                        + f" | {r.seconds:.0f} | {r.peak_mb:.0f} |")
         else:
             why = f"skipped: {r.skipped}" if r.skipped else f"FAILED: {r.error}"
-            rows.append(f"| {r.job.name} | {r.job.label} | {why} |" + " |" * len(cols))
+            rows.append(f"| {r.job.name} | {r.job.label} | {why} |" + " |" * (len(cols) - 1)
+                        + f" {r.seconds:.0f} | {r.peak_mb:.0f} |")
     for preset, s in preset_sums(results).items():
         rows.append(f"| **{preset}: sum of the blocks above** | | "
-                    + " | ".join(_fmt(s[k]) for k in cols) + " | |")
+                    + " | ".join(_fmt(s[k]) for k in cols) + " | | |")
     p = PAPER_TABLE_II
     rows.append(f"| **paper Table II** (Vivado, Xilinx FFT IP) | 1 TX x 4 RX | {p['LUT']:g} | "
                 f"{p['LUTRAM']:g} | {p['FF']:g} | - | {p['DSP']:g} | - | - | "
-                f"{p['BRAM']:g} | {p['URAM']:g} | |")
+                f"{p['BRAM']:g} | {p['URAM']:g} | | |")
     return head + "\n".join(rows) + "\n"
 
 
@@ -407,6 +439,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "synth",
                     help="output folder (default out/synth)")
     ap.add_argument("--list", action="store_true", help="list the jobs of every set and exit")
+    ap.add_argument("--timeout", type=float, default=None, metavar="S",
+                    help="stop a Yosys job after S seconds (reported as failed)")
     ap.add_argument("--merge", type=Path, nargs="+", default=None, metavar="JSON",
                     help="no Yosys: write one report (into --out) from the estimate.json of "
                          "earlier runs")
@@ -435,14 +469,14 @@ def main(argv: list[str] | None = None) -> int:
     results: list[Result] = []
     for job in jobs:
         print(f"synth-estimate: {job.name} ({job.top} {job.label}) ...", flush=True)
-        r = run_job(job, files_for(job.top, files), work, yosys)
+        r = run_job(job, files_for(job.top, files), work, yosys, args.timeout)
         if r.skipped:
             print(f"  skipped: {r.skipped}", flush=True)
         elif r.error:
             print(f"  FAILED after {r.seconds:.0f} s: {r.error}", flush=True)
         else:
             c = r.columns
-            print(f"  {r.seconds:.0f} s: "
+            print(f"  {r.seconds:.0f} s, {r.peak_mb:.0f} MB: "
                   + ", ".join(f"{k} {_fmt(v)}" for k, v in c.items()), flush=True)
         results.append(r)
     return write_report(results, out, args.set, _yosys_version(yosys))
