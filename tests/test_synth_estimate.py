@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import re
 import shutil
+import subprocess
 import textwrap
 from pathlib import Path
 
@@ -19,10 +20,13 @@ from synth.yosys_estimate import (
     XCZU7EV,
     Job,
     Result,
+    _wait,
     capacity_table,
     files_for,
     job_sets,
     main,
+    markdown,
+    merge_reports,
     rtl_files,
 )
 
@@ -174,3 +178,29 @@ def test_capacity_table_percentages() -> None:
     assert "115200 (50.0%)" in row and "46080 (10.0%)" in row and "864 (50.0%)" in row
     assert "32 (10.3%)" in row and "48 (50.0%)" in row
     assert XCZU7EV == {"LUT": 230400, "FF": 460800, "DSP": 1728, "BRAM": 312, "URAM": 96}
+
+
+def test_merge_reports_and_failed_rows(tmp_path: Path) -> None:
+    """A long job run alone merges into one report; a failed job keeps its time and memory."""
+    top = _top("full")
+    ok = Result(top, 1200.0, {"LUT6": 1000, "FDRE": 500, "DSP48E2": 7}, peak_mb=2100.0)
+    bad = Result(Job("full/x", "x", {}), 3600.0, error="timeout after 3600 s", peak_mb=4000.0)
+    for name, r in (("a", ok), ("b", bad)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "estimate.json").write_text(json.dumps({"results": [r.to_json()]}))
+    assert merge_reports([tmp_path / "a" / "estimate.json", tmp_path / "b" / "estimate.json"],
+                         tmp_path / "m") == 1   # the failed job is reported as a failure
+    text = (tmp_path / "m" / "estimate.md").read_text()
+    assert "| full/radar_pipeline | " in text and "| 1200 | 2100 |" in text
+    assert "FAILED: timeout after 3600 s" in text and "| 3600 | 4000 |" in text
+    assert "full/radar_pipeline (top) | 1000 (0.4%)" in text
+    head, _, row = markdown([bad]).splitlines()[:3]
+    assert row.count("|") == head.count("|")   # same columns as the header
+
+
+def test_wait_kills_after_timeout() -> None:
+    proc = subprocess.Popen(["sleep", "30"])
+    rc, peak_kb = _wait(proc, 0.5)
+    assert rc is None and peak_kb >= 0
+    proc = subprocess.Popen(["true"])
+    assert _wait(proc, 10)[0] == 0
