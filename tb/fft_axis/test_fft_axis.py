@@ -362,7 +362,9 @@ async def test_reset_mid_frame(dut) -> None:
 # with 2 lanes, a 12-bit data width, 2 guard bits, the window and a custom schedule
 # (overflow-heavy); the paper's 64 x 4 lanes; odd log2 N with the inverse; the full preset's
 # 256 (SQNR >= 64 dB); 1024 with the window; 24-bit data with W = 27 (the twiddle's
-# four-multiplier form, all others use three, Gauss). FFT_AXIS_FULL=1 adds the largest N = 4096 and
+# four-multiplier form, all others use three, Gauss); no window with stage 0 unscaled, so
+# full-scale input reaches the twiddle at full scale (its pre-add re + im needs W+1 bits).
+# FFT_AXIS_FULL=1 adds the largest N = 4096 and
 # N = 32 (two more builds).
 PARAMS = [
     dict(N=16, NUM_CH=2, DATA_W=12, GUARD_W=2, WINDOW=1, SCALE_SCH=0b1010),
@@ -371,6 +373,7 @@ PARAMS = [
     dict(N=256, NUM_CH=1),
     dict(N=1024, NUM_CH=1, WINDOW=1),
     dict(N=16, NUM_CH=1, DATA_W=24, GUARD_W=2, INVERSE=1),
+    dict(N=16, NUM_CH=1, SCALE_SCH=0b1110),
 ]
 if os.environ.get("FFT_AXIS_FULL", "0") not in ("", "0"):
     PARAMS += [dict(N=4096, NUM_CH=1, WINDOW=1), dict(N=32, NUM_CH=1, INVERSE=1)]
