@@ -21,7 +21,7 @@ help:
 	@echo "make test            whole regression (pytest -n $(JOBS))"
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
-	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv) and check it"
+	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv, fft_*_rom.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"

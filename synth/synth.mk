@@ -2,8 +2,13 @@
 #   include synth/synth.mk
 #
 #   make synth-estimate                    Yosys synth_xilinx -family xcup estimate, paper-fpga
-#                                          blocks + top, table in $(OUT)/synth/estimate.md
-#   make synth-estimate SYNTH_SET=all      ... also the blocks at the full preset (slow)
+#                                          blocks + top + detector, table in
+#                                          $(OUT)/synth/estimate.md (with % of the xczu7ev)
+#   make synth-estimate SYNTH_SET=full     the full preset: blocks, detector and the top with
+#                                          FRAME_STORE=1 (slow: tens of minutes)
+#   make synth-estimate SYNTH_SET=full-blocks   ... without the full top
+#   make synth-estimate SYNTH_SET=all      paper-fpga + full
+#   SYNTH_TIMEOUT=3600                     stop a Yosys job after that many seconds
 #   make synth-estimate SYNTH_SET=ci       the quick subset the regression runs
 #   make synth-vivado                      Vivado OOC synthesis of the same jobs, reports in
 #                                          $(OUT)/vivado/ (needs vivado on PATH)
@@ -13,12 +18,13 @@
 SYNTH_SET  ?= paper-fpga
 SYNTH_ONLY ?=
 SYNTH_IMPL ?= 0
+SYNTH_TIMEOUT ?=
 
 .PHONY: synth-estimate synth-vivado
 
 synth-estimate: $(STAMP)
 	$(RUN) python -m synth.yosys_estimate --set $(SYNTH_SET) --out $(OUT)/synth \
-	  $(if $(SYNTH_ONLY),--only $(SYNTH_ONLY))
+	  $(if $(SYNTH_ONLY),--only $(SYNTH_ONLY)) $(if $(SYNTH_TIMEOUT),--timeout $(SYNTH_TIMEOUT))
 
 synth-vivado: $(STAMP)
 	@command -v vivado >/dev/null 2>&1 || { echo "synth-vivado: vivado is not on PATH: install AMD Vivado ML (free Standard edition covers xczu7ev) and source <install>/settings64.sh"; exit 1; }

@@ -69,6 +69,8 @@ class Job:
     expect_dsp: int | None = None
     # instances of this job in the chain (the sum-of-blocks row multiplies by it)
     instances: int = 1
+    # counted in the sum-of-blocks row (the mode-0 chain; not the detector)
+    in_sum: bool = True
 
     @property
     def label(self) -> str:
@@ -76,30 +78,49 @@ class Job:
         return " ".join(f"{k}={v}" for k, v in self.params.items())
 
 
-def _fft_dsp(n: int, lanes: int, window: bool) -> int:
-    """DSP48E2 of one fft_axis: 4 per complex twiddle multiplier, 2 per lane for the window.
+def _fft_dsp(n: int, lanes: int, window: bool, data_w: int = 16, guard_w: int = 4) -> int:
+    """DSP48E2 of one fft_axis: 3 per complex twiddle multiplier (Gauss; 4 when the internal
+    width W = DATA_W + 1 + GUARD_W is 27, rtl/fft/fft_twiddle.sv), 2 per lane for the window.
 
     Twiddle multipliers follow the odd stages s = 1, 3, ... with s + 1 < log2(N).
     """
     log2n = n.bit_length() - 1
     twiddles = len([s for s in range(1, log2n, 2) if s + 1 < log2n])
-    return lanes * (4 * twiddles + (2 if window else 0))
+    per_twiddle = 3 if data_w + 1 + guard_w + 1 <= 27 else 4
+    return lanes * (per_twiddle * twiddles + (2 if window else 0))
+
+
+FULL_AXI_DATA_W = 512
+"""m_axi_mem width of the ``full`` top (FRAME_STORE = 1), the width the RTL frame source
+uses (``radar.sources.FULL_AXI_DATA_W``; a test keeps the two equal)."""
+
+# xczu7ev (ZCU106) capacity, the denominators of the utilization percentages.
+XCZU7EV: dict[str, float] = {"LUT": 230400, "FF": 460800, "DSP": 1728, "BRAM": 312, "URAM": 96}
 
 
 def _jobs_for(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int,
-              packet_words: int = 1024, out_banks: int = 4) -> list[Job]:
+              packet_words: int = 1024, out_banks: int = 4,
+              frame_store: bool = False) -> list[Job]:
     """The blocks of radar_pipeline with the parameters the top gives them (its defaults:
-    PACKET_WORDS 1024, OUT_BANKS 4, Hann window on both FFTs)."""
+    PACKET_WORDS 1024, OUT_BANKS 4, Hann window on both FFTs); the corner turn on chip, or
+    with ``frame_store`` the external store's AXI4 master (FRAME_STORE = 1)."""
     frame_words = num_tx * n_range * n_doppler
+    if frame_store:
+        store = Job(f"{preset}/frame_store_axi", "frame_store_axi",
+                    {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
+                     "N_DOPPLER": n_doppler, "DATA_W": 16, "AXI_DATA_W": FULL_AXI_DATA_W},
+                    uram=True)
+    else:
+        store = Job(f"{preset}/corner_turn", "corner_turn",
+                    {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
+                     "N_DOPPLER": n_doppler, "DATA_W": 16}, uram=True)
     jobs = [
         Job(f"{preset}/chirp_pingpong", "chirp_pingpong",
             {"NUM_RX": num_rx, "N_RANGE": n_range, "DATA_W": 16}),
         Job(f"{preset}/range_fft", "fft_axis",
             {"N": n_range, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1},
             expect_dsp=_fft_dsp(n_range, num_rx, True)),
-        Job(f"{preset}/corner_turn", "corner_turn",
-            {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
-             "N_DOPPLER": n_doppler, "DATA_W": 16}, uram=True),
+        store,
         Job(f"{preset}/doppler_fft", "fft_axis",
             {"N": n_doppler, "NUM_CH": num_rx, "DATA_W": 16, "WINDOW": 1},
             expect_dsp=_fft_dsp(n_doppler, num_rx, True)),
@@ -111,12 +132,29 @@ def _jobs_for(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: in
     return jobs
 
 
-def _top_job(preset: str, num_tx: int, num_rx: int, n_range: int, n_doppler: int) -> Job:
-    return Job(f"{preset}/radar_pipeline", "radar_pipeline",
-               {"NUM_TX": num_tx, "NUM_RX": num_rx, "N_RANGE": n_range,
-                "N_DOPPLER": n_doppler, "DATA_W": 16},
-               uram=True,
-               note="whole top (rtl/top/radar_pipeline.sv)")
+def _top_job(preset: str, frame_store: bool = False) -> Job:
+    """The whole radar_pipeline with the HDL parameters the model/RTL source give it
+    (:meth:`model.radar_pipeline.PipelineParams.hdl_parameters`)."""
+    from model.config import get_preset
+    from model.radar_pipeline import PipelineParams
+
+    chain = PipelineParams(frame_store=frame_store,
+                           axi_data_w=FULL_AXI_DATA_W if frame_store else 128)
+    params = chain.hdl_parameters(get_preset(preset))
+    return Job(f"{preset}/radar_pipeline", "radar_pipeline", params, uram=True,
+               note="whole top (rtl/top/radar_pipeline.sv)"
+                    + (", FRAME_STORE = 1" if frame_store else ""))
+
+
+def _detect_job(preset: str) -> Job:
+    """The on-chip detector (rtl/detect/detect_chain.sv) with the default detector settings
+    (:class:`model.detect_chain.DetectConfig`) at the preset's dimensions; not part of the
+    mode-0 chain, so not in the sum of the blocks."""
+    from model.detect_chain import DetectConfig
+
+    params = DetectConfig(*_dims(preset)).hdl_parameters()
+    return Job(f"{preset}/detect_chain", "detect_chain", params, uram=True, in_sum=False,
+               note="OUTPUT_MODE = 1 detector")
 
 
 def _dims(preset: str) -> tuple[int, int, int, int]:
@@ -128,15 +166,19 @@ def _dims(preset: str) -> tuple[int, int, int, int]:
 
 
 def job_sets() -> dict[str, list[Job]]:
-    """The named job sets: ``ci`` (quick), ``paper-fpga``, ``full`` and ``all``."""
-    paper = _jobs_for("paper-fpga", *_dims("paper-fpga")) + [
-        _top_job("paper-fpga", *_dims("paper-fpga"))]
-    # full: the 128 Mib frame of the corner turn (and so the top) cannot fit the device
-    # (docs/buffers.md); the range and Doppler FFTs are the same 256-point 16-lane core.
-    full = [j for j in _jobs_for("full", *_dims("full"))
-            if j.top != "corner_turn" and not j.name.endswith("doppler_fft")]
+    """The named job sets: ``ci`` (quick), ``paper-fpga`` (blocks, top, detector), ``full``
+    (blocks, detector and the top with FRAME_STORE = 1), ``full-blocks`` (``full`` without
+    its top), ``all`` (``paper-fpga`` + ``full``)."""
+    paper = (_jobs_for("paper-fpga", *_dims("paper-fpga"))
+             + [_top_job("paper-fpga"), _detect_job("paper-fpga")])
+    # full: the range and Doppler FFTs are the same 256-point 16-lane core (one run, x2);
+    # the 128 Mib frame lives in DDR4 (FRAME_STORE = 1, frame_store_axi)
+    full = [j for j in _jobs_for("full", *_dims("full"), frame_store=True)
+            if not j.name.endswith("doppler_fft")]
     full = [replace(j, name="full/range_doppler_fft", instances=2)
             if j.name.endswith("range_fft") else j for j in full]
+    full_blocks = full + [_detect_job("full")]
+    full = full_blocks + [_top_job("full", frame_store=True)]
     ci = [
         Job("ci/fft_axis", "fft_axis", {"N": 16, "NUM_CH": 1, "DATA_W": 16, "WINDOW": 0},
             expect_dsp=_fft_dsp(16, 1, False)),
@@ -144,7 +186,8 @@ def job_sets() -> dict[str, list[Job]]:
             {"NUM_TX": 1, "NUM_RX": 1, "N_RANGE": 64, "N_DOPPLER": 256, "DATA_W": 16},
             uram=True),
     ]
-    return {"ci": ci, "paper-fpga": paper, "full": full, "all": paper + full}
+    return {"ci": ci, "paper-fpga": paper, "full": full, "full-blocks": full_blocks,
+            "all": paper + full}
 
 
 @dataclass
@@ -156,6 +199,8 @@ class Result:
     cells: dict[str, int] = field(default_factory=dict)
     skipped: str = ""
     error: str = ""
+    # peak resident memory of the Yosys run (MB; the WebAssembly build stops at 4 GiB)
+    peak_mb: float = 0.0
 
     def count(self, *types: str) -> int:
         """Sum of the cells of the given types."""
@@ -179,10 +224,20 @@ class Result:
             "URAM": self.count("URAM288"),
         }
 
+    @classmethod
+    def from_json(cls, rec: dict) -> Result:
+        """A result back from :meth:`to_json` (the job looked up by name, else rebuilt)."""
+        known = {j.name: j for js in job_sets().values() for j in js}
+        job = known.get(rec["name"]) or Job(rec["name"], rec["top"], dict(rec["params"]),
+                                             uram=bool(rec["uram"]))
+        return cls(job, float(rec["seconds"]), dict(rec["cells"]), rec["skipped"],
+                   rec["error"], float(rec.get("peak_mb", 0)))
+
     def to_json(self) -> dict[str, object]:
         """JSON-ready record of the job and its counts."""
         return {"name": self.job.name, "top": self.job.top, "params": self.job.params,
                 "uram": self.job.uram, "seconds": round(self.seconds, 1),
+                "peak_mb": round(self.peak_mb),
                 "cells": self.cells, "columns": self.columns if self.cells else {},
                 "skipped": self.skipped, "error": self.error}
 
@@ -240,8 +295,27 @@ def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     ])
 
 
-def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result:
-    """Synthesize one job; the Yosys log is kept in ``work/<name>.log``."""
+def _wait(proc: subprocess.Popen, timeout: float | None) -> tuple[int | None, int]:
+    """Wait for ``proc`` (killing it after ``timeout`` s); (exit code or None on timeout,
+    its peak resident memory in KiB from ``wait4``)."""
+    t_end = None if timeout is None else time.monotonic() + timeout
+    while True:
+        pid, status, ru = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            return proc.returncode, ru.ru_maxrss
+        if t_end is not None and time.monotonic() > t_end:
+            proc.kill()
+            _, _, ru = os.wait4(proc.pid, 0)
+            proc.returncode = -9
+            return None, ru.ru_maxrss
+        time.sleep(0.5)
+
+
+def run_job(job: Job, files: list[Path], work: Path, yosys: list[str],
+            timeout: float | None = None) -> Result:
+    """Synthesize one job (killed after ``timeout`` seconds if given); the Yosys log is kept
+    in ``work/<name>.log``."""
     res = Result(job)
     if job.top == "radar_pipeline" and not TOP_FILE.exists():
         res.skipped = f"{TOP_FILE.relative_to(ROOT)} does not exist yet"
@@ -257,12 +331,20 @@ def run_job(job: Job, files: list[Path], work: Path, yosys: list[str]) -> Result
     stat_json.unlink(missing_ok=True)
     nice = ["nice", "-n", "10"] if shutil.which("nice") else []
     t0 = time.monotonic()
-    proc = subprocess.run([*nice, *yosys, "-q", "-l", log.name, ys.name], cwd=work,
-                          capture_output=True, text=True, check=False)
+    out_txt = work / f"{tag}.out"
+    with out_txt.open("w") as fh:
+        proc = subprocess.Popen([*nice, *yosys, "-q", "-l", log.name, ys.name], cwd=work,
+                                stdout=fh, stderr=subprocess.STDOUT)
+        rc, peak_kb = _wait(proc, timeout)
     res.seconds = time.monotonic() - t0
-    if proc.returncode != 0 or not stat_json.exists():
-        lines = [ln for ln in (proc.stderr + proc.stdout).splitlines() if "ERROR" in ln]
-        res.error = (lines[-1] if lines else f"yosys exit {proc.returncode}") + f" (log: {log})"
+    res.peak_mb = peak_kb / 1024.0   # peak resident memory (nice execs Yosys: same process)
+    output = out_txt.read_text(errors="replace")
+    if rc is None:
+        res.error = f"timeout after {res.seconds:.0f} s (log: {log})"
+        return res
+    if rc != 0 or not stat_json.exists():
+        lines = [ln for ln in output.splitlines() if "ERROR" in ln or "exception" in ln]
+        res.error = (lines[-1] if lines else f"yosys exit {rc}") + f" (log: {log})"
         return res
     stat = json.loads(stat_json.read_text())
     design = stat.get("design", {})
@@ -274,34 +356,70 @@ def _fmt(v: float) -> str:
     return f"{v:g}"
 
 
+_COLS = ["LUT", "LUTRAM", "FF", "CARRY4", "DSP", "RAMB18", "RAMB36", "BRAM", "URAM"]
+
+
+def preset_sums(results: Iterable[Result]) -> dict[str, dict[str, float]]:
+    """Per preset, the columns summed over its chain blocks (instances counted, the top and
+    jobs with ``in_sum`` False left out)."""
+    sums: dict[str, dict[str, float]] = {}
+    for r in results:
+        if r.cells and r.job.top != "radar_pipeline" and r.job.in_sum:
+            s = sums.setdefault(r.job.name.split("/")[0], dict.fromkeys(_COLS, 0.0))
+            for k in _COLS:
+                s[k] += r.columns[k] * r.job.instances
+    return sums
+
+
+def capacity_table(results: Iterable[Result]) -> str:
+    """Tops and chain sums as counts and percent of the xczu7ev (LUT = logic + memory LUTs,
+    as Vivado's "CLB LUTs"); empty when there is neither."""
+    results = list(results)
+    rows = []
+    entries = [(f"{r.job.name} (top)", r.columns) for r in results
+               if r.cells and r.job.top == "radar_pipeline"]
+    entries += [(f"{preset}: sum of the chain blocks", s)
+                for preset, s in preset_sums(results).items()]
+    entries += [(f"{r.job.name}", r.columns) for r in results
+                if r.cells and not r.job.in_sum]
+    for name, c in entries:
+        used = {"LUT": c["LUT"] + c["LUTRAM"], "FF": c["FF"], "DSP": c["DSP"],
+                "BRAM": c["BRAM"], "URAM": c["URAM"]}
+        rows.append(f"| {name} | " + " | ".join(
+            f"{_fmt(used[k])} ({100 * used[k] / XCZU7EV[k]:.1f}%)" for k in XCZU7EV) + " |")
+    if not rows:
+        return ""
+    cap = " | ".join(f"{_fmt(v)}" for v in XCZU7EV.values())
+    return ("| against the xczu7ev | LUT (logic + memory) | FF | DSP48E2 | BRAM (36 Kb) | "
+            "URAM |\n|---|---:|---:|---:|---:|---:|\n" + "\n".join(rows)
+            + f"\n| capacity | {cap} |\n")
+
+
 def markdown(results: Iterable[Result]) -> str:
     """The estimate table (one row per job) and Table II of the paper."""
-    cols = ["LUT", "LUTRAM", "FF", "CARRY4", "DSP", "RAMB18", "RAMB36", "BRAM", "URAM"]
-    head = ("| block | parameters | " + " | ".join(cols) + " | Yosys s |\n"
-            "|---|---|" + "---:|" * (len(cols) + 1) + "\n")
+    results = list(results)
+    cols = _COLS
+    head = ("| block | parameters | " + " | ".join(cols) + " | Yosys s | Yosys MB |\n"
+            "|---|---|" + "---:|" * (len(cols) + 2) + "\n")
     rows = []
-    sums: dict[str, dict[str, float]] = {}
     for r in results:
         if r.cells:
             c = r.columns
             name = r.job.name + (f" (x{r.job.instances})" if r.job.instances > 1 else "")
             rows.append(f"| {name} | {r.job.label} | "
-                        + " | ".join(_fmt(c[k]) for k in cols) + f" | {r.seconds:.0f} |")
-            preset = r.job.name.split("/")[0]
-            if r.job.top != "radar_pipeline":
-                s = sums.setdefault(preset, dict.fromkeys(cols, 0.0))
-                for k in cols:
-                    s[k] += c[k] * r.job.instances
+                        + " | ".join(_fmt(c[k]) for k in cols)
+                        + f" | {r.seconds:.0f} | {r.peak_mb:.0f} |")
         else:
             why = f"skipped: {r.skipped}" if r.skipped else f"FAILED: {r.error}"
-            rows.append(f"| {r.job.name} | {r.job.label} | {why} |" + " |" * len(cols))
-    for preset, s in sums.items():
+            rows.append(f"| {r.job.name} | {r.job.label} | {why} |" + " |" * (len(cols) - 1)
+                        + f" {r.seconds:.0f} | {r.peak_mb:.0f} |")
+    for preset, s in preset_sums(results).items():
         rows.append(f"| **{preset}: sum of the blocks above** | | "
-                    + " | ".join(_fmt(s[k]) for k in cols) + " | |")
+                    + " | ".join(_fmt(s[k]) for k in cols) + " | | |")
     p = PAPER_TABLE_II
     rows.append(f"| **paper Table II** (Vivado, Xilinx FFT IP) | 1 TX x 4 RX | {p['LUT']:g} | "
                 f"{p['LUTRAM']:g} | {p['FF']:g} | - | {p['DSP']:g} | - | - | "
-                f"{p['BRAM']:g} | {p['URAM']:g} | |")
+                f"{p['BRAM']:g} | {p['URAM']:g} | | |")
     return head + "\n".join(rows) + "\n"
 
 
@@ -313,14 +431,22 @@ def main(argv: list[str] | None = None) -> int:
         description="Yosys synth_xilinx -family xcup resource estimate per block "
                     "(docs/synth.md).")
     ap.add_argument("--set", default="paper-fpga", choices=sorted(sets),
-                    help="job set: ci (quick), paper-fpga (blocks + top, default), full "
-                         "(blocks at the full preset), all")
+                    help="job set: ci (quick), paper-fpga (blocks, top, detector; default), "
+                         "full (blocks, detector, top with FRAME_STORE=1), full-blocks "
+                         "(full without its top), all (paper-fpga + full)")
     ap.add_argument("--only", default="",
                     help="comma-separated substrings: run only jobs whose name contains one")
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "synth",
                     help="output folder (default out/synth)")
     ap.add_argument("--list", action="store_true", help="list the jobs of every set and exit")
+    ap.add_argument("--timeout", type=float, default=None, metavar="S",
+                    help="stop a Yosys job after S seconds (reported as failed)")
+    ap.add_argument("--merge", type=Path, nargs="+", default=None, metavar="JSON",
+                    help="no Yosys: write one report (into --out) from the estimate.json of "
+                         "earlier runs")
     args = ap.parse_args(argv)
+    if args.merge:
+        return merge_reports(args.merge, args.out)
 
     if args.list:
         for name, jobs in sets.items():
@@ -343,29 +469,39 @@ def main(argv: list[str] | None = None) -> int:
     results: list[Result] = []
     for job in jobs:
         print(f"synth-estimate: {job.name} ({job.top} {job.label}) ...", flush=True)
-        r = run_job(job, files_for(job.top, files), work, yosys)
+        r = run_job(job, files_for(job.top, files), work, yosys, args.timeout)
         if r.skipped:
             print(f"  skipped: {r.skipped}", flush=True)
         elif r.error:
             print(f"  FAILED after {r.seconds:.0f} s: {r.error}", flush=True)
         else:
             c = r.columns
-            print(f"  {r.seconds:.0f} s: "
+            print(f"  {r.seconds:.0f} s, {r.peak_mb:.0f} MB: "
                   + ", ".join(f"{k} {_fmt(v)}" for k, v in c.items()), flush=True)
         results.append(r)
+    return write_report(results, out, args.set, _yosys_version(yosys))
+
+
+def write_report(results: list[Result], out: Path, set_name: str, version: str) -> int:
+    """Write ``out/estimate.md`` (job table, capacity table) and ``out/estimate.json``; print
+    the tables; 1 if a job failed."""
     table = markdown(results)
-    notes = (f"\nYosys {_yosys_version(yosys)} `synth_xilinx -family xcup -flatten -noiopad "
-             "-noclkbuf` "
-             "(`-uram` for corner_turn, axis_packetizer and the top), out of context. "
+    cap = capacity_table(results)
+    notes = (f"\nYosys {version} `synth_xilinx -family xcup -flatten -noiopad -noclkbuf` "
+             "(`-uram` for the buffers' blocks, the detector and the tops), out of context. "
              "LUT = logic LUTs, "
              "LUTRAM = LUTs used as distributed RAM or shift registers; BRAM in 36 Kb "
              "blocks (RAMB18 = 0.5). Yosys maps carry chains to CARRY4 (one CARRY8 = 2 "
              "CARRY4). Yosys reads rtl/ as written (`rtl/**/*.sv`, packages first).\n")
-    (out / "estimate.md").write_text(table + notes)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "estimate.md").write_text(table + ("\n" + cap if cap else "") + notes)
     (out / "estimate.json").write_text(json.dumps(
-        {"set": args.set, "results": [r.to_json() for r in results]}, indent=1))
+        {"set": set_name, "version": version, "results": [r.to_json() for r in results]},
+        indent=1))
     print()
     print(table)
+    if cap:
+        print(cap)
     print(f"synth-estimate: wrote {out / 'estimate.md'} and {out / 'estimate.json'}")
     failed = [r.job.name for r in results if r.error]
     if failed:
@@ -373,6 +509,16 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def merge_reports(paths: list[Path], out: Path) -> int:
+    """One report from the ``estimate.json`` of several runs (e.g. a long job run alone)."""
+    results, version = [], "?"
+    for p in paths:
+        data = json.loads(p.read_text())
+        version = data.get("version", version)
+        results += [Result.from_json(rec) for rec in data["results"]]
+    return write_report(results, out.resolve(), "merged", version)
 
 
 def _yosys_version(yosys: list[str]) -> str:

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Twiddle multiplier between two radix-2^2 stage pairs of the streaming FFT: looks up
-// W_M^(i0*(b1+2*b0)) in the shared ROM from the sample's index tag and multiplies every lane
-// with registered inputs and products (DSP48E2 friendly), convergent rounding, saturation.
+// W_M^(i0*(b1+2*b0)) in the quarter-wave ROM from the sample's index tag and multiplies every
+// lane with registered inputs and products (DSP48E2 friendly; three real products per lane,
+// Gauss, four for W = 27), exact sums, convergent rounding, saturation.
 `default_nettype none
 
 module fft_twiddle #(
@@ -33,19 +34,21 @@ module fft_twiddle #(
 );
   // coefficient ROM geometry (rtl/fft/fft_rom_pkg.sv, generated)
   localparam int ROM_LOG2 = fft_rom_pkg::ROM_LOG2;
-  localparam int ROM_SIZE = fft_rom_pkg::ROM_SIZE;
   localparam int COEF_W = fft_rom_pkg::COEF_W;
   localparam int COEF_FRAC = fft_rom_pkg::COEF_FRAC;
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int PRW = W + COEF_W;   // product width
+  // Three real multipliers per lane (Gauss) when the pre-added operand re + im (W+1 bits)
+  // fits a DSP48E2 A port (27 bits), else four. Same exact products, so the same bits.
+  localparam bit GAUSS = (W + 1 <= 27);
 
   if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad_log2m
     $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
   end
 
   // ---------------------------------------------------------------- ROM index from the tag
-  logic [ROM_LOG2-1:0] rom_idx, sin_idx;
+  logic [ROM_LOG2-1:0] rom_idx;
   always_comb begin
     logic [ROM_LOG2-1:0] i0, e;
     logic [1:0] m;
@@ -53,39 +56,102 @@ module fft_twiddle #(
     m  = {in_pos[LOG2M-2], in_pos[LOG2M-1]};   // b1 + 2*b0
     e  = ROM_LOG2'(i0 * ROM_LOG2'(m));
     rom_idx = e << (ROM_LOG2 - LOG2M);
-    sin_idx = rom_idx - ROM_LOG2'(ROM_SIZE / 4);
   end
+
+  // C = COS(k), S = SIN(k) = COS(k - 1024): quarter-wave ROM (generated, combinational)
+  logic [COEF_W-1:0] rom_cos, rom_sin;
+  fft_twiddle_rom u_rom (.k(rom_idx), .cos_o(rom_cos), .sin_o(rom_sin));
 
   // ---------------------------------------------------------------- stage 1: operands
   logic [DW-1:0]        d1_q;
   logic [LOG2N-1:0]     pos1_q, pos2_q, pos3_q;
   logic                 ov1_q, ov2_q, ov3_q;
   logic                 vld1_q, vld2_q, vld3_q;
-  logic signed [COEF_W-1:0] c1_q, s1_q;
-
-  // ---------------------------------------------------------------- stage 2: products
-  logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
-  logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
-  logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
-  logic signed [PRW-1:0] prs_r_q [NUM_CH];   // re*S
 
   // ---------------------------------------------------------------- stage 3: sum, round
   logic [DW-1:0] y_d, y3_q;
   logic          y_ov;
+
+  // Products (stage 2) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
+  // the inverse has S -> -S), full precision before the rounding: two forms, same bits.
+  logic signed [63:0] yr_full [NUM_CH];
+  logic signed [63:0] yi_full [NUM_CH];
+
+  if (GAUSS) begin : g_gauss
+    // Three real products per lane (Gauss): with d = -S (forward) or +S (inverse)
+    //   k1 = C*(re + im), k2 = re*(d - C), k3 = im*(C + d), yr = k1 - k3, yi = k1 + k2.
+    // |C +- S| <= 92682 < 2^17, so both coefficient sums stay COEF_W bits (one per twiddle,
+    // shared by every lane); the data pre-add re + im is W+1 <= 27 bits (DSP48E2 A port).
+    logic signed [COEF_W-1:0] c1_q, p1_q, m1_q;   // C, d - C, C + d
+    logic signed [W:0]        a1_q [NUM_CH];      // re + im
+    logic signed [PRW:0]      k1_q [NUM_CH];
+    logic signed [PRW-1:0]    k2_q [NUM_CH];
+    logic signed [PRW-1:0]    k3_q [NUM_CH];
+    logic signed [COEF_W:0]   cc, ss;
+
+    assign cc = (COEF_W+1)'(signed'(rom_cos));
+    assign ss = (COEF_W+1)'(signed'(rom_sin));
+
+    always_ff @(posedge clk) begin
+      if (en) begin
+        c1_q <= signed'(rom_cos);
+        p1_q <= COEF_W'(INVERSE ? ss - cc : -ss - cc);
+        m1_q <= COEF_W'(INVERSE ? cc + ss : cc - ss);
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
+                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+          k1_q[ch] <= (PRW+1)'(a1_q[ch]) * (PRW+1)'(c1_q);
+          k2_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(p1_q);
+          k3_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(m1_q);
+        end
+      end
+    end
+
+    always_comb begin
+      for (int ch = 0; ch < NUM_CH; ch++) begin
+        yr_full[ch] = 64'(k1_q[ch]) - 64'(k3_q[ch]);
+        yi_full[ch] = 64'(k1_q[ch]) + 64'(k2_q[ch]);
+      end
+    end
+  end else begin : g_four
+    // Four real products per lane (W = 27: the pre-add would not fit the 27-bit A port).
+    logic signed [COEF_W-1:0] c1_q, s1_q;
+    logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
+    logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
+    logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
+    logic signed [PRW-1:0] prs_r_q [NUM_CH];   // re*S
+
+    always_ff @(posedge clk) begin
+      if (en) begin
+        c1_q <= signed'(rom_cos);
+        s1_q <= signed'(rom_sin);
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          prc_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(c1_q);
+          prs_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(s1_q);
+          prc_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(c1_q);
+          prs_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(s1_q);
+        end
+      end
+    end
+
+    always_comb begin
+      for (int ch = 0; ch < NUM_CH; ch++) begin
+        if (INVERSE) begin   // x * (C + jS)
+          yr_full[ch] = 64'(prc_r_q[ch]) - 64'(prs_i_q[ch]);
+          yi_full[ch] = 64'(prc_i_q[ch]) + 64'(prs_r_q[ch]);
+        end else begin       // x * (C - jS)
+          yr_full[ch] = 64'(prc_r_q[ch]) + 64'(prs_i_q[ch]);
+          yi_full[ch] = 64'(prc_i_q[ch]) - 64'(prs_r_q[ch]);
+        end
+      end
+    end
+  end
 
   always_ff @(posedge clk) begin
     if (en) begin
       d1_q   <= in_data;
       pos1_q <= in_pos;
       ov1_q  <= in_ov;
-      c1_q   <= signed'(fft_rom_pkg::COS(rom_idx));
-      s1_q   <= signed'(fft_rom_pkg::COS(sin_idx));
-      for (int ch = 0; ch < NUM_CH; ch++) begin
-        prc_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(c1_q);
-        prs_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(s1_q);
-        prc_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(c1_q);
-        prs_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(s1_q);
-      end
       pos2_q <= pos1_q;
       ov2_q  <= ov1_q;
       y3_q   <= y_d;
@@ -99,15 +165,8 @@ module fft_twiddle #(
     y_d  = '0;
     y_ov = 1'b0;
     for (int ch = 0; ch < NUM_CH; ch++) begin
-      if (INVERSE) begin   // x * (C + jS)
-        yr = 64'(prc_r_q[ch]) - 64'(prs_i_q[ch]);
-        yi = 64'(prc_i_q[ch]) + 64'(prs_r_q[ch]);
-      end else begin       // x * (C - jS)
-        yr = 64'(prc_r_q[ch]) + 64'(prs_i_q[ch]);
-        yi = 64'(prc_i_q[ch]) - 64'(prs_r_q[ch]);
-      end
-      yr = fft_pkg::round_conv(yr, COEF_FRAC);
-      yi = fft_pkg::round_conv(yi, COEF_FRAC);
+      yr = fft_pkg::round_conv(yr_full[ch], COEF_FRAC);
+      yi = fft_pkg::round_conv(yi_full[ch], COEF_FRAC);
       y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
       y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
       y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));

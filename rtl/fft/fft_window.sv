@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Input stage of the streaming FFT: widens each I/Q sample to the internal format
 // (GUARD_W fraction bits) and, with WINDOW = 1, multiplies it by the periodic Hann window
-// from the shared ROM (registered operands and product, convergent rounding).
+// from the quarter-wave ROM fft_hann_rom (registered operands and product, convergent rounding).
 `default_nettype none
 
 module fft_window #(
@@ -49,8 +49,11 @@ module fft_window #(
     logic signed [COEF_W-1:0]   w1_q;
     logic [DW-1:0]              y_d, y2_q;
     logic [ROM_LOG2-1:0]        rom_idx;
+    logic [COEF_W-1:0]          rom_hann;
 
     assign rom_idx = ROM_LOG2'(in_pos) << (ROM_LOG2 - LOG2N);
+    // HANN(k): quarter-wave ROM (generated, combinational)
+    fft_hann_rom u_rom (.k(rom_idx), .hann_o(rom_hann));
 
     always_comb begin
       logic signed [63:0] p;
@@ -65,7 +68,7 @@ module fft_window #(
     always_ff @(posedge clk) begin
       if (en) begin
         d1_q   <= in_data;
-        w1_q   <= signed'(fft_rom_pkg::HANN(rom_idx));
+        w1_q   <= signed'(rom_hann);
         pos1_q <= in_pos;
         y2_q   <= y_d;
         pos2_q <= pos1_q;

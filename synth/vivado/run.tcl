@@ -7,24 +7,32 @@
 #          -tclargs <top> <out_dir> <impl 0|1> [NAME=VALUE ...]
 #
 # NAME=VALUE pairs are HDL parameters (synth_design -generic). `make synth-vivado` runs every
-# block of a job set through this script (synth/vivado_flow.py); docs/synth.md has the details.
+# job of a set (blocks and the radar_pipeline top, paper-fpga with FRAME_STORE = 0 and full
+# with FRAME_STORE = 1) through a generated per-job script, OUT/<job>/job.tcl
+# (synth/vivado_flow.py job_tcl), that sets top, out_dir, impl, generics, pkgs and mods and
+# then sources this file; docs/synth.md has the details.
 
 set part xczu7ev-ffvc1156-2-e
-if {[llength $argv] < 3} {
-  puts stderr "usage: vivado -mode batch -source run.tcl -tclargs <top> <out_dir> <impl 0|1> \[NAME=VALUE ...\]"
-  exit 2
-}
-lassign $argv top out_dir impl
-set generics [lrange $argv 3 end]
 set here [file dirname [file normalize [info script]]]
 set root [file normalize [file join $here .. ..]]
+if {![info exists top]} {
+  if {[llength $argv] < 3} {
+    puts stderr "usage: vivado -mode batch -source run.tcl -tclargs <top> <out_dir> <impl 0|1> \[NAME=VALUE ...\]"
+    exit 2
+  }
+  lassign $argv top out_dir impl
+  set generics [lrange $argv 3 end]
+}
+if {![info exists pkgs]} {
+  # every rtl/*/*.sv, packages first (Vivado keeps only what `top` uses)
+  set all [lsort [glob -nocomplain [file join $root rtl * *.sv]]]
+  set pkgs [lsearch -all -inline -glob $all *_pkg.sv]
+  set mods [lsearch -all -inline -not -glob $all *_pkg.sv]
+}
 file mkdir $out_dir
 
-# ---- sources: packages first, then every module of rtl/ (Vivado keeps only what `top` uses)
+# ---- sources: packages first, then the modules
 create_project -in_memory -part $part
-set all [lsort [glob -nocomplain [file join $root rtl * *.sv]]]
-set pkgs [lsearch -all -inline -glob $all *_pkg.sv]
-set mods [lsearch -all -inline -not -glob $all *_pkg.sv]
 read_verilog -sv $pkgs
 read_verilog -sv $mods
 read_xdc -mode out_of_context [file join $here zcu106.xdc]

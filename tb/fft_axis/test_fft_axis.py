@@ -21,7 +21,7 @@ from cocotbext.axi import AxiStreamFrame
 
 from model import fft_axis as ff
 from model.axis_packetizer import bytes_to_words, words_to_bytes
-from model.fft_rom import PKG_PATH, render_rom_pkg
+from model.fft_rom import stale_files
 from rtlsim.axis import AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
@@ -361,7 +361,10 @@ async def test_reset_mid_frame(dut) -> None:
 # One Verilator build per HDL parameter set (each costs ~30-60 s of a core): the smallest N
 # with 2 lanes, a 12-bit data width, 2 guard bits, the window and a custom schedule
 # (overflow-heavy); the paper's 64 x 4 lanes; odd log2 N with the inverse; the full preset's
-# 256 (SQNR >= 64 dB); 1024 with the window. FFT_AXIS_FULL=1 adds the largest N = 4096 and
+# 256 (SQNR >= 64 dB); 1024 with the window; 24-bit data with W = 27 (the twiddle's
+# four-multiplier form, all others use three, Gauss); no window with stage 0 unscaled, so
+# full-scale input reaches the twiddle at full scale (its pre-add re + im needs W+1 bits).
+# FFT_AXIS_FULL=1 adds the largest N = 4096 and
 # N = 32 (two more builds).
 PARAMS = [
     dict(N=16, NUM_CH=2, DATA_W=12, GUARD_W=2, WINDOW=1, SCALE_SCH=0b1010),
@@ -369,6 +372,8 @@ PARAMS = [
     dict(N=128, NUM_CH=4, INVERSE=1),
     dict(N=256, NUM_CH=1),
     dict(N=1024, NUM_CH=1, WINDOW=1),
+    dict(N=16, NUM_CH=1, DATA_W=24, GUARD_W=2, INVERSE=1),
+    dict(N=16, NUM_CH=1, SCALE_SCH=0b1110),
 ]
 if os.environ.get("FFT_AXIS_FULL", "0") not in ("", "0"):
     PARAMS += [dict(N=4096, NUM_CH=1, WINDOW=1), dict(N=32, NUM_CH=1, INVERSE=1)]
@@ -377,10 +382,11 @@ if os.environ.get("FFT_AXIS_FULL", "0") not in ("", "0"):
 def run(parameters: dict, testcase: str | None = None,
         extra_env: dict[str, str] | None = None) -> None:
     """Build (once) and run the cocotb tests for one parameter set."""
-    # the generated ROM package is never rewritten here (parallel workers, and a stale file
+    # the generated ROM files are never rewritten here (parallel workers, and a stale file
     # must not be hidden from the up-to-date test): a stale one fails, naming `make gen`
-    if PKG_PATH.read_text() != render_rom_pkg():
-        raise RuntimeError(f"{PKG_PATH} is stale: run `make gen`")
+    stale = stale_files()
+    if stale:
+        raise RuntimeError(f"{', '.join(str(p) for p in stale)} stale: run `make gen`")
     here = Path(__file__).resolve().parent
     run_cocotb("fft_axis", rtl_sources("common/*.sv", "fft/*.sv"), "test_fft_axis", here,
                parameters=parameters, testcase=testcase, extra_env=extra_env)

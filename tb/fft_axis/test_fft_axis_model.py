@@ -6,12 +6,38 @@ import numpy as np
 import pytest
 
 from model import fft_axis as ff
-from model.fft_rom import PKG_PATH, cos_table, hann_table, render_rom_pkg, sin_table
+from model.fft_rom import (
+    QUARTER,
+    ROM_SIZE,
+    cos_table,
+    hann_from_quarters,
+    hann_quarters,
+    hann_table,
+    sin_table,
+    stale_files,
+    twiddle_from_quarters,
+    twiddle_quarters,
+)
 
 
 def test_rom_package_up_to_date() -> None:
-    """rtl/fft/fft_rom_pkg.sv is exactly what model/fft_rom.py generates."""
-    assert PKG_PATH.read_text() == render_rom_pkg(), "stale: run `make gen`"
+    """rtl/fft/fft_rom_pkg.sv, fft_twiddle_rom.sv and fft_hann_rom.sv are exactly what
+    model/fft_rom.py generates."""
+    assert not stale_files(), "stale: run `make gen`"
+
+
+def test_quarter_wave_roms_rebuild_the_full_tables() -> None:
+    """The RTL's quarter-wave tables plus quadrant symmetry give every entry bit for bit."""
+    k = np.arange(ROM_SIZE)
+    c, s = twiddle_from_quarters(k)
+    assert np.array_equal(c, cos_table()) and np.array_equal(s, sin_table())
+    assert np.array_equal(hann_from_quarters(k), hann_table())
+    cq, sq = twiddle_quarters()
+    h0, h3 = hann_quarters()
+    assert len(cq) == len(sq) == len(h0) == len(h3) == QUARTER
+    # widths the generated modules declare: 17-bit and 16-bit unsigned
+    assert 0 <= min(cq.min(), sq.min()) and max(cq.max(), sq.max()) < 1 << 17
+    assert 0 <= min(h0.min(), h3.min()) and max(h0.max(), h3.max()) < 1 << 16
 
 
 def test_rom_values() -> None:
@@ -79,3 +105,27 @@ def test_bad_parameters() -> None:
         ff.fft_fixed(np.zeros((1, 48)))
     with pytest.raises(ValueError, match="16-bit"):
         ff.fft_fixed(np.full((1, 16), 40000.0))
+
+
+@pytest.mark.parametrize("w", [15, 21, 26])
+@pytest.mark.parametrize("inverse", [False, True])
+def test_gauss_twiddle_identity_and_widths(w: int, inverse: bool) -> None:
+    """rtl/fft/fft_twiddle.sv's three-product form (W <= 26) equals the four-product complex
+    product exactly, for every ROM coefficient pair and the extreme W-bit operands, and every
+    operand fits the width the RTL gives it (coefficient sums 18 bits, re + im W+1 bits)."""
+    c, s = cos_table(), sin_table()                          # (4096,) each
+    d = s if inverse else -s
+    p_coef, m_coef = d - c, c + d                            # RTL p1_q, m1_q
+    lim = 1 << 17
+    assert (np.abs(p_coef) < lim).all() and (np.abs(m_coef) < lim).all()
+    lo, hi = -(1 << (w - 1)), (1 << (w - 1)) - 1
+    vals = np.array([lo, lo + 1, -1, 0, 1, hi - 1, hi], dtype=object)
+    re, im = (v.ravel() for v in np.meshgrid(vals, vals))
+    for k in range(0, 4096, 7):
+        ci, si, pi, mi = (int(v) for v in (c[k], s[k], p_coef[k], m_coef[k]))
+        a = re + im
+        assert all(-(1 << w) <= v < (1 << w) for v in a)    # W+1 bits
+        k1, k2, k3 = a * ci, re * pi, im * mi
+        sg = 1 if inverse else -1                            # x * (C + sg*jS)
+        assert (k1 - k3 == re * ci - sg * im * si).all()
+        assert (k1 + k2 == im * ci + sg * re * si).all()
