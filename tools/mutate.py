@@ -347,8 +347,15 @@ def apply(mutant: Mutant, root: Path) -> None:
     """Write the mutant's line into the copy of the tree at ``root``."""
     p = root / mutant.path
     lines = p.read_text().splitlines(keepends=True)
-    assert lines[mutant.line - 1].rstrip("\n") == mutant.before, "source changed"
-    lines[mutant.line - 1] = mutant.after + "\n"
+    k = mutant.line - 1
+    if k >= len(lines) or lines[k].rstrip("\n") != mutant.before:
+        # lines moved since the candidates were listed (e.g. a FORMAL block added): the
+        # nearest identical line
+        same = [j for j, ln in enumerate(lines) if ln.rstrip("\n") == mutant.before]
+        if not same:
+            raise SystemExit(f"error: {mutant.ident}: source line no longer exists")
+        k = min(same, key=lambda j: abs(j - k))
+    lines[k] = mutant.after + "\n"
     p.write_text("".join(lines))
 
 
