@@ -30,6 +30,8 @@ OUT = REPO / "out" / "coverage"
 TBS = tuple(sorted(p.parent.name for p in (REPO / "tb").glob("*/test_*.py")
                    if p.stem == f"test_{p.parent.name}"))
 """Every block testbench folder (``tb/<block>/test_<block>.py``)."""
+_PARAM_SUFFIX = r"__(?:pi\d+|[A-Z]\w*)$"
+"""Verilator's suffix of a parameterised copy of a module (``__P41``, ``__pi2``)."""
 _POINT = re.compile(r"^C '(.*)' (\d+)$")
 
 
@@ -44,7 +46,7 @@ def parse_points(files: list[Path]) -> dict[tuple, int]:
                 continue
             fields = dict(kv.split("\x02", 1) for kv in m.group(1).split("\x01") if "\x02" in kv)
             if "page" in fields:  # one module, whatever its parameters (page v_line/mod__P41)
-                fields["page"] = re.sub(r"__[A-Z]\w*$", "", fields["page"])
+                fields["page"] = re.sub(_PARAM_SUFFIX, "", fields["page"])
             key = tuple(sorted((k, v) for k, v in fields.items() if k != "h"))
             points[key] = max(points.get(key, 0), int(m.group(2)))
     return points
@@ -59,7 +61,7 @@ def summary(points: dict[tuple, int]) -> dict[str, dict[str, list[int]]]:
         m = re.match(r"v_(\w+?)/(\w+)", page)
         if not m:
             continue
-        kind, module = m.group(1), re.sub(r"__[A-Z]\w*$", "", m.group(2))
+        kind, module = m.group(1), re.sub(_PARAM_SUFFIX, "", m.group(2))
         cell = table[module][kind]
         cell[1] += 1
         cell[0] += count > 0
