@@ -105,7 +105,9 @@ TESTS: dict[str, list[list[str]]] = {
 }
 
 SLOW_STAGE = 4.0
-"""Timeout factor of a stage running ``radar_pipeline`` or every FFT parameter set."""
+"""Timeout factor of a stage running one of :data:`SLOW_TBS` (their Verilator builds alone
+take minutes on a loaded machine)."""
+SLOW_TBS = ("radar_pipeline", "fft_axis", "detect_chain", "frame_store_axi")
 
 # The fixed CI subset (tests/test_mutate_ci.py): realistic one-line bugs in the cheapest
 # testbenches; every one must be killed.
@@ -385,7 +387,8 @@ def ccache_env() -> dict[str, str]:
     if not exe:
         return {}
     makeflags = os.environ.get("MAKEFLAGS", "")
-    return {"MAKEFLAGS": f"{makeflags} OBJCACHE={exe}".strip(),
+    # the model itself unoptimised: it is compiled once per mutant and runs a short test
+    return {"MAKEFLAGS": f"{makeflags} OBJCACHE={exe} OPT_FAST=-O0 OPT_SLOW=-O0".strip(),
             "CCACHE_DIR": str(OUT / "ccache"),
             "CCACHE_BASEDIR": tempfile.gettempdir(),  # temporary tree paths made relative
             "CCACHE_NOHASHDIR": "1"}
@@ -415,7 +418,7 @@ def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
         verdict = "survived"
         for stage in stages:
             # per stage: the whole-pipeline and full-FFT stages get a longer budget
-            slow = any("radar_pipeline" in t or t.endswith("test_fft_axis.py") for t in stage)
+            slow = any(big in t for t in stage for big in SLOW_TBS)
             t_stage = time.monotonic()
             left = timeout * (SLOW_STAGE if slow else 1.0) - (time.monotonic() - t_stage)
             cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
@@ -490,6 +493,16 @@ def sample(modules: list[str], n: int, seed: int) -> list[Mutant]:
 
 
 EQUIVALENT: dict[str, str] = {
+    "detect_chain:drop:0": (
+        "s_axis_tready without snap_room: the guard is redundant by design; the CFAR holds "
+        "2*PR+2 rows and tests row p-PR-1 while row p is written, so the writer leads the "
+        "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
+        "detect_records' simulation assertion 'snapshot written without room' never fired "
+        "under the chain testbench's long output stalls"),
+    "frame_store_gearbox:drop:9": (
+        "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
+        "full_q is already 1 and is not cleared in that cycle (the clear needs the last "
+        "part leaving, which makes TREADY high), so the register is unchanged"),
 }
 """Surviving mutants that are equivalent (no test can kill them), with the reason; keyed by
 ``module:op:index`` of the current sources (docs/verification.md lists them)."""
