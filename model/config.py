@@ -358,6 +358,10 @@ PRESETS: dict[str, RadarConfig] = {
 DATA_W = 16
 """Bits of I and of Q on every sample stream of the RTL (DESIGN.md section 3)."""
 
+FPGA_CLOCK_HZ = 100e6
+"""The fabric clock of the RTL (the paper's 100 MHz, Hz): ADC samples are paced against it,
+and the benchmarks turn cycle counts into frame rates and bandwidths with it."""
+
 
 def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
     """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,

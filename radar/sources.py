@@ -23,7 +23,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from model.config import RadarConfig
+from model.config import FPGA_CLOCK_HZ, RadarConfig
 from model.radar_pipeline import PipelineParams, chain_gain, scaled_cube
 from model.reference import radar_cube
 
@@ -37,9 +37,6 @@ RTL_SIM_MAX_FRAME_BITS = 16 * 2**20
 FULL_AXI_DATA_W = 512
 """AXI_DATA_W of the external frame store when the RTL source needs it (the ZCU106 PL DDR4
 through MIG: 512-bit user interface at the 100 MHz fabric clock, docs/frame_store.md)."""
-
-FPGA_CLOCK_HZ = 100e6
-"""The fabric clock the ADC samples are paced against (the paper's 100 MHz)."""
 
 
 class SourceError(Exception):

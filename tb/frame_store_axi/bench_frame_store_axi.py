@@ -23,12 +23,11 @@ from collections import Counter
 from pathlib import Path
 
 from model import frame_store_axi as fs
-from model.config import get_preset
+from model.config import FPGA_CLOCK_HZ, get_preset
 from rtlsim.toolchain import rtl_sources, run_cocotb
 
 HERE = Path(__file__).resolve().parent
 
-CLOCK_HZ = 100e6
 """Pipeline (and AXI port) clock: the chain's 100 MHz."""
 DRAM_PEAK = 64 / 8 * 2400e6
 """ZCU106 PL DDR4 through MIG: 64-bit bus at 2400 MT/s = 19.2 GB/s (shared by both
@@ -68,7 +67,7 @@ def model_table() -> None:
         hits, total = pm.row_hits(trace, g.axi_bytes)
         one = fs.interleaved_trace(g, 1)
         need = 2 * g.frame_bytes * fps                      # write + read per second
-        port = 2 * g.axi_bytes * CLOCK_HZ                   # AW/W and AR/R run concurrently
+        port = 2 * g.axi_bytes * FPGA_CLOCK_HZ                   # AW/W and AR/R run concurrently
         print(f"{name:<13} {axi_w:>4} {tile_r:>6} {g.frame_bytes / 2**20:>9.2f} "
               f"{g.memory_bytes / 2**20:>7.2f} {2 * g.frame_bytes / 1e6:>12.2f} "
               f"{g.strip_buffer_bits / 2**20:>10.2f} {need / 1e9:>9.2f} {port / 1e9:>9.2f} "
@@ -76,7 +75,7 @@ def model_table() -> None:
               f"{hist_text(one)}")
     print(f"page model: {pm.page_bytes} B rows, {pm.banks} banks, ROW_BANK_COLUMN map, "
           f"{pm.access_bytes} B accesses (BL8 x 64 bit); DDR4 peak {DRAM_PEAK / 1e9:.1f} GB/s; "
-          f"port = {CLOCK_HZ / 1e6:.0f} MHz x AXI width, both directions")
+          f"port = {FPGA_CLOCK_HZ / 1e6:.0f} MHz x AXI width, both directions")
 
 
 def rtl_params(full: bool) -> dict:
@@ -119,7 +118,7 @@ def rtl_table(full: bool, frames: int) -> None:
         hits, total = pm.row_hits([tuple(t) for t in r["trace"]], g.axi_bytes)
         # full-size frame period scales with the frame's words (the store is streaming)
         full_period = period * full_words / g.frame_words
-        fps = CLOCK_HZ / full_period
+        fps = FPGA_CLOCK_HZ / full_period
         label = "always ready" if stall == 0 else f"{stall:.0%} random stalls"
         print(f"{label:<16} {period:>10} {beats:>7} {beats / period:>7.1%} "
               f"{r['latency_cycles']:>11} {hits / total:>8.2%} {fps:>16.0f} "

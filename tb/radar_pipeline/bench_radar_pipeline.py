@@ -24,12 +24,11 @@ sys.path[:0] = [str(HERE.parents[1]), str(HERE)]
 from test_radar_pipeline import CONFIGS  # noqa: E402
 
 from model.axis_packetizer import packets_per_frame  # noqa: E402
-from model.config import get_preset  # noqa: E402
+from model.config import FPGA_CLOCK_HZ, get_preset  # noqa: E402
 from model.radar_pipeline import PipelineParams  # noqa: E402
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES  # noqa: E402
 from rtlsim.toolchain import rtl_sources, run_cocotb  # noqa: E402
 
-CLOCK_HZ = 100e6
 PAPER_FPS = 3.79
 PAPER_LINK_BPS = 766e6
 
@@ -65,7 +64,7 @@ def main() -> None:
           f"{'DMA Mbit/s':>10} {'sim cyc/s':>9}  note")
     for name, cfg, period, latency, speed, note in rows:
         samples = cfg.n_chirps * cfg.n_range
-        fps = CLOCK_HZ / period
+        fps = FPGA_CLOCK_HZ / period
         radar_fps = 1.0 / cfg.frame_time_s if name != "small4" else float("nan")
         words = cfg.num_tx * cfg.n_range * cfg.n_doppler
         dma_mbps = (words * 32 * cfg.num_rx * radar_fps / 1e6) if name != "small4" else \
