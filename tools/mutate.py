@@ -499,6 +499,9 @@ EQUIVALENT: dict[str, str] = {
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
+    "mark_fifo:const:8": (
+        "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
+        "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "
