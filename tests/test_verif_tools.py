@@ -24,6 +24,7 @@ def _load(name: str):
 
 mutate = _load("mutate")
 formal = _load("formal")
+coverage = _load("coverage")
 
 
 def test_every_operator_has_mutants() -> None:
@@ -66,8 +67,47 @@ def test_formal_files_declare_tasks_and_depths() -> None:
     assert len(files) >= 7
     for sby in files:
         props, tasks, depths = formal.sby_tasks(sby)
-        assert props and "cover" in tasks and any(t.startswith("prove") for t in tasks), sby
+        assert props and any(t.startswith("cover") for t in tasks), sby
+        assert any(t.startswith(("prove", "bmc")) for t in tasks), sby
         assert all(depths[t] > 0 for t in tasks)
+
+
+def test_every_block_testbench_is_mapped() -> None:
+    """Every RTL module with a testbench (its own or its parent's) has mutation stages, and
+    every testbench folder is run by the coverage tool."""
+    tb_modules = set(coverage.TBS)
+    assert {"nci", "cfar_2d", "detect_records", "detect_chain", "frame_store_axi",
+            "mark_fifo", "fft_axis", "radar_pipeline"} <= tb_modules
+    rtl = {p.stem for p in (REPO / "rtl").rglob("*.sv")
+           if not p.stem.endswith("_pkg") and p.stem != "axis_checker"}
+    assert rtl - set(mutate.TESTS) == set(), "RTL modules without mutation stages"
+    for stages in mutate.TESTS.values():
+        for stage in stages:
+            for arg in stage:
+                path = arg.split("::")[0]
+                assert arg == "-k" or not path.startswith("tb") or (REPO / path).exists(), arg
+    assert set(mutate.CHEAPEST) <= tb_modules
+
+
+def test_mutant_applies_after_lines_moved(tmp_path: Path) -> None:
+    m = mutate.candidates("frame_store_fifo")[0]
+    (tmp_path / Path(m.path).parent).mkdir(parents=True)
+    (tmp_path / m.path).write_text("// a new first line\n" + (REPO / m.path).read_text())
+    mutate.apply(m, tmp_path)
+    assert (tmp_path / m.path).read_text().splitlines()[m.line] == m.after
+
+
+def test_coverage_table_and_parse(tmp_path: Path) -> None:
+    dat = tmp_path / "a.dat"
+    key = "\x01f\x02/x/rtl/buffers/m.sv\x01l\x02{}\x01page\x02v_line/m__P3\x01h\x02top.u{}"
+    # line 12 hit in one instance only (the instance is dropped from the key), 13 never
+    dat.write_text(f"# SystemC::Coverage-3\nC '{key.format(12, 1)}' 0\n"
+                   f"C '{key.format(12, 2)}' 5\nC '{key.format(13, 1)}' 0\n")
+    points = coverage.parse_points([dat, dat])
+    table = coverage.summary(points)
+    assert table["m"]["line"] == [1, 2]
+    text = coverage.table_text(table, markdown=True)
+    assert "| `m` | 1/2 (50.0%) | - | - |" in text
 
 
 @pytest.mark.skipif(os.environ.get("MUTATE_CI", "0") in ("", "0"),

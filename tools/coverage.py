@@ -9,7 +9,9 @@ Runs each testbench folder with ``COVERAGE=1`` (the toolchain then builds with
 
     python tools/coverage.py                     # every testbench folder
     python tools/coverage.py frame_align         # one (tb/frame_align)
+    python tools/coverage.py --quick             # cheapest parameter set of each testbench
     python tools/coverage.py --report-only       # merge and tabulate existing .dat files
+    python tools/coverage.py --markdown          # the table as Markdown (docs/verification.md)
 """
 
 from __future__ import annotations
@@ -25,8 +27,11 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 COV_DIR = REPO / "sim_build" / "coverage"
 OUT = REPO / "out" / "coverage"
-TBS = ("frame_align", "chirp_pingpong", "corner_turn", "axis_packetizer", "fft_axis",
-       "radar_pipeline")
+TBS = tuple(sorted(p.parent.name for p in (REPO / "tb").glob("*/test_*.py")
+                   if p.stem == f"test_{p.parent.name}"))
+"""Every block testbench folder (``tb/<block>/test_<block>.py``)."""
+_PARAM_SUFFIX = r"__(?:pi\d+|[A-Z]\w*)$"
+"""Verilator's suffix of a parameterised copy of a module (``__P41``, ``__pi2``)."""
 _POINT = re.compile(r"^C '(.*)' (\d+)$")
 
 
@@ -41,7 +46,7 @@ def parse_points(files: list[Path]) -> dict[tuple, int]:
                 continue
             fields = dict(kv.split("\x02", 1) for kv in m.group(1).split("\x01") if "\x02" in kv)
             if "page" in fields:  # one module, whatever its parameters (page v_line/mod__P41)
-                fields["page"] = re.sub(r"__[A-Z]\w*$", "", fields["page"])
+                fields["page"] = re.sub(_PARAM_SUFFIX, "", fields["page"])
             key = tuple(sorted((k, v) for k, v in fields.items() if k != "h"))
             points[key] = max(points.get(key, 0), int(m.group(2)))
     return points
@@ -56,7 +61,7 @@ def summary(points: dict[tuple, int]) -> dict[str, dict[str, list[int]]]:
         m = re.match(r"v_(\w+?)/(\w+)", page)
         if not m:
             continue
-        kind, module = m.group(1), re.sub(r"__[A-Z]\w*$", "", m.group(2))
+        kind, module = m.group(1), re.sub(_PARAM_SUFFIX, "", m.group(2))
         cell = table[module][kind]
         cell[1] += 1
         cell[0] += count > 0
@@ -83,21 +88,53 @@ def write_uncovered(points: dict[tuple, int], path: Path) -> None:
     path.write_text("".join(f"rtl/{r}:{ln} {page} {o}\n" for r, ln, page, o in sorted(rows)))
 
 
-def run_testbenches(names: list[str]) -> int:
+def cheapest(name: str) -> list[str]:
+    """pytest arguments of the cheapest parameter set of testbench ``tb/<name>`` (the first
+    stage of the mutation runner, tools/mutate.py)."""
+    sys.path.insert(0, str(REPO / "tools"))
+    from mutate import CHEAPEST
+    return list(CHEAPEST.get(name, [f"tb/{name}/test_{name}.py"]))
+
+
+def run_testbenches(names: list[str], quick: bool = False) -> int:
     env = dict(os.environ, COVERAGE="1")
     rc = 0
     for name in names:
-        print(f"coverage: running tb/{name}", flush=True)
+        target = cheapest(name) if quick else [f"tb/{name}"]
+        print(f"coverage: running {' '.join(target)}", flush=True)
         rc |= subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "1",
-                              "-p", "no:cacheprovider", f"tb/{name}"], cwd=REPO,
+                              "-p", "no:cacheprovider", *target], cwd=REPO,
                              env=env).returncode
     return rc
+
+
+def table_text(table: dict[str, dict[str, list[int]]], markdown: bool = False) -> str:
+    """Per-module table: hit/total (percent) of each point kind."""
+    kinds = ("line", "branch", "toggle")
+
+    def cell(hit: int, total: int) -> str:
+        return "-" if not total else f"{hit}/{total} ({100 * hit / total:.1f}%)"
+
+    if markdown:
+        lines = ["| module | line | branch | toggle |", "|---|---:|---:|---:|"]
+        for module in sorted(table):
+            lines.append(f"| `{module}` | " + " | ".join(
+                cell(*table[module].get(k, [0, 0])) for k in kinds) + " |")
+        return "\n".join(lines)
+    lines = [f"{'module':20s}" + "".join(f"{k:>22s}" for k in kinds)]
+    for module in sorted(table):
+        lines.append(f"{module:20s}" + "".join(
+            f"{cell(*table[module].get(k, [0, 0])):>22s}" for k in kinds))
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("testbenches", nargs="*", help=f"tb/ folders (default: {' '.join(TBS)})")
     ap.add_argument("--report-only", action="store_true")
+    ap.add_argument("--quick", action="store_true",
+                    help="only the cheapest parameter set of each testbench")
+    ap.add_argument("--markdown", action="store_true", help="print the table as Markdown")
     args = ap.parse_args(argv)
     names = args.testbenches or list(TBS)
     bad = [n for n in names if not (REPO / "tb" / n).is_dir()]
@@ -109,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
         for old in COV_DIR.glob("*.dat"):
             if any(old.name.startswith(f"{n}__") for n in names):
                 old.unlink()
-        rc = run_testbenches(names)
+        rc = run_testbenches(names, quick=args.quick)
     files = sorted(COV_DIR.glob("*.dat"))
     if not files:
         print("error: no coverage data (run without --report-only)", file=sys.stderr)
@@ -119,16 +156,7 @@ def main(argv: list[str] | None = None) -> int:
     write_merged(points, OUT / "merged.dat")
     write_uncovered(points, OUT / "uncovered.txt")
     table = summary(points)
-    kinds = ("line", "branch", "toggle")
-    head = f"{'module':18s}" + "".join(f"{k:>20s}" for k in kinds)
-    lines = [head]
-    for module in sorted(table):
-        row = f"{module:18s}"
-        for k in kinds:
-            hit, total = table[module].get(k, [0, 0])
-            row += f"{'-':>20s}" if not total else f"{hit:7d}/{total:<6d}{100 * hit / total:5.1f}%"
-        lines.append(row)
-    text = "\n".join(lines)
+    text = table_text(table, markdown=args.markdown)
     (OUT / "summary.txt").write_text(text + "\n")
     print(text)
     print(f"\nmerged: {OUT / 'merged.dat'}; uncovered points: {OUT / 'uncovered.txt'}")

@@ -58,6 +58,61 @@ module frame_store_fifo #(
     end
   end
 
+`ifdef FORMAL
+  // Formal properties (formal/frame_store_fifo.sby). Both ports obey AXI-Stream (the sink's
+  // rules assumed, the source's asserted: rtl/common/axis_checker.sv); no beat created or
+  // lost: pushes - pops == count <= DEPTH; order and contents: any word pushed (picked by
+  // the solver) leaves after exactly the words ahead of it, unchanged.
+  logic f_past = 1'b0;
+  logic [7:0] f_in = '0, f_out = '0;
+  (* anyseq *) logic f_pick;
+  logic [WIDTH-1:0] f_word;
+  logic [PTR_W:0] f_pos;
+  logic f_track = 1'b0;
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_in <= '0;
+      f_out <= '0;
+      f_track <= 1'b0;
+    end else begin
+      f_in  <= f_in + 8'(push);
+      f_out <= f_out + 8'(pop);
+      if (f_track && pop) begin
+        if (f_pos == '0) f_track <= 1'b0;
+        f_pos <= f_pos - 1'b1;
+      end
+      if (!f_track && push && f_pick) begin
+        f_track <= 1'b1;
+        f_word  <= s_axis_tdata;
+        f_pos   <= count_q - (PTR_W+1)'(pop);
+      end
+    end
+  end
+`ifdef F_TOP_FRAME_STORE_FIFO
+  initial assume (rst);
+`endif
+  always_comb if (f_past && !rst) begin
+    assert (count_q <= (PTR_W+1)'(DEPTH));
+    assert ((PTR_W+1)'(f_in - f_out) == count_q);
+    assert (PTR_W'(wr_ptr_q - rd_ptr_q) == count_q[PTR_W-1:0]);
+    if (f_track) begin
+      assert (f_pos < count_q);
+      assert (mem_q[PTR_W'(rd_ptr_q + f_pos[PTR_W-1:0])] == f_word);
+      if (pop && f_pos == '0) assert (m_axis_tdata == f_word);
+    end
+  end
+  always_comb if (f_past && !rst) begin
+    cover (count_q == (PTR_W+1)'(DEPTH) && pop);
+    cover (push && pop && count_q == (PTR_W+1)'(DEPTH - 1));
+    cover (f_track && pop && f_pos == (PTR_W+1)'(0) && f_out == 8'(DEPTH + 2));
+  end
+  axis_checker #(.PAYLOAD_W(WIDTH), .ASSUME(1'b1)) f_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready), .payload(s_axis_tdata));
+  axis_checker #(.PAYLOAD_W(WIDTH)) f_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready), .payload(m_axis_tdata));
+`endif
+
 endmodule
 
 `default_nettype wire

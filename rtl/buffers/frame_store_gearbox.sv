@@ -31,6 +31,41 @@ module frame_store_gearbox #(
     $fatal(1, "frame_store_gearbox (%m): OUT_W=%0d must be a power of two in 8..4096", OUT_W);
   end
 
+`ifdef FORMAL
+  // Formal properties (formal/frame_store_gearbox.sby, tasks per direction). Both ports obey
+  // AXI-Stream (sink assumed, source asserted: rtl/common/axis_checker.sv); no beat created
+  // or lost: narrow beats == N x wide beats + the parts held; contents: any narrow part
+  // (picked by the solver) sits in the right slice of the right wide word.
+  localparam int F_N  = IN_W < OUT_W ? OUT_W / IN_W : IN_W / OUT_W;
+  localparam int F_NW = F_N > 1 ? $clog2(F_N) : 1;
+  localparam int F_PW = IN_W < OUT_W ? IN_W : OUT_W;
+  logic f_past = 1'b0;
+  logic [7:0] f_in = '0, f_out = '0;
+  wire f_ib = s_axis_tvalid && s_axis_tready;
+  wire f_ob = m_axis_tvalid && m_axis_tready;
+  always_ff @(posedge clk) begin
+    f_past <= 1'b1;
+    if (rst) begin
+      f_in  <= '0;
+      f_out <= '0;
+    end else begin
+      f_in  <= f_in + 8'(f_ib);
+      f_out <= f_out + 8'(f_ob);
+    end
+  end
+`ifdef F_TOP_FRAME_STORE_GEARBOX
+  initial assume (rst);
+`endif
+  (* anyconst *) logic [F_NW-1:0] f_slot;   // which part of a wide word is watched
+  (* anyseq *) logic f_pick;                // the solver picks the watched word
+  logic [F_PW-1:0] f_part;
+  logic f_track = 1'b0;
+  axis_checker #(.PAYLOAD_W(IN_W), .ASSUME(1'b1)) f_chk_s_axis (
+    .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready), .payload(s_axis_tdata));
+  axis_checker #(.PAYLOAD_W(OUT_W)) f_chk_m_axis (
+    .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready), .payload(m_axis_tdata));
+`endif
+
   if (IN_W == OUT_W) begin : g_pass
     assign m_axis_tdata  = s_axis_tdata;
     assign m_axis_tvalid = s_axis_tvalid;
@@ -73,6 +108,33 @@ module frame_store_gearbox #(
       end
     end
 
+`ifdef FORMAL
+    // watch narrow input beat number f_slot of some wide word: it leaves in slice f_slot
+    always_ff @(posedge clk) begin
+      if (rst) f_track <= 1'b0;
+      else begin
+        if (f_track && f_ob) f_track <= 1'b0;
+        if (!f_track && f_ib && f_pick && idx_q == f_slot) begin
+          f_track <= 1'b1;
+          f_part  <= s_axis_tdata;
+        end
+      end
+    end
+    always_comb if (f_past && !rst) begin
+      assert (f_in == 8'(F_N) * f_out + 8'(idx_q) + (full_q ? 8'(F_N) : 8'd0));
+      if (full_q) assert (idx_q == '0);
+      if (f_track) begin
+        assert (acc_q[f_slot*IN_W +: IN_W] == f_part);
+        assert (full_q || idx_q > f_slot);
+        if (f_ob) assert (m_axis_tdata[f_slot*IN_W +: IN_W] == f_part);
+      end
+    end
+    always_comb if (f_past && !rst) begin
+      cover (f_track && f_ob && f_slot == F_NW'(F_N - 1) && f_out == 8'd2);
+      cover (f_ob && f_ib);
+    end
+`endif
+
   end else begin : g_split
     // one wide beat -> N narrow beats, least significant first
     localparam int N   = IN_W / OUT_W;
@@ -104,6 +166,33 @@ module frame_store_gearbox #(
         if (s_axis_tvalid && s_axis_tready) full_q <= 1'b1;
       end
     end
+`ifdef FORMAL
+    // watch slice f_slot of some wide input word: it leaves as narrow beat number f_slot
+    always_ff @(posedge clk) begin
+      if (rst) f_track <= 1'b0;
+      else begin
+        if (f_track && out_beat && idx_q == f_slot) f_track <= 1'b0;
+        if (!f_track && f_ib && f_pick) begin
+          f_track <= 1'b1;
+          f_part  <= s_axis_tdata[f_slot*OUT_W +: OUT_W];
+        end
+      end
+    end
+    always_comb if (f_past && !rst) begin
+      assert (8'(F_N) * f_in == f_out + (full_q ? 8'(F_N) - 8'(idx_q) : 8'd0));
+      if (!full_q) assert (idx_q == '0);
+      if (f_track) begin
+        assert (full_q && idx_q <= f_slot);
+        assert (hold_q[f_slot*OUT_W +: OUT_W] == f_part);
+        if (out_beat && idx_q == f_slot) assert (m_axis_tdata == f_part);
+      end
+    end
+    always_comb if (f_past && !rst) begin
+      cover (f_track && out_beat && idx_q == f_slot && f_slot == F_NW'(F_N - 1)
+             && f_in == 8'd2);
+      cover (out_beat && f_ib);
+    end
+`endif
   end
 
 endmodule

@@ -295,6 +295,28 @@ async def test_slverr(dut):
 
 
 @cocotb.test()
+async def test_slverr_read_only(dut):
+    """Only a read beat answers SLVERR (its write succeeded): the sticky flag and the count
+    must come from the R channel alone."""
+    tb = TB(dut)
+    await tb.reset()
+    g = tb.g
+    off = (g.frame_bytes // 3) // g.axi_bytes * g.axi_bytes
+    lo = g.mem_base + off
+    tb.ram.read_if.bad = (lo, lo + g.axi_bytes)
+    frames = [tb.random_frame() for _ in range(2)]
+    got = await tb.run_frames(frames)
+    woff = g.word_offsets()
+    lane = woff[:, None] + 4 * np.arange(g.num_rx)[None, :]
+    exp_in = [f.copy() for f in frames]
+    exp_in[0][(lane >= off) & (lane < off + g.axi_bytes)] = 0
+    tb.check_payload(got, exp_in)
+    st = tb.status()
+    assert st["status_mem_error"] == 1 and st["mem_error_count"] == 1, st
+    tb.ram.set_bad(None)
+
+
+@cocotb.test()
 async def test_framing_error(dut):
     """An early TLAST is flagged and counted; data still placed by count."""
     tb = TB(dut)
