@@ -46,7 +46,8 @@ class _Recorder(Processor):
         super().__init__(CFG, Feed(), health)
         self.got: list[int] = []
 
-    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0) -> None:
+    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0,
+               cfg: object = None) -> None:
         self.got.append(frame_id)
 
 
@@ -105,6 +106,57 @@ def test_sender_restart_without_pause(frames):
     assert s["stream_restarts"] >= 2
     assert rec.got[-3:] == [1, 2, 3]
     assert s["frames_complete"] >= 10
+
+
+@pytest.mark.parametrize("packet_words", [1023, 4093, 500])
+def test_packet_words_learnt_from_the_header(packet_words):
+    """No --packet-words: the stream's PACKET_WORDS comes from the first packet's header
+    (``radar capture`` writes the most that fit a datagram, 4093 on paper-fpga); a sender that
+    restarts with another PACKET_WORDS is learnt again."""
+    health = LinkHealth()
+    rec = _Recorder(health)
+    ingest = PacketIngest(CFG, None, health, rec, gain=1.0)
+    for k in range(3):
+        for p in frame_packets(_cube(k), CFG, packet_words, k):
+            ingest.push(p)
+    assert ingest.packet_words == packet_words
+    ingest.idle()
+    for k in range(2):
+        for p in frame_packets(_cube(k), CFG, 1023, k):
+            ingest.push(p)
+    ingest.idle()
+    s = health.snapshot()
+    assert ingest.packet_words == 1023
+    assert rec.got == [0, 1, 2, 0, 1]
+    assert (s["frames_complete"], s["frames_damaged"], s["packets_lost"], s["malformed"],
+            s["late_packets"]) == (5, 0, 0, 0, 0)
+
+
+def test_preset_learnt_from_the_header():
+    """A UDP stream without --preset: the view starts on ``full`` and learns paper-fpga
+    (and its PACKET_WORDS) from the first packet; cubes reach the processor with that
+    preset's shape and gain."""
+    from model.config import PRESETS
+    from model.radar_pipeline import PipelineParams, chain_gain
+
+    full = get_preset("full")
+    health = LinkHealth()
+    got: list[tuple[int, tuple[int, ...], float, str]] = []
+
+    class Rec(Processor):
+        def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:
+            got.append((frame_id, cube.shape, scale, cfg.name))
+
+    ingest = PacketIngest(full, None, health, Rec(full, Feed(), health), gain=1.0,
+                          configs=list(PRESETS.values()))
+    for k in range(2):
+        for p in frame_packets(_cube(k), CFG, 4093, k):
+            ingest.push(p)
+    ingest.idle()
+    gain = chain_gain(CFG, PipelineParams())
+    assert got == [(k, CFG.cube_shape, pytest.approx(1 / gain), "paper-fpga") for k in (0, 1)]
+    s = health.snapshot()
+    assert (s["frames_complete"], s["malformed"], s["packets_lost"]) == (2, 0, 0)
 
 
 def test_reordered_frame_is_not_lost(frames):

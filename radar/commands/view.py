@@ -2,7 +2,7 @@
 capture or a scene.
 
     radar view --replay FILE.dmacap [--fps 20] [--loss P]   a capture, looped
-    radar view --udp-port P [--preset full]                 what `radar replay`/the board sends
+    radar view --udp-port P [--preset P]                    what `radar replay`/the board sends
     radar view --scene table1 [--preset paper-fpga]          simulated frames
     ... [--host 127.0.0.1] [--port 8050] [--gnn]
 
@@ -121,9 +121,11 @@ def build(args: argparse.Namespace, stop: threading.Event
                                         args=(make_cube, args.frames, processor, health,
                                               stop, args.fps)))
         return feed, health, threads, desc
-    gain = chain_gain(cfg, PipelineParams(packet_words=packet_words))
+    gain = chain_gain(cfg, PipelineParams())  # the FFT scaling only, not PACKET_WORDS
     try:
-        ingest = PacketIngest(cfg, packet_words, health, processor, gain)
+        # a UDP stream without --preset: the preset is learnt from the packet headers too
+        learn = None if args.replay or args.preset else list(PRESETS.values())
+        ingest = PacketIngest(cfg, packet_words, health, processor, gain, configs=learn)
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
     if args.replay:
@@ -196,9 +198,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="address the UDP receiver binds (default 127.0.0.1)")
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: the capture's geometry, the scene's preset, "
-                        "or full for UDP)")
-    v.add_argument("--packet-words", type=int, default=1023,
-                   help="PACKET_WORDS of a UDP stream (default 1023)")
+                        "or for UDP learnt from the packet headers)")
+    v.add_argument("--packet-words", type=int, default=None,
+                   help="PACKET_WORDS of a UDP stream (default: learnt from the packet "
+                        "headers, as radar receive does)")
     v.add_argument("--host", default="127.0.0.1",
                    help="address the web page is served on (default 127.0.0.1)")
     v.add_argument("--port", type=int, default=DEFAULT_PORT,

@@ -8,16 +8,23 @@ paper-fpga, >= 5 for full), frames the view skipped to stay current, and the vie
 resident memory (start / end / max, MiB) and the page's JS heap: flat memory means nothing
 queues up. "draw ms" is the page's time to draw one update (all four plots), so the display
 rate an idle machine reaches is about 1000 / draw ms; the load average is printed because the
-machine is shared. ``--duration 600`` is the 10-minute run of the issue.
+machine is shared. ``--minutes 10`` is the 10-minute run of the issue.
 
-    python -m radar.view.bench_view [--duration 20] [--presets paper-fpga full]
-                                    [--screenshot docs/img/radar_view.png] [--gnn]
+Where the time goes, as CPU time per frame (independent of the machine's load): the view
+process's decode, host processing and message preparation (timed here on the capture's first
+frame), the message's size, and the page's main thread drawing one update: the page's own
+draw and, for comparison in the same browser on the same message, the reference draw of main
+ea510a1 (one full Plotly.react per plot, ``bench_reference.js``).
+
+    python -m radar.view.bench_view [--duration 20 | --minutes 10] [--presets paper-fpga full]
+                                    [--screenshot docs/img/view_table1.png] [--gnn]
                                     [--capture out/table1_paper-fpga.dmacap]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -27,12 +34,24 @@ from typing import Any
 
 import numpy as np
 
-from host.capture import CaptureInfo, frame_packets, write_capture
+from host.capture import CaptureInfo, frame_packets, read_capture, write_capture
+from host.pipeline import DetectionParams, process_cube
+from host.stream import StreamDecoder
+from model.config import RadarConfig, get_preset
 from model.radar_pipeline import PipelineParams, chain_gain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
 from radar.view.browser import chromium_missing_reason, launch, start_view
+from radar.view.feed import ViewFrame
+from radar.view.render import MessageCache
+from radar.view.sources import channel_power_sum
+
+REFERENCE_JS = Path(__file__).with_name("bench_reference.js")
+"""The page's draw before the canvas heat maps (main ea510a1), timed beside the new one."""
+
+DRAW_REPEATS = 30
+"""Updates drawn from one recorded message to time the page's draw."""
 
 GOALS = {"paper-fpga": 20.0, "full": 5.0}
 """Display updates per second the issue asks for."""
@@ -59,6 +78,93 @@ def make_capture(preset: str, path: Path, frames: int = 4, packet_words: int = 1
     return path
 
 
+def _cpu_ms(fn: Any, repeats: int = 3) -> tuple[float, Any]:
+    """(CPU time per call of ``fn()``, ms; its last result)."""
+    t0 = time.process_time()
+    for _ in range(repeats):
+        out = fn()
+    return 1e3 * (time.process_time() - t0) / repeats, out
+
+
+def server_costs(capture: Path, cfg: RadarConfig) -> dict[str, float]:
+    """CPU ms per frame of the view process's stages on the capture's first frame, and the
+    message's size (KiB): decode (packets -> cube), host processing (CFAR, angles, point
+    cloud, channel sum), message (pooled, quantised maps and JSON)."""
+    info, packets = read_capture(capture)
+    pkts = list(packets)
+    dec = StreamDecoder(cfg, info.packet_words)
+    n = dec.n_packets
+
+    def decode() -> np.ndarray:
+        d = StreamDecoder(cfg, info.packet_words)
+        frames = [f for p in pkts[:n] for f in d.push_packet(p)] + d.flush()
+        return frames[0].cube
+
+    t_dec, cube = _cpu_ms(decode)
+    cube = (cube / chain_gain(cfg, PipelineParams())).astype(np.complex64)
+    t_proc, cloud = _cpu_ms(lambda: process_cube(cube, cfg, DetectionParams(), frame=0))
+    t_nci, nci = _cpu_ms(lambda: channel_power_sum(cube))
+    frame = ViewFrame(seq=1, frame_id=0, cfg=cfg, cloud=cloud, cube=cube, nci=nci)
+    t_msg, text = _cpu_ms(lambda: MessageCache().get(frame, 0, {}))
+    return {"decode_ms": t_dec, "process_ms": t_proc + t_nci, "message_ms": t_msg,
+            "message_kib": len(text) / 1024}
+
+
+def draw_cpu_ms(page: Any, cdp: Any, fn: str, repeats: int = DRAW_REPEATS) -> float:
+    """Page main-thread CPU per update, ms: the newest frame message drawn ``repeats`` times
+    by the page function ``fn`` (each followed by a browser paint)."""
+    t0 = _thread_time_s(cdp)
+    page.evaluate(f"""async () => {{
+        const msg = window.radarView.lastFrame;
+        for (let i = 0; i < {repeats}; i++) {{
+            await {fn}(msg);
+            await new Promise(resolve => requestAnimationFrame(resolve));
+        }}
+    }}""")
+    return 1e3 * (_thread_time_s(cdp) - t0) / repeats
+
+
+def _proc_cpu_s(pid: int) -> float:
+    """User + system CPU time of one process so far, s (0 when it is gone)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def browser_cpu_s(profile: Path) -> float:
+    """CPU time so far of every chromium process of the browser using ``profile`` (the
+    browser process, found by its --user-data-dir, and all its descendants), s."""
+    parent: dict[int, int] = {}
+    roots = []
+    for d in Path("/proc").iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            stat = (d / "stat").read_text()
+            cmd = (d / "cmdline").read_bytes()
+        except OSError:
+            continue
+        parent[int(d.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+        if f"--user-data-dir={profile}".encode() in cmd:
+            roots.append(int(d.name))
+    tree = set(roots)
+    grew = True
+    while grew:
+        new = {p for p, pp in parent.items() if pp in tree and p not in tree}
+        tree |= new
+        grew = bool(new)
+    return sum(_proc_cpu_s(p) for p in tree)
+
+
+def _heap_mib(page: Any, cdp: Any) -> float:
+    """The page's live JS heap after a garbage collection, MiB (without it the figure is
+    mostly how long ago the collector last ran)."""
+    cdp.send("HeapProfiler.collectGarbage")
+    return float(page.evaluate("performance.memory.usedJSHeapSize")) / 2**20
+
+
 def _thread_time_s(cdp: Any) -> float:
     """CPU time of the page's main thread so far, s (Chrome DevTools ``ThreadTime``)."""
     metrics = cdp.send("Performance.getMetrics")["metrics"]
@@ -75,7 +181,8 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
     view = start_view(args, timeout_s=120)
     try:
         with sync_playwright() as pw:
-            ctx = launch(pw, folder / f"profile-{preset}")
+            profile = folder / f"profile-{preset}"
+            ctx = launch(pw, profile)
             page = ctx.new_page()
             page.goto(view.url)
             page.wait_for_function("window.radarView.frames >= 3", timeout=120_000)
@@ -84,20 +191,26 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
             time.sleep(1.0)
             state0 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
                                    "h: window.radarView.lastHealth})")
-            thread0, cpu0 = _thread_time_s(cdp), view.cpu_s()
+            thread0, cpu0, all0 = _thread_time_s(cdp), view.cpu_s(), browser_cpu_s(profile)
             rss = [view.rss_kib()]
-            heap0 = page.evaluate("performance.memory.usedJSHeapSize")
+            heap0 = _heap_mib(page, cdp)
             t_end = time.monotonic() + duration_s
             while time.monotonic() < t_end:
                 time.sleep(min(1.0, max(0.0, t_end - time.monotonic())))
                 rss.append(view.rss_kib())
             state1 = page.evaluate("({f: window.radarView.frames, t: performance.now(), "
                                    "h: window.radarView.lastHealth, ms: window.radarView.drawMs})")
-            heap1 = page.evaluate("performance.memory.usedJSHeapSize")
-            thread1, cpu1 = _thread_time_s(cdp), view.cpu_s()
+            heap1 = _heap_mib(page, cdp)
+            thread1, cpu1, all1 = _thread_time_s(cdp), view.cpu_s(), browser_cpu_s(profile)
             if screenshot is not None:
                 screenshot.parent.mkdir(parents=True, exist_ok=True)
                 page.screenshot(path=str(screenshot))
+            # the draw alone, new and reference, on the same message (live drawing held)
+            page.evaluate("window.radarView.hold = true")
+            time.sleep(0.5)
+            draw_new = draw_cpu_ms(page, cdp, "window.radarView.drawFrame")
+            page.add_script_tag(content=REFERENCE_JS.read_text())
+            draw_old = draw_cpu_ms(page, cdp, "window.referenceDraw")
             ctx.close()
     finally:
         view.stop()
@@ -109,17 +222,23 @@ def run(preset: str, duration_s: float, folder: Path, screenshot: Path | None,
     return {"decoded_fps": decoded / dt, "display_fps": (state1["f"] - state0["f"]) / dt,
             "page_cpu_ms": 1e3 * (thread1 - thread0) / drawn,
             "host_cpu_ms": 1e3 * (cpu1 - cpu0) / max(1, decoded),
+            "browser_cpu_ms": 1e3 * (all1 - all0) / drawn,
+            "view_per_update_ms": 1e3 * (cpu1 - cpu0) / drawn,
             "not_shown": h1["frames_not_shown"] - h0["frames_not_shown"],
             "rss0": rss[0] / 1024, "rss1": rss[-1] / 1024, "rss_max": max(rss) / 1024,
-            "heap0": heap0 / 2**20, "heap1": heap1 / 2**20, "seconds": dt,
+            "heap0": heap0, "heap1": heap1, "seconds": dt,
             "draw_ms": sum(state1["ms"].values()),
+            "draw_new_ms": draw_new, "draw_old_ms": draw_old,
+            **server_costs(cap, get_preset(preset)),
             "rss_trace": [rss[round(i * (len(rss) - 1) / 5)] / 1024 for i in range(6)]}
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--duration", type=float, default=20.0,
-                   help="seconds watched per preset (default 20; 600 = the 10-minute run)")
+                   help="seconds watched per preset (default 20)")
+    p.add_argument("--minutes", type=float, default=None,
+                   help="minutes watched per preset instead (10: the issue's memory run)")
     p.add_argument("--presets", nargs="+", default=["paper-fpga", "full"],
                    choices=sorted(GOALS))
     p.add_argument("--screenshot", type=Path, default=None,
@@ -127,7 +246,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--gnn", action="store_true", help="run the GNN too (boxes on the page)")
     p.add_argument("--capture", type=Path, default=None,
                    help="replay this capture for the first preset instead of making one")
+    p.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = p.parse_args(argv)
+    duration = 60.0 * args.minutes if args.minutes is not None else args.duration
     reason = chromium_missing_reason()
     if reason:
         print(f"bench_view: {reason}", file=sys.stderr)
@@ -135,33 +256,51 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for i, preset in enumerate(args.presets):
-            r = run(preset, args.duration, Path(tmp), args.screenshot if i == 0 else None,
+            r = run(preset, duration, Path(tmp), args.screenshot if i == 0 else None,
                     args.gnn, args.capture if i == 0 else None)
             rows.append((preset, r))
-    load = os.getloadavg()[0]
-    print(f"radar view in headless chromium, Table I replay, {args.duration:g} s per preset"
-          f"{' with GNN' if args.gnn else ''}; load average {load:.1f} on {os.cpu_count()} "
-          f"CPUs")
+    load = os.getloadavg()
+    print(f"radar view in headless chromium, Table I replay, {duration:g} s per preset"
+          f"{' with GNN' if args.gnn else ''}; load average {load[0]:.1f} (1 min), "
+          f"{load[1]:.1f} (5 min) on {os.cpu_count()} CPUs")
     print(f"{'preset':<11}{'feed fps':>9}{'decoded/s':>10}{'display/s':>10}{'goal':>6}"
-          f"{'skipped':>8}{'draw ms':>8}{'RSS start':>10}{'end':>7}{'max MiB':>8}"
-          f"{'JS heap MiB':>13}")
+          f"{'skipped':>8}{'RSS start':>10}{'end':>7}{'max MiB':>8}{'JS heap MiB':>13}")
     for preset, r in rows:
         ok = "ok" if r["display_fps"] >= GOALS[preset] else "MISS"
         print(f"{preset:<11}{FEED_FPS[preset]:>9.0f}{r['decoded_fps']:>10.1f}"
-              f"{r['display_fps']:>10.1f}{GOALS[preset]:>4.0f} {ok:<3}{r['not_shown']:>6.0f}"
-              f"{r['draw_ms']:>8.0f}"
+              f"{r['display_fps']:>10.1f}{GOALS[preset]:>4.0f} {ok:<4}{r['not_shown']:>5.0f}"
               f"{r['rss0']:>10.0f}{r['rss1']:>7.0f}{r['rss_max']:>8.0f}"
               f"{r['heap0']:>6.1f}->{r['heap1']:<5.1f}")
-    print("CPU time per update (what an unloaded machine could reach: 1000 / ms per s)")
-    print(f"{'preset':<11}{'page main thread ms/update':>28}{'view process ms/frame':>23}"
-          f"{'page-bound /s':>15}{'host-bound /s':>15}")
+    print("Where the time goes: CPU ms per frame (independent of the load); 'old' is the draw "
+          "of main ea510a1 on the same message in the same browser")
+    print(f"{'preset':<11}{'decode':>7}{'host proc':>10}{'message':>8}{'KiB':>5}"
+          f"{'browser draw':>13}{'old':>6}{'ratio':>6}{'live page':>10}{'live view':>10}"
+          f"{'draw-bound /s':>14}{'old':>6}")
     for preset, r in rows:
-        print(f"{preset:<11}{r['page_cpu_ms']:>28.1f}{r['host_cpu_ms']:>23.1f}"
-              f"{1e3 / max(r['page_cpu_ms'], 1e-3):>15.1f}"
-              f"{1e3 / max(r['host_cpu_ms'], 1e-3):>15.1f}")
+        print(f"{preset:<11}{r['decode_ms']:>7.1f}{r['process_ms']:>10.1f}"
+              f"{r['message_ms']:>8.1f}{r['message_kib']:>5.0f}{r['draw_new_ms']:>13.1f}"
+              f"{r['draw_old_ms']:>6.1f}{r['draw_old_ms'] / max(r['draw_new_ms'], 1e-3):>6.1f}"
+              f"{r['page_cpu_ms']:>10.1f}{r['host_cpu_ms']:>10.1f}"
+              f"{1e3 / max(r['draw_new_ms'], 1e-3):>14.1f}"
+              f"{1e3 / max(r['draw_old_ms'], 1e-3):>6.1f}")
+    print("  live page: page main-thread CPU per update drawn during the run; live view: view "
+          "process CPU per decoded frame (decode of every frame, processing of those shown)")
+    print("CPU per display update during the run, all processes (what 2 quiet cores reach: "
+          "2000 / total ms, at most 1000 / page main thread ms)")
+    print(f"{'preset':<11}{'chromium (all)':>15}{'of it main':>11}{'view process':>13}"
+          f"{'total':>7}{'quiet 2-core estimate /s':>26}")
+    for preset, r in rows:
+        total = r["browser_cpu_ms"] + r["view_per_update_ms"]
+        est = min(2e3 / max(total, 1e-3), 1e3 / max(r["page_cpu_ms"], 1e-3))
+        r["quiet_estimate"] = est
+        print(f"{preset:<11}{r['browser_cpu_ms']:>15.1f}{r['page_cpu_ms']:>11.1f}"
+              f"{r['view_per_update_ms']:>13.1f}{total:>7.1f}{est:>26.1f}")
     for preset, r in rows:
         trace = " ".join(f"{v:.0f}" for v in r["rss_trace"])
         print(f"{preset}: view RSS MiB at 0, 20, ..., 100 % of the run: {trace}")
+    if args.json:
+        args.json.write_text(json.dumps({"duration_s": duration, "load": load,
+                                         "rows": dict(rows)}, indent=1))
     return 0
 
 

@@ -11,6 +11,7 @@ to ``lo + q * (hi - lo) / 255`` dB. Doppler is shifted so velocity increases lef
 from __future__ import annotations
 
 import base64
+import functools
 import json
 import math
 import threading
@@ -38,7 +39,15 @@ def pool_max(a: np.ndarray, max_axis: int = MAX_AXIS) -> np.ndarray:
     fr = max(1, math.ceil(a.shape[0] / max_axis))
     fc = max(1, math.ceil(a.shape[1] / max_axis))
     r, c = a.shape[0] // fr, a.shape[1] // fc
-    return a[:r * fr, :c * fc].reshape(r, fr, c, fc).max(axis=(1, 3))
+    a = a[:r * fr, :c * fc]
+    # element-wise maximum of the fr * fc strided sub-grids: ~4x faster than a reduction
+    # over reshaped axes for the small factors used here
+    out = a[::fr, ::fc].copy()
+    for i in range(fr):
+        for j in range(fc):
+            if i or j:
+                np.maximum(out, a[i::fr, j::fc], out=out)
+    return out
 
 
 def pool_axis(x: np.ndarray, n_out: int) -> np.ndarray:
@@ -57,6 +66,14 @@ def range_axis(cfg: RadarConfig) -> np.ndarray:
     return np.arange(cfg.n_range) * cfg.range_bin_m
 
 
+@functools.lru_cache(maxsize=16)
+def _axes(cfg: RadarConfig, rows: int, cols: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(range_m of the rows, velocity_mps of the columns) of a pooled map, rounded (the same
+    for every frame of a preset: computed once)."""
+    return (tuple(_r(pool_axis(range_axis(cfg), rows))),
+            tuple(_r(pool_axis(velocity_axis(cfg), cols))))
+
+
 def heatmap(power: np.ndarray, cfg: RadarConfig) -> dict[str, Any]:
     """Power map float (n_range, n_doppler), linear -> quantised heat-map message part."""
     shifted = np.fft.fftshift(power, axes=1)
@@ -68,11 +85,11 @@ def heatmap(power: np.ndarray, cfg: RadarConfig) -> dict[str, Any]:
     lo = min(SCALE_STEP_DB * math.floor((float(np.median(db)) - FLOOR_BELOW_MEDIAN_DB)
                                         / SCALE_STEP_DB), hi - SCALE_STEP_DB)
     q = np.clip(np.rint((db - lo) * (255.0 / (hi - lo))), 0, 255).astype(np.uint8)
+    range_m, velocity_mps = _axes(cfg, int(q.shape[0]), int(q.shape[1]))
     return {"q": base64.b64encode(q.tobytes()).decode("ascii"),
             "rows": int(q.shape[0]), "cols": int(q.shape[1]),
             "lo": round(lo, 2), "hi": round(hi, 2),
-            "range_m": _r(pool_axis(range_axis(cfg), q.shape[0])),
-            "velocity_mps": _r(pool_axis(velocity_axis(cfg), q.shape[1]))}
+            "range_m": range_m, "velocity_mps": velocity_mps}
 
 
 def box_outline(obj: dict[str, Any]) -> tuple[list[float], list[float]]:
@@ -115,7 +132,8 @@ def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dic
     if frame.nci is not None:
         msg["nci"] = heatmap(frame.nci, cfg)
         prof = 10 * np.log10(np.maximum(frame.nci.sum(axis=1), 1e-20))
-        msg["profile"] = {"range_m": _r(range_axis(cfg)), "db": _r(prof, 2),
+        msg["profile"] = {"range_m": _axes(cfg, cfg.n_range, cfg.n_doppler)[0],
+                          "db": _r(prof, 2),
                           "det_range_m": _r(cloud.range_m),
                           "det_db": _r(prof[np.clip(cloud.range_bin, 0, cfg.n_range - 1)]
                                        if len(cloud) else np.zeros(0), 2)}

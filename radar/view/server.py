@@ -78,12 +78,16 @@ class ViewServer:
         app.add_routes([web.get("/", self._index), web.get("/ws", self._ws),
                         web.get("/api/state", self._state),
                         web.get("/static/plotly.min.js", self._plotly_js),
+                        web.get("/favicon.ico", self._no_icon),
                         web.static("/static", STATIC_DIR)])
         return app
 
     async def _index(self, request: web.Request) -> web.StreamResponse:
         return web.FileResponse(STATIC_DIR / "index.html",
                                 headers={"Cache-Control": "no-cache"})
+
+    async def _no_icon(self, request: web.Request) -> web.Response:
+        return web.Response(status=204)  # browsers ask for one; a 404 would log an error
 
     async def _plotly_js(self, request: web.Request) -> web.StreamResponse:
         return web.FileResponse(self._plotly, headers={"Cache-Control": "max-age=3600"})

@@ -17,7 +17,7 @@ import random
 import socket
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,9 +25,10 @@ import numpy as np
 
 from host.capture import read_capture
 from host.pipeline import DetectionParams, process_cube
-from host.stream import Frame, StreamDecoder
-from host.udp import UDP_MAX_PAYLOAD
+from host.stream import Frame, StreamDecoder, geometry_from_packet
+from host.udp import UDP_MAX_PAYLOAD, max_packet_words
 from model.config import RadarConfig
+from model.radar_pipeline import PipelineParams, chain_gain
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
 
@@ -63,18 +64,20 @@ class Processor:
         self.ego_speed_mps = ego_speed_mps
         self.source = source
         self._cond = threading.Condition()
-        self._slot: tuple[int, np.ndarray, float] | None = None
+        self._slot: tuple[int, np.ndarray, float, RadarConfig] | None = None
         self._skipped = 0
         self.errors = 0
 
-    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0) -> None:
-        """Hand over a cube complex (n_virtual, n_range, n_doppler); ``cube * scale`` is in
-        reference units. The processor owns the cube from now on (scaled in place on its
-        own thread, so the ingest thread stays free for the link)."""
+    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0,
+               cfg: RadarConfig | None = None) -> None:
+        """Hand over a cube complex (n_virtual, n_range, n_doppler) of configuration ``cfg``
+        (default: :attr:`cfg`); ``cube * scale`` is in reference units. The processor owns
+        the cube from now on (scaled in place on its own thread, so the ingest thread stays
+        free for the link)."""
         with self._cond:
             if self._slot is not None:
                 self._skipped += 1
-            self._slot = (frame_id, cube, scale)
+            self._slot = (frame_id, cube, scale, cfg or self.cfg)
             self._cond.notify()
 
     def run(self, stop: threading.Event) -> None:
@@ -86,23 +89,25 @@ class Processor:
                     self._cond.wait(0.2)
                 if self._slot is None:
                     continue
-                (frame_id, cube, scale), self._slot = self._slot, None
+                (frame_id, cube, scale, cfg), self._slot = self._slot, None
                 skipped, self._skipped = self._skipped, 0
             self.feed.taken()
             try:
                 if scale != 1.0:
                     cube *= np.float32(scale) if cube.dtype == np.complex64 else scale
-                self._process(frame_id, cube, skipped)
+                self._process(frame_id, cube, skipped, cfg)
             except Exception as exc:  # noqa: BLE001 - a bad frame must not stop the view
                 self.errors += 1
                 with self.health.lock:
                     self.health.problems.append(f"frame {frame_id}: processing failed: {exc}")
 
-    def _process(self, frame_id: int, cube: np.ndarray, skipped: int) -> None:
-        cloud = process_cube(cube, self.cfg, self.params, frame=frame_id)
+    def _process(self, frame_id: int, cube: np.ndarray, skipped: int,
+                 cfg: RadarConfig | None = None) -> None:
+        cfg = cfg or self.cfg
+        cloud = process_cube(cube, cfg, self.params, frame=frame_id)
         objects = (self.detect_objects(cloud, ego_speed_mps=self.ego_speed_mps)
                    if self.detect_objects is not None and len(cloud) else [])
-        frame = ViewFrame(seq=self.feed.next_seq(), frame_id=frame_id, cfg=self.cfg,
+        frame = ViewFrame(seq=self.feed.next_seq(), frame_id=frame_id, cfg=cfg,
                           cloud=cloud, cube=cube, nci=channel_power_sum(cube),
                           objects=objects, source=self.source)
         self.health.on_shown(len(cloud), len(objects), skipped)
@@ -116,27 +121,68 @@ class PacketIngest:
     of packets in a row belonging to frames already closed; then, or after
     :data:`IDLE_RESTART_S` without datagrams (:meth:`idle`), a fresh decoder takes over.
     ``gain``: the chain's cube gain (decoded cubes are divided by it).
+    ``packet_words``: the stream's PACKET_WORDS, or None to learn it (as ``radar receive``
+    does) from the header of the first datagram after each (re)start; the decoder waiting
+    for that datagram assumes the most that fit a UDP datagram. ``configs``: the presets the
+    stream may be of (default: ``cfg`` only); with more than one, the preset is learnt from
+    the headers too (``cfg`` first), and ``gain`` follows the learnt preset.
     """
 
-    def __init__(self, cfg: RadarConfig, packet_words: int, health: LinkHealth,
-                 processor: Processor, gain: float, use_damaged: bool = True) -> None:
+    def __init__(self, cfg: RadarConfig, packet_words: int | None, health: LinkHealth,
+                 processor: Processor, gain: float, use_damaged: bool = True,
+                 configs: Sequence[RadarConfig] | None = None) -> None:
         self.cfg = cfg
-        self.packet_words = packet_words
+        self.configs = [cfg] + [c for c in configs or [] if c != cfg]
+        self.fixed_packet_words = packet_words
         self.health = health
         self.processor = processor
         self.gain = gain
         self.use_damaged = use_damaged
-        self.decoder = StreamDecoder(cfg, packet_words)  # ValueError on a bad geometry
+        self.decoder = self._new_decoder()  # ValueError on a bad geometry
+        self._learn = self._learning()
         self._late_run: list[bytes] = []
         self._late_msgs: list[str] = []
         self._last_id: int | None = None
         self._presumed_lost: set[int] = set()
         self._dirty = False
 
+    @property
+    def packet_words(self) -> int:
+        """PACKET_WORDS the current decoder expects."""
+        return self.decoder.packet_words
+
+    def _new_decoder(self, packet_words: int | None = None) -> StreamDecoder:
+        pw = packet_words or self.fixed_packet_words or max_packet_words(self.cfg.num_rx)
+        return StreamDecoder(self.cfg, pw)
+
+    def _learning(self) -> bool:
+        return self.fixed_packet_words is None or len(self.configs) > 1
+
+    def _learn_geometry(self, data: bytes) -> None:
+        """Preset and PACKET_WORDS from this datagram's header, when it is a packet of one of
+        :attr:`configs`; a datagram that is not stays with the decoder (which counts it as
+        malformed)."""
+        try:
+            cfg, pw = geometry_from_packet(data, self.configs)
+        except ValueError:
+            return
+        self._learn = False
+        pw = self.fixed_packet_words or pw
+        if cfg != self.cfg:
+            self.cfg = cfg
+            self.gain = chain_gain(cfg, PipelineParams())
+            with self.health.lock:
+                self.health.problems.append(f"stream is of preset {cfg.name}")
+        if cfg != self.decoder.cfg or pw != self.decoder.packet_words:
+            self.health.retire_decoder(self.decoder.stats)
+            self.decoder = self._new_decoder(pw)
+
     def push(self, data: bytes) -> None:
         """One datagram (one DMA packet)."""
         self.health.on_datagram(len(data))
         self._dirty = True
+        if self._learn:
+            self._learn_geometry(data)
         dec = self.decoder
         late = dec.stats.late_packets
         try:
@@ -165,6 +211,8 @@ class PacketIngest:
             self.restart()
             with self.health.lock:
                 self.health.problems.append("sender restarted (frame ids started again)")
+            if self._learn:
+                self._learn_geometry(replay[0])
             for p in replay:
                 frames += self.decoder.push_packet(p)
         for f in frames:
@@ -183,7 +231,8 @@ class PacketIngest:
             self._frame(f)
         self._sync()
         self.health.retire_decoder(self.decoder.stats)
-        self.decoder = StreamDecoder(self.cfg, self.packet_words)
+        self.decoder = self._new_decoder(self.decoder.packet_words)
+        self._learn = self._learning()
         self._late_run, self._late_msgs = [], []
         self._last_id = None
         self._presumed_lost.clear()
@@ -220,7 +269,7 @@ class PacketIngest:
         self.health.on_frame(f, self.packet_words, self.decoder.n_packets, self._id_gap(
             f.frame_id))
         if f.complete or self.use_damaged:
-            self.processor.submit(f.frame_id, f.cube, scale=1.0 / self.gain)
+            self.processor.submit(f.frame_id, f.cube, scale=1.0 / self.gain, cfg=self.cfg)
 
 
 def udp_loop(sock: socket.socket, ingest: PacketIngest, stop: threading.Event,

@@ -6,6 +6,9 @@
 const state = window.radarView = {
   draws: 0, frames: 0, lastSeq: null, drawFps: 0, connected: false, reconnects: 0,
   drawTimes: [], lastHealth: null, drawMs: {},
+  // benchmark hooks: hold = true stops drawing live messages; lastFrame is the newest frame
+  // message drawn; drawFrame(msg) draws one message (radar.view.bench_view times it)
+  hold: false, lastFrame: null, drawFrame: null,
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };
 const MARGIN = { l: 55, r: 10, t: 30, b: 40 };
@@ -21,29 +24,167 @@ const ALARMS = new Set(["frames_damaged", "frames_lost", "packets_lost", "malfor
 let channel = 0;
 let ws = null;
 
-function decodeMap(m) {
-  // base64 uint8 codes (rows x cols) -> dB values, lo + q * (hi - lo) / 255
-  const bin = atob(m.q);
-  const step = (m.hi - m.lo) / 255;
-  const z = new Array(m.rows);
-  for (let r = 0; r < m.rows; r++) {
-    const row = new Float32Array(m.cols);
-    for (let c = 0; c < m.cols; c++) row[c] = m.lo + bin.charCodeAt(r * m.cols + c) * step;
-    z[r] = row;
+// Heat maps: plotly draws the axes, title and colour bar (a placeholder heatmap trace with
+// the map's extent and colour range) and is called again only when those change (5 dB grid,
+// channel, preset); each frame's cells go into a canvas over the plot area, one pixel per
+// cell through a 256-entry lookup table of the trace's own colorscale (codes q are linear
+// in dB from lo to hi = zmin to zmax). A full Plotly.react per frame re-runs defaults, axes,
+// colour bar and PNG encoding of the image: about 25 ms per map, against < 1 ms here.
+function lookupTable(colorscale) {
+  // [[fraction, "rgb(...)"|"#rrggbb"], ...] -> Uint32Array(256) of ABGR (little endian RGBA)
+  const ctx = document.createElement("canvas").getContext("2d");
+  const rgb = colorscale.map(([f, c]) => {
+    ctx.fillStyle = c; const h = ctx.fillStyle;  // canonical "#rrggbb"
+    return [f, parseInt(h.slice(1, 3), 16), parseInt(h.slice(3, 5), 16),
+            parseInt(h.slice(5, 7), 16)];
+  });
+  const lut = new Uint32Array(256);
+  for (let q = 0, k = 0; q < 256; q++) {
+    const f = q / 255;
+    while (k < rgb.length - 2 && f > rgb[k + 1][0]) k++;
+    const [f0, r0, g0, b0] = rgb[k], [f1, r1, g1, b1] = rgb[k + 1];
+    const t = f1 > f0 ? Math.min(1, Math.max(0, (f - f0) / (f1 - f0))) : 0;
+    lut[q] = (255 << 24 | Math.round(b0 + t * (b1 - b0)) << 16
+              | Math.round(g0 + t * (g1 - g0)) << 8 | Math.round(r0 + t * (r1 - r0))) >>> 0;
   }
-  return z;
+  return lut;
 }
 
-function heatmap(div, m, title) {
-  if (!m) { Plotly.purge(div); return Promise.resolve(); }
+function decodeCodes(m) {
+  // base64 uint8 codes, row-major (rows = range bins from 0 up, cols = velocity bins)
+  const bin = atob(m.q);
+  const q = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) q[i] = bin.charCodeAt(i);
+  return q;
+}
+
+function half(a) { return a.length > 1 ? (a[1] - a[0]) / 2 : 0.5; }
+
+function heatFrame(div, m, title) {
+  // the plotly part: axes over the cells' extent, colour bar lo..hi dB
+  const dx = half(m.velocity_mps), dy = half(m.range_m);
+  const xr = [m.velocity_mps[0] - dx, m.velocity_mps[m.cols - 1] + dx];
+  const yr = [m.range_m[0] - dy, m.range_m[m.rows - 1] + dy];
   return Plotly.react(div, [{
-    type: "heatmap", z: decodeMap(m), x: m.velocity_mps, y: m.range_m,
-    zmin: m.lo, zmax: m.hi, colorscale: "Viridis", colorbar: { title: { text: "dB" }, ticklabeloverflow: "allow" },
-    hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>%{z:.1f} dB<extra></extra>",
+    type: "heatmap", z: [[m.lo, m.hi]], x: [m.velocity_mps[0], m.velocity_mps[m.cols - 1]],
+    y: [m.range_m[0]], zmin: m.lo, zmax: m.hi,
+    colorscale: "Viridis", hoverinfo: "skip",
+    colorbar: { title: { text: "dB" }, ticklabeloverflow: "allow" },
   }], {
-    title: { text: title, font: { size: 13 } }, margin: MARGIN, uirevision: div,
-    xaxis: axis("radial velocity (m/s)"), yaxis: axis("range (m)"),
+    title: { text: title, font: { size: 13 } }, margin: MARGIN, hovermode: false,
+    xaxis: axis("radial velocity (m/s)", { range: xr, fixedrange: true }),
+    yaxis: axis("range (m)", { range: yr, fixedrange: true }),
   }, CONFIG);
+}
+
+function heatCanvas(div) {
+  if (div.heat) return div.heat;
+  const canvas = document.createElement("canvas");
+  canvas.className = "heat";
+  const tip = document.createElement("span");
+  tip.className = "heat-tip";
+  div.append(canvas, tip);
+  const h = div.heat = { canvas, tip, key: null, lut: null, m: null, codes: null };
+  canvas.addEventListener("mousemove", (ev) => {
+    if (!h.m) return;
+    const box = canvas.getBoundingClientRect();
+    const c = Math.floor((ev.clientX - box.left) / box.width * h.m.cols);
+    const r = h.m.rows - 1 - Math.floor((ev.clientY - box.top) / box.height * h.m.rows);
+    if (c < 0 || r < 0 || c >= h.m.cols || r >= h.m.rows) return;
+    const db = h.m.lo + h.codes[r * h.m.cols + c] * (h.m.hi - h.m.lo) / 255;
+    tip.textContent = `v ${h.m.velocity_mps[c].toFixed(2)} m/s, r ${h.m.range_m[r].toFixed(1)} m, `
+                      + `${db.toFixed(1)} dB`;
+  });
+  canvas.addEventListener("mouseleave", () => { tip.textContent = ""; });
+  return h;
+}
+
+function placeHeat(div) {
+  // the canvas covers the plot area exactly (plotly's margins and size)
+  const h = div.heat, size = div._fullLayout && div._fullLayout._size;
+  if (!h || !size) return;
+  Object.assign(h.canvas.style, { left: `${size.l}px`, top: `${size.t}px`,
+                                  width: `${size.w}px`, height: `${size.h}px` });
+}
+
+async function heatmap(div, m, title, msg) {
+  const el = document.getElementById(div);
+  if (!m) {  // a detection-record stream: no maps, the detections in their place
+    if (el.heat) Object.assign(el.heat, { key: null, m: null, codes: null });
+    if (el.heat) el.heat.canvas.hidden = true;
+    return div === "plot-nci" ? detectionMap(div, msg) : noMap(div, title);
+  }
+  const h = heatCanvas(el);
+  const key = JSON.stringify([title, m.lo, m.hi, m.rows, m.cols, m.range_m[0],
+                              m.range_m[m.rows - 1], m.velocity_mps[0],
+                              m.velocity_mps[m.cols - 1]]);
+  if (key !== h.key) {
+    el.figureKey = null;
+    await heatFrame(el, m, title);
+    if (!h.lut) h.lut = lookupTable(el._fullData[0].colorscale);
+    if (!h.bound) { el.on("plotly_afterplot", () => placeHeat(el)); h.bound = true; }
+    placeHeat(el);
+    h.key = key;
+  }
+  const codes = decodeCodes(m);
+  if (h.canvas.width !== m.cols || h.canvas.height !== m.rows) {
+    h.canvas.width = m.cols;
+    h.canvas.height = m.rows;
+    h.image = new ImageData(m.cols, m.rows);
+  }
+  const px = new Uint32Array(h.image.data.buffer);
+  const { rows, cols } = m, lut = h.lut;
+  for (let r = 0; r < rows; r++) {  // row 0 (range 0) at the bottom
+    const src = r * cols, dst = (rows - 1 - r) * cols;
+    for (let c = 0; c < cols; c++) px[dst + c] = lut[codes[src + c]];
+  }
+  h.canvas.getContext("2d").putImageData(h.image, 0, 0);
+  h.canvas.hidden = false;
+  h.m = m;
+  h.codes = codes;
+}
+
+// Line and scatter plots: Plotly.react when the figure's frame changes (trace count, axis
+// ranges: the key), else Plotly.animate with redraw: false, plotly's fast path that moves the
+// traces' points without redrawing axes, titles and colour bars.
+const ANIMATE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false },
+                  mode: "immediate" };
+
+function update(id, traces, layout, key) {
+  const div = document.getElementById(id);
+  key = JSON.stringify([traces.length, key]);
+  if (div.figureKey === key) {
+    if (!traces.length) return Promise.resolve();
+    return Plotly.animate(div, { data: traces, traces: traces.map((_, i) => i) }, ANIMATE);
+  }
+  div.figureKey = key;
+  return Plotly.react(div, traces, layout, CONFIG);
+}
+
+function noMap(div, title) {
+  return update(div, [], {
+    title: { text: title, font: { size: 13 } }, margin: MARGIN,
+    xaxis: { visible: false }, yaxis: { visible: false },
+    annotations: [{ text: "no per-channel map in a detection-record stream", showarrow: false,
+                    xref: "paper", yref: "paper", x: 0.5, y: 0.5 }],
+  }, "no map");
+}
+
+function detectionMap(div, msg) {
+  // the cells the FPGA's CFAR passed on the integrated map, coloured by SNR
+  const p = msg.points, vmax = msg.limits.max_velocity_mps, r = msg.limits.max_range_m;
+  return update(div, [{
+    type: "scatter", mode: "markers", x: p.v, y: p.range, name: "detections",
+    marker: { size: 8, color: p.snr, cmin: 0, cmax: 40, colorscale: "Viridis",
+              line: { width: 1, color: "#222" },
+              colorbar: { title: { text: "SNR dB" }, ticklabeloverflow: "allow" } },
+    hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>SNR %{marker.color:.1f} dB<extra></extra>",
+  }], {
+    title: { text: "range-Doppler detections (record stream: no map)", font: { size: 13 } },
+    margin: MARGIN, showlegend: false,
+    xaxis: axis("radial velocity (m/s)", { range: [-vmax, vmax] }),
+    yaxis: axis("range (m)", { range: [0, r] }),
+  }, ["detections", r, vmax]);
 }
 
 function pointCloud(div, msg) {
@@ -68,26 +209,42 @@ function pointCloud(div, msg) {
                   hoverinfo: "skip", name: "labels" });
   }
   const r = msg.limits.max_range_m;
-  return Plotly.react(div, traces, {
+  return update(div, traces, {
     title: { text: "point cloud, coloured by radial velocity; GNN objects", font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "cloud",
     xaxis: axis("y (m, left +)", { range: [r / 2, -r / 2] }),
     yaxis: axis("x (m, forward)", { range: [0, r] }),
-  }, CONFIG);
+  }, [r, vmax]);
 }
 
 function profile(div, msg) {
   const pr = msg.profile;
-  if (!pr) { Plotly.purge(div); return Promise.resolve(); }
-  return Plotly.react(div, [
+  if (!pr) {  // a detection-record stream: each detection's SNR over its range
+    const p = msg.points, r = msg.limits.max_range_m;
+    const top = 10 * Math.ceil(Math.max(10, ...p.snr) / 10) + 5;
+    return update(div, [{ type: "scatter", mode: "markers", x: p.range, y: p.snr,
+                          name: "detections",
+                          marker: { color: "#c62828", size: 7, symbol: "x" } }], {
+      title: { text: "detections: SNR over range (record stream: no profile)",
+               font: { size: 13 } },
+      margin: MARGIN, showlegend: false,
+      xaxis: axis("range (m)", { range: [0, r] }), yaxis: axis("SNR (dB)", { range: [0, top] }),
+    }, ["records", r, top]);
+  }
+  // y range on a 10 dB grid: the axes stay put from frame to frame
+  let lo = Infinity, hi = -Infinity;
+  for (const v of pr.db) { if (v < lo) lo = v; if (v > hi) hi = v; }
+  const yr = [10 * Math.floor(lo / 10) - 5, 10 * Math.ceil(hi / 10) + 5];
+  const xr = [pr.range_m[0], pr.range_m[pr.range_m.length - 1]];
+  return update(div, [
     { type: "scatter", mode: "lines", x: pr.range_m, y: pr.db, name: "integrated" },
     { type: "scatter", mode: "markers", x: pr.det_range_m, y: pr.det_db, name: "detections",
       marker: { color: "#c62828", size: 7, symbol: "x" } },
   ], {
     title: { text: "range profile (all channels, all Doppler bins)", font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "profile",
-    xaxis: axis("range (m)"), yaxis: axis("power (dB)"),
-  }, CONFIG);
+    xaxis: axis("range (m)", { range: xr }), yaxis: axis("power (dB)", { range: yr }),
+  }, [xr, yr]);
 }
 
 function showHealth(h) {
@@ -134,13 +291,14 @@ async function draw(msg) {
     const input = document.getElementById("channel");
     input.max = msg.n_virtual - 1;
     await timed("rd", () => heatmap("plot-rd", msg.rd,
-                                      `range-Doppler, virtual channel ${msg.channel}`));
+                                      `range-Doppler, virtual channel ${msg.channel}`, msg));
     await timed("nci", () => heatmap("plot-nci", msg.nci,
-                                     "range-Doppler, integrated over channels"));
+                                     "range-Doppler, integrated over channels", msg));
     await timed("cloud", () => pointCloud("plot-cloud", msg));
     await timed("profile", () => profile("plot-profile", msg));
     state.frames += 1;
     state.lastSeq = msg.seq;
+    state.lastFrame = msg;
     countDraw();
   }
   showHealth(msg.health);
@@ -176,6 +334,7 @@ function connect() {
     if (channel) ws.send(JSON.stringify({ channel }));
   };
   ws.onmessage = (ev) => {
+    if (state.hold) return;
     pending = JSON.parse(ev.data);  // a message not yet drawn is replaced: newest wins
     if (!drawing) drawLoop();
   };
@@ -188,6 +347,7 @@ function connect() {
   };
 }
 
+state.drawFrame = draw;
 document.getElementById("channel").addEventListener("change", (ev) => {
   channel = Math.max(0, parseInt(ev.target.value, 10) || 0);
   if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify({ channel }));
