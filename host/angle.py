@@ -10,6 +10,7 @@ steering vector is ``steering(n, s)`` and the angle spectrum is the inverse DFT 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -108,6 +109,150 @@ def peak_sin_batch(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
 def peak_power_batch(x: np.ndarray, n_fft: int) -> np.ndarray:
     """:func:`peak_power` over the last axis of ``x``, complex (..., n_channels): float (...)."""
     return np.max(np.abs(_spectrum_unshifted(x, n_fft)) ** 2, axis=-1)
+
+
+COARSE_FFT = 128
+"""Length of the coarse angle FFT of the fast peak search (:func:`fine_peaks`)."""
+
+
+@lru_cache(maxsize=8)
+def _zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """(demodulation table complex (n_fft, n): exp(+2 pi j v k / n_fft) per fine bin k,
+    offset matrix complex (n, 2 half + 1): exp(+2 pi j v o / n_fft), o = -half..half)."""
+    v = np.arange(n)
+    demod = np.exp(2j * np.pi * np.outer(np.arange(n_fft), v) / n_fft)
+    offs = np.exp(2j * np.pi * np.outer(v, np.arange(-half, half + 1)) / n_fft)
+    return demod, offs
+
+
+def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Maximum of |angle spectrum| on the ``n_fft``-point grid, found without the
+    ``n_fft``-point FFT: a ``coarse``-point FFT picks the lobe, then the spectrum is
+    evaluated on the fine grid within one coarse bin of its peak (one small matrix product
+    after demodulating each row by its coarse peak) and the window moves uphill until the
+    maximum is inside it (the fine-grid maximum of that lobe).
+
+    x: complex (m, n). Returns (fine bin int (m,) in the unshifted order of
+    ``_spectrum_unshifted``, magnitudes float (m,) of bins k - 1, k, k + 1)."""
+    m, n = x.shape
+    coarse = min(coarse, n_fft)
+    step = n_fft // coarse
+    half = step
+    rows = np.arange(m)
+    if not m:
+        z = np.zeros(0)
+        return np.zeros(0, np.int64), z, z, z
+    kc = np.argmax(np.abs(np.fft.ifft(x, n=coarse, axis=-1)), axis=-1)
+    centre = kc * step
+    demod, offs = _zoom_tables(n, n_fft, half)
+    jb = np.zeros(m, np.int64)
+    mag = np.zeros((m, 2 * half + 1))
+    todo = rows
+    max_it = n_fft // (2 * half) + 2
+    for it in range(max_it):
+        mag_t = np.abs((x[todo] * demod[centre[todo]]) @ offs)
+        j = np.argmax(mag_t, axis=-1)
+        mag[todo] = mag_t
+        jb[todo] = j
+        edge = (j == 0) | (j == 2 * half)
+        if not edge.any() or it == max_it - 1:
+            break
+        todo = todo[edge]
+        centre[todo] = (centre[todo] + j[edge] - half) % n_fft
+    k = (centre + jb - half) % n_fft
+    b = mag[rows, jb]
+    a = mag[rows, np.clip(jb - 1, 0, 2 * half)]
+    c = mag[rows, np.clip(jb + 1, 0, 2 * half)]
+    return k, a, b, c
+
+
+def _interpolated_sin(k0: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                      n_fft: int) -> np.ndarray:
+    """sin(az) float (m,) of fine-grid peaks (unshifted bin k0 with magnitudes a, b, c at
+    k0 - 1, k0, k0 + 1): :func:`peak_sin`'s parabolic interpolation."""
+    k = (k0 + n_fft // 2) % n_fft                  # index in the fftshift order
+    den = a - 2 * b + c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, 1.0), 0.0)
+    s = 2.0 * (k + delta - n_fft // 2) / n_fft
+    return (s + 1.0) % 2.0 - 1.0
+
+
+def peak_sin_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_sin_batch` through :func:`fine_peaks` (same grid maximum, same
+    interpolation; differs only where another lobe is within the coarse grid's scalloping
+    of the strongest): (sin(az) float (m,), |peak|^2 float (m,))."""
+    k0, a, b, c = fine_peaks(x, n_fft)
+    return _interpolated_sin(k0, a, b, c, n_fft), b * b
+
+
+def peak_power_fast(x: np.ndarray, n_fft: int) -> np.ndarray:
+    """:func:`peak_power_batch` through :func:`fine_peaks`, x complex (..., n): float (...)."""
+    shape = x.shape[:-1]
+    _, _, b, _ = fine_peaks(x.reshape(-1, x.shape[-1]), n_fft)
+    return (b * b).reshape(shape)
+
+
+@dataclass(frozen=True)
+class AngleArrays:
+    """Angle components of many cells as flat arrays (one entry per component, cells in
+    order, strongest first within a cell): ``cell`` int (p,) row of the input; ``sin_az``,
+    ``snr_db`` float (p,); ``amplitude`` complex (p,)."""
+
+    cell: np.ndarray
+    sin_az: np.ndarray
+    amplitude: np.ndarray
+    snr_db: np.ndarray
+
+    @property
+    def azimuth_deg(self) -> np.ndarray:
+        return np.degrees(np.arcsin(np.clip(self.sin_az, -1.0, 1.0)))
+
+
+def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
+                         ) -> AngleArrays:
+    """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
+    (no ``n_fft``-point FFT); rows with a second component go through
+    :func:`estimate_angles` one by one, as there."""
+    xs = np.asarray(x, dtype=np.complex128)
+    n_rows, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if not n_rows:
+        z = np.zeros(0)
+        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
+    ch = np.arange(n)
+    s1, _ = peak_sin_fast(xs, params.n_fft)
+    st1 = np.exp(-1j * np.pi * s1[:, None] * ch[None, :])
+    a1 = np.sum(np.conj(st1) * xs, axis=1) / n
+    p1 = np.abs(a1) ** 2
+    more = np.zeros(n_rows, bool)
+    if params.max_targets > 1:
+        res = xs - a1[:, None] * st1
+        s2, _ = peak_sin_fast(res, params.n_fft)
+        st2 = np.exp(-1j * np.pi * s2[:, None] * ch[None, :])
+        p2 = np.abs(np.sum(np.conj(st2) * res, axis=1) / n) ** 2
+        with np.errstate(divide="ignore"):
+            snr2 = 10 * np.log10(p2 * n / noise)
+            more = (snr2 >= params.min_snr_db) & (
+                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+    snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
+    multi = np.flatnonzero(more)
+    if not len(multi):
+        return AngleArrays(np.arange(n_rows), s1, a1, snr1)
+    cell, sin_az, amp, snr = [], [], [], []
+    for i in multi:
+        for c in estimate_angles(xs[i], float(noise[i]), params):
+            cell.append(i)
+            sin_az.append(c.sin_az)
+            amp.append(c.amplitude)
+            snr.append(c.snr_db)
+    single = np.flatnonzero(~more)
+    cell_a = np.concatenate([single, np.array(cell, np.int64)])
+    order = np.argsort(cell_a, kind="stable")
+    return AngleArrays(cell_a[order], np.concatenate([s1[single], sin_az])[order],
+                       np.concatenate([a1[single], np.array(amp, complex)])[order],
+                       np.concatenate([snr1[single], snr])[order])
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams

@@ -26,7 +26,12 @@ from __future__ import annotations
 import numpy as np
 
 from host.cfar import detection_mask, local_peaks, sidelobe_masked
-from host.pipeline import DetectionParams, gaussian_offset, points_from_cells
+from host.pipeline import (
+    DetectionParams,
+    gaussian_offset,
+    points_from_cells,
+    points_from_cells_reference,
+)
 from host.pointcloud import PointCloud
 from host.records import RecordArrays
 from model.config import RadarConfig
@@ -59,8 +64,9 @@ def record_offsets(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bo
     )
     for axis, (lm, lp) in enumerate(neighbours):
         both = (lm > 0) & (lp > 0)
-        for i in np.flatnonzero(both):
-            out[i, axis] = gaussian_offset(np.log(lm[i]), np.log(c[i]), np.log(lp[i]))
+        if both.any():
+            out[both, axis] = gaussian_offset(np.log(lm[both]), np.log(c[both]),
+                                              np.log(lp[both]))
         only_p = (lp > 0) & ~both
         only_m = (lm > 0) & ~both
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -89,9 +95,11 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
 
 
 def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
-                    frame: int = 0) -> PointCloud:
+                    frame: int = 0, reference: bool = False) -> PointCloud:
     """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
-    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``."""
+    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``.
+    ``reference``: run the replaced implementation (``points_from_cells_reference``; for the
+    benchmark's old-vs-new timing)."""
     params = params or DetectionParams()
     if arr.snapshot.shape[1:] != (cfg.n_virtual,):
         raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
@@ -99,5 +107,6 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     idx, pmap = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
-    return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
+    fn = points_from_cells_reference if reference else points_from_cells
+    return fn(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                              offsets, cfg, params, frame)
