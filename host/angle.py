@@ -125,33 +125,40 @@ def _zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]
     return demod, offs
 
 
-def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT
+def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Maximum of |angle spectrum| on the ``n_fft``-point grid, found without the
-    ``n_fft``-point FFT: a ``coarse``-point FFT picks the lobe, then the spectrum is
-    evaluated on the fine grid within one coarse bin of its peak (one small matrix product
-    after demodulating each row by its coarse peak) and the window moves uphill until the
-    maximum is inside it (the fine-grid maximum of that lobe).
+    ``n_fft``-point FFT: a ``coarse``-point FFT (single precision) picks the lobe and a
+    parabolic fit a starting fine bin; the spectrum is then evaluated exactly (double
+    precision) on the 2 half + 1 fine bins around it (one small matrix product after
+    demodulating each row by the window centre) and the window moves uphill until its
+    maximum is inside it: the fine-grid maximum of that lobe, as the ``n_fft``-point FFT
+    finds it unless another lobe is within the coarse grid's scalloping of it.
 
     x: complex (m, n). Returns (fine bin int (m,) in the unshifted order of
     ``_spectrum_unshifted``, magnitudes float (m,) of bins k - 1, k, k + 1)."""
     m, n = x.shape
-    coarse = min(coarse, n_fft)
-    step = n_fft // coarse
-    half = step
-    rows = np.arange(m)
     if not m:
         z = np.zeros(0)
         return np.zeros(0, np.int64), z, z, z
-    kc = np.argmax(np.abs(np.fft.ifft(x, n=coarse, axis=-1)), axis=-1)
-    centre = kc * step
+    coarse = min(coarse, n_fft)
+    step = n_fft // coarse
+    rows = np.arange(m)
+    cm = np.abs(np.fft.ifft(x.astype(np.complex64), n=coarse, axis=-1))
+    kc = np.argmax(cm, axis=-1)
+    ca, cb, cc = cm[rows, (kc - 1) % coarse], cm[rows, kc], cm[rows, (kc + 1) % coarse]
+    den = ca - 2 * cb + cc
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(den < 0, 0.5 * (ca - cc) / np.where(den < 0, den, 1.0), 0.0)
+    centre = (kc * step + np.round(np.clip(delta, -0.5, 0.5) * step).astype(np.int64)) % n_fft
     demod, offs = _zoom_tables(n, n_fft, half)
     jb = np.zeros(m, np.int64)
     mag = np.zeros((m, 2 * half + 1))
     todo = rows
-    max_it = n_fft // (2 * half) + 2
+    max_it = n_fft // half + 2
+    xd = np.asarray(x, dtype=np.complex128)
     for it in range(max_it):
-        mag_t = np.abs((x[todo] * demod[centre[todo]]) @ offs)
+        mag_t = np.abs((xd[todo] * demod[centre[todo]]) @ offs)
         j = np.argmax(mag_t, axis=-1)
         mag[todo] = mag_t
         jb[todo] = j
