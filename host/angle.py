@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+import scipy.fft
 
 from model.config import RadarConfig
 from model.reference import angle_spectrum, tdm_phase_compensation
@@ -125,15 +126,22 @@ def _zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]
     return demod, offs
 
 
+SECOND_LOBE = 0.8
+"""A coarse local maximum at least this fraction of the coarse maximum (amplitude) is
+refined as well (two nearly equal lobes: the coarse grid's scalloping, at most 0.91 dB
+at 2x oversampling, could rank them wrongly)."""
+
+
 def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Maximum of |angle spectrum| on the ``n_fft``-point grid, found without the
-    ``n_fft``-point FFT: a ``coarse``-point FFT (single precision) picks the lobe and a
-    parabolic fit a starting fine bin; the spectrum is then evaluated exactly (double
-    precision) on the 2 half + 1 fine bins around it (one small matrix product after
-    demodulating each row by the window centre) and the window moves uphill until its
-    maximum is inside it: the fine-grid maximum of that lobe, as the ``n_fft``-point FFT
-    finds it unless another lobe is within the coarse grid's scalloping of it.
+    ``n_fft``-point FFT: a ``coarse``-point FFT (single precision) picks the lobe (the
+    runner-up lobe too when it is within ``SECOND_LOBE`` of it) and a parabolic fit a
+    starting fine bin; the spectrum is then evaluated exactly (double precision) on the
+    2 half + 1 fine bins around it (one small matrix product after demodulating each row
+    by the window centre) and the window moves uphill until its maximum is inside it: the
+    fine-grid maximum of that lobe, as the ``n_fft``-point FFT finds it unless a third lobe
+    is within the coarse grid's scalloping of it.
 
     x: complex (m, n). Returns (fine bin int (m,) in the unshifted order of
     ``_spectrum_unshifted``, magnitudes float (m,) of bins k - 1, k, k + 1)."""
@@ -142,10 +150,35 @@ def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 
         z = np.zeros(0)
         return np.zeros(0, np.int64), z, z, z
     coarse = min(coarse, n_fft)
+    rows = np.arange(m)
+    cm = np.abs(scipy.fft.ifft(x.astype(np.complex64), n=coarse, axis=-1, workers=1))
+    kc = np.argmax(cm, axis=-1)
+    xd = np.asarray(x, dtype=np.complex128)
+    k, a, b, c = _refine(xd, cm, kc, n_fft, half)   # before cm is changed below
+    # runner-up lobe: the largest coarse bin outside the first lobe's 5 bins (a shoulder of
+    # the first lobe climbs back to it: harmless)
+    first = cm[rows, kc]
+    for o in (-2, -1, 0, 1, 2):
+        cm[rows, (kc + o) % coarse] = 0.0
+    k2c = np.argmax(cm, axis=-1)
+    two = np.flatnonzero(cm[rows, k2c] >= SECOND_LOBE * first)
+    if len(two):
+        k2, a2, b2, c2 = _refine(xd[two], cm[two], k2c[two], n_fft, half)
+        better = b2 > b[two]
+        w = two[better]
+        k[w], a[w], b[w], c[w] = k2[better], a2[better], b2[better], c2[better]
+    return k, a, b, c
+
+
+def _refine(xd: np.ndarray, cm: np.ndarray, kc: np.ndarray, n_fft: int, half: int
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Fine-grid local maximum of |spectrum| of the rows of xd (complex (m, n)) uphill from
+    coarse bin kc (int (m,)) of the coarse magnitudes cm (float (m, coarse)):
+    :func:`fine_peaks`'s (k, |X(k - 1)|, |X(k)|, |X(k + 1)|)."""
+    m, n = xd.shape
+    coarse = cm.shape[1]
     step = n_fft // coarse
     rows = np.arange(m)
-    cm = np.abs(np.fft.ifft(x.astype(np.complex64), n=coarse, axis=-1))
-    kc = np.argmax(cm, axis=-1)
     ca, cb, cc = cm[rows, (kc - 1) % coarse], cm[rows, kc], cm[rows, (kc + 1) % coarse]
     den = ca - 2 * cb + cc
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -156,7 +189,6 @@ def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 
     mag = np.zeros((m, 2 * half + 1))
     todo = rows
     max_it = n_fft // half + 2
-    xd = np.asarray(x, dtype=np.complex128)
     for it in range(max_it):
         mag_t = np.abs((xd[todo] * demod[centre[todo]]) @ offs)
         j = np.argmax(mag_t, axis=-1)
@@ -194,11 +226,12 @@ def peak_sin_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     return _interpolated_sin(k0, a, b, c, n_fft), b * b
 
 
-def peak_power_fast(x: np.ndarray, n_fft: int) -> np.ndarray:
-    """:func:`peak_power_batch` through :func:`fine_peaks`, x complex (..., n): float (...)."""
+def peak_power_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_power_batch` through :func:`fine_peaks`, x complex (..., n): (peak
+    power float (...), and the peak's sin(az) float (...) as :func:`peak_sin_fast`)."""
     shape = x.shape[:-1]
-    _, _, b, _ = fine_peaks(x.reshape(-1, x.shape[-1]), n_fft)
-    return (b * b).reshape(shape)
+    k0, a, b, c = fine_peaks(x.reshape(-1, x.shape[-1]), n_fft)
+    return (b * b).reshape(shape), _interpolated_sin(k0, a, b, c, n_fft).reshape(shape)
 
 
 @dataclass(frozen=True)
@@ -217,11 +250,12 @@ class AngleArrays:
         return np.degrees(np.arcsin(np.clip(self.sin_az, -1.0, 1.0)))
 
 
-def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
-                         ) -> AngleArrays:
+def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
+                         first_sin: np.ndarray | None = None) -> AngleArrays:
     """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
     (no ``n_fft``-point FFT); rows with a second component go through
-    :func:`estimate_angles` one by one, as there."""
+    :func:`estimate_angles` one by one, as there. ``first_sin``: float (n,) the rows'
+    strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
     xs = np.asarray(x, dtype=np.complex128)
     n_rows, n = xs.shape
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
@@ -229,7 +263,7 @@ def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: A
         z = np.zeros(0)
         return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
     ch = np.arange(n)
-    s1, _ = peak_sin_fast(xs, params.n_fft)
+    s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
     st1 = np.exp(-1j * np.pi * s1[:, None] * ch[None, :])
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2

@@ -406,13 +406,20 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
     if cfg.num_tx > 1 and params.unfold_velocity:
         c = np.arange(cfg.num_tx)
         comp = _tdm_comp_fast(cfg, sb[:, None] + c[None, :] * nd)       # (n, num_tx, n_v)
-        class_power = peak_power_fast(x[:, None, :] * comp, params.angle.n_fft)
+        xc = x[:, None, :] * comp
+        class_power, class_sin = peak_power_fast(xc, params.angle.n_fft)
     else:
         class_power = np.zeros((n, 0))
     fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
     k = sb + fold * nd
-    # step 4: angles of the TDM-compensated channel vectors
-    ang = estimate_angles_fast(x * _tdm_comp_fast(cfg, k), noise / nv, params.angle)
+    # step 4: angles of the TDM-compensated channel vectors (the phasors of k are those of
+    # its class k mod num_tx n_doppler: the class's vector and peak serve)
+    if class_power.shape[1]:
+        rows, cls = np.arange(n), fold % cfg.num_tx
+        ang = estimate_angles_fast(xc[rows, cls], noise / nv, params.angle,
+                                   first_sin=class_sin[rows, cls])
+    else:
+        ang = estimate_angles_fast(x * _tdm_comp_fast(cfg, k), noise / nv, params.angle)
     velocity = (k + dd) * cfg.velocity_bin_mps
     # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
