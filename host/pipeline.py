@@ -262,10 +262,10 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
                                 params: DetectionParams, frame: int = 0) -> PointCloud:
     """The implementation :func:`points_from_cells` replaced (1024-point angle FFTs of
     every cell and TDM hypothesis, per-cell Python unfolding decision); kept for the
-    benchmark's old-vs-new timing and the tests. Point cloud of detected cells (steps 3 to 5 of the module docstring), whether they
-    come from a cube (:func:`process_cube`) or from the FPGA's records
-    (``host.record_points``). Vectorised over the cells: the angle FFTs of all cells and
-    TDM hypotheses run as batches.
+    benchmark's old-vs-new timing and the tests. Point cloud of detected cells (steps 3 to
+    5 of the module docstring), whether they come from a cube (:func:`process_cube`) or
+    from the FPGA's records (``host.record_points``). Vectorised over the cells: the angle
+    FFTs of all cells and TDM hypotheses run as batches.
 
     cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
