@@ -439,15 +439,16 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
 
 
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
-                 frame: int = 0) -> PointCloud:
-    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
+                 frame: int = 0, reference: bool = False) -> PointCloud:
+    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units).
+    ``reference``: through :func:`points_from_cells_reference` (benchmark comparison)."""
     params = params or DetectionParams()
     cfg.check_cube(cube)
     cells, noise, nci = detect_cells(cube, cfg, params)
     offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
     r, d = cells[:, 0], cells[:, 1]
-    return points_from_cells(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params,
-                             frame)
+    fn = points_from_cells_reference if reference else points_from_cells
+    return fn(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params, frame)
 
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
