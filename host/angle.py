@@ -194,7 +194,9 @@ def _refine(xd: np.ndarray, cm: np.ndarray, kc: np.ndarray, n_fft: int, half: in
         j = np.argmax(mag_t, axis=-1)
         mag[todo] = mag_t
         jb[todo] = j
-        edge = (j == 0) | (j == 2 * half)
+        # uphill only when the edge is strictly higher (ties, as in a flat or zero spectrum,
+        # stop here)
+        edge = ((j == 0) & (mag_t[:, 0] > mag_t[:, 1])) | (j == 2 * half)
         if not edge.any() or it == max_it - 1:
             break
         todo = todo[edge]

@@ -97,15 +97,17 @@ def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
 
 
 def sparse_sidelobe_masked(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
-                           margin_db: float) -> np.ndarray:
+                           margin_db: float, nonzero: tuple[np.ndarray, np.ndarray] | None = None
+                           ) -> np.ndarray:
     """``host.cfar.sidelobe_masked`` of a map that is 0 except at detected cells (the
     records' map): only detected cells of the same column / row can mask, so the test runs
     over those pairs instead of whole columns and rows (same result). pmap: float
-    (n_range, n_doppler); cells: int (m, 2). Returns bool (m,)."""
+    (n_range, n_doppler); cells: int (m, 2); ``nonzero``: (rows, columns) of pmap's
+    non-zero cells when the caller knows them. Returns bool (m,)."""
     nr, nd = pmap.shape
     env_r = sidelobe_envelope(nr, windowed[0]) * 10 ** (margin_db / 10)
     env_d = sidelobe_envelope(nd, windowed[1]) * 10 ** (margin_db / 10)
-    rr, dd = np.nonzero(pmap)
+    rr, dd = np.nonzero(pmap) if nonzero is None else nonzero
     w = pmap[rr, dd]
     r, d = cells[:, 0], cells[:, 1]
     col = _group_max(d, dd, w, np.argsort(dd, kind="stable"), env_r, r, rr)
@@ -128,8 +130,9 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
     lo, hi = cfg.detection_bins
     r, d = arr.range_bin, arr.doppler_bin
-    keep = (index[r, d] == np.arange(len(arr))) & (pmap[r, d] > 0) & (r >= lo) & (r < hi)
-    i = np.flatnonzero(keep)
+    own = (index[r, d] == np.arange(len(arr))) & (pmap[r, d] > 0)     # pmap's non-zero cells
+    nonzero = (r[own], d[own])
+    i = np.flatnonzero(own & (r >= lo) & (r < hi))
     r, d = r[i], d[i]
     p = pmap[r, d]
     mx = p.copy()
@@ -143,7 +146,8 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     i, cells = i[order], np.stack([r[order], d[order]], axis=1)
     windowed = (params.range_window, params.doppler_window)
     if params.sidelobe_margin_db is not None and len(cells):
-        i = i[~sparse_sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db)]
+        i = i[~sparse_sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db,
+                                      nonzero)]
     return i, pmap
 
 
