@@ -42,7 +42,7 @@ def _same_decode(words: np.ndarray, num_tx: int) -> None:
         np.testing.assert_array_equal(x.snapshot, y.snapshot)
 
 
-@pytest.mark.parametrize("num_tx,num_rx", [(4, 16), (1, 4), (3, 8), (2, 2)])
+@pytest.mark.parametrize("num_tx,num_rx", [(4, 16), (1, 4), (3, 8), (2, 2), (1, 1)])
 def test_decode_matches_reference_on_random_frames(num_tx: int, num_rx: int) -> None:
     rng = np.random.default_rng(num_tx * 100 + num_rx)
     cfg = get_preset("full")
