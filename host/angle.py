@@ -252,6 +252,15 @@ class AngleArrays:
         return np.degrees(np.arcsin(np.clip(self.sin_az, -1.0, 1.0)))
 
 
+def _steering_rows(s: np.ndarray, n: int) -> np.ndarray:
+    """exp(-j pi v s) for v = 0..n-1 of every s (float (m,)), complex (m, n), from 2 sqrt(n)
+    exponentials per row (exp(-j pi (a b0 + c) s) = exp(-j pi a b0 s) exp(-j pi c s))."""
+    b0 = int(np.ceil(np.sqrt(n)))
+    lo = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(b0)))            # (m, b0)
+    hi = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(-(-n // b0)) * b0))  # (m, n/b0)
+    return (hi[:, :, None] * lo[:, None, :]).reshape(len(s), -1)[:, :n]
+
+
 def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
                          first_sin: np.ndarray | None = None) -> AngleArrays:
     """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
@@ -264,16 +273,15 @@ def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: A
     if not n_rows:
         z = np.zeros(0)
         return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
-    ch = np.arange(n)
     s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
-    st1 = np.exp(-1j * np.pi * s1[:, None] * ch[None, :])
+    st1 = _steering_rows(s1, n)
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2
     more = np.zeros(n_rows, bool)
     if params.max_targets > 1:
         res = xs - a1[:, None] * st1
         s2, _ = peak_sin_fast(res, params.n_fft)
-        st2 = np.exp(-1j * np.pi * s2[:, None] * ch[None, :])
+        st2 = _steering_rows(s2, n)
         p2 = np.abs(np.sum(np.conj(st2) * res, axis=1) / n) ** 2
         with np.errstate(divide="ignore"):
             snr2 = 10 * np.log10(p2 * n / noise)

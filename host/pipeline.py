@@ -316,15 +316,23 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
         r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
 
 
-def _tdm_comp_fast(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
-    """:func:`_tdm_comp` with one complex exponential per TX instead of per virtual channel
-    (the same phasors: the phase depends on the channel's TX only), complex (..., n_virtual)."""
+def _tdm_tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
+    """:func:`_tdm_comp`'s phasors per TX, complex (..., num_tx): the phase depends on the
+    channel's TX only, so one complex exponential per TX gives the same values."""
     k = np.asarray(k)
     k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     k = signed_bin(k, cfg.n_doppler)
-    per_tx = np.exp(-2j * np.pi * np.multiply.outer(k, np.arange(cfg.num_tx))
-                    / (cfg.n_doppler * cfg.num_tx))
-    return per_tx[..., np.arange(cfg.n_virtual) // cfg.num_rx]
+    return np.exp(-2j * np.pi * np.multiply.outer(k, np.arange(cfg.num_tx))
+                  / (cfg.n_doppler * cfg.num_tx))
+
+
+def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """x complex (n, n_virtual) times :func:`_tdm_comp` of k (int (n,) or (n, h)) without
+    forming the per-channel phasors: complex (n, n_virtual) or (n, h, n_virtual)."""
+    ph = _tdm_tx_phasors(cfg, k)                                   # (n, [h,] num_tx)
+    n = len(x)
+    xt = x.reshape(n, *([1] * (ph.ndim - 2)), cfg.num_tx, cfg.num_rx)
+    return (xt * ph[..., None]).reshape(*ph.shape[:-1], cfg.n_virtual)
 
 
 def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.ndarray,
@@ -405,8 +413,7 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
     # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
     if cfg.num_tx > 1 and params.unfold_velocity:
         c = np.arange(cfg.num_tx)
-        comp = _tdm_comp_fast(cfg, sb[:, None] + c[None, :] * nd)       # (n, num_tx, n_v)
-        xc = x[:, None, :] * comp
+        xc = _tdm_compensate(cfg, x, sb[:, None] + c[None, :] * nd)    # (n, num_tx, n_v)
         class_power, class_sin = peak_power_fast(xc, params.angle.n_fft)
     else:
         class_power = np.zeros((n, 0))
@@ -419,7 +426,7 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
         ang = estimate_angles_fast(xc[rows, cls], noise / nv, params.angle,
                                    first_sin=class_sin[rows, cls])
     else:
-        ang = estimate_angles_fast(x * _tdm_comp_fast(cfg, k), noise / nv, params.angle)
+        ang = estimate_angles_fast(_tdm_compensate(cfg, x, k), noise / nv, params.angle)
     velocity = (k + dd) * cfg.velocity_bin_mps
     # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
