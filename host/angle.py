@@ -185,15 +185,18 @@ def _refine(xd: np.ndarray, cm: np.ndarray, kc: np.ndarray, n_fft: int, half: in
         delta = np.where(den < 0, 0.5 * (ca - cc) / np.where(den < 0, den, 1.0), 0.0)
     centre = (kc * step + np.round(np.clip(delta, -0.5, 0.5) * step).astype(np.int64)) % n_fft
     demod, offs = _zoom_tables(n, n_fft, half)
-    jb = np.zeros(m, np.int64)
-    mag = np.zeros((m, 2 * half + 1))
     todo = rows
     max_it = n_fft // half + 2
     for it in range(max_it):
-        mag_t = np.abs((xd[todo] * demod[centre[todo]]) @ offs)
-        j = np.argmax(mag_t, axis=-1)
-        mag[todo] = mag_t
-        jb[todo] = j
+        if it == 0:             # all rows: no gathers
+            mag = np.abs((xd * demod[centre]) @ offs)
+            j = jb = np.argmax(mag, axis=-1)
+            mag_t = mag
+        else:
+            mag_t = np.abs((xd[todo] * demod[centre[todo]]) @ offs)
+            j = np.argmax(mag_t, axis=-1)
+            mag[todo] = mag_t
+            jb[todo] = j
         # uphill only when the edge is strictly higher (ties, as in a flat or zero spectrum,
         # stop here)
         edge = ((j == 0) & (mag_t[:, 0] > mag_t[:, 1])) | (j == 2 * half)
