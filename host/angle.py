@@ -10,8 +10,10 @@ steering vector is ``steering(n, s)`` and the angle spectrum is the inverse DFT 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
+import scipy.fft
 
 from model.config import RadarConfig
 from model.reference import angle_spectrum, tdm_phase_compensation
@@ -108,6 +110,203 @@ def peak_sin_batch(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
 def peak_power_batch(x: np.ndarray, n_fft: int) -> np.ndarray:
     """:func:`peak_power` over the last axis of ``x``, complex (..., n_channels): float (...)."""
     return np.max(np.abs(_spectrum_unshifted(x, n_fft)) ** 2, axis=-1)
+
+
+COARSE_FFT = 128
+"""Length of the coarse angle FFT of the fast peak search (:func:`fine_peaks`)."""
+
+
+@lru_cache(maxsize=8)
+def _zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """(demodulation table complex (n_fft, n): exp(+2 pi j v k / n_fft) per fine bin k,
+    offset matrix complex (n, 2 half + 1): exp(+2 pi j v o / n_fft), o = -half..half)."""
+    v = np.arange(n)
+    demod = np.exp(2j * np.pi * np.outer(np.arange(n_fft), v) / n_fft)
+    offs = np.exp(2j * np.pi * np.outer(v, np.arange(-half, half + 1)) / n_fft)
+    return demod, offs
+
+
+SECOND_LOBE = 0.8
+"""A coarse local maximum at least this fraction of the coarse maximum (amplitude) is
+refined as well (two nearly equal lobes: the coarse grid's scalloping, at most 0.91 dB
+at 2x oversampling, could rank them wrongly)."""
+
+
+def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Maximum of |angle spectrum| on the ``n_fft``-point grid, found without the
+    ``n_fft``-point FFT: a ``coarse``-point FFT (single precision) picks the lobe (the
+    runner-up lobe too when it is within ``SECOND_LOBE`` of it) and a parabolic fit a
+    starting fine bin; the spectrum is then evaluated exactly (double precision) on the
+    2 half + 1 fine bins around it (one small matrix product after demodulating each row
+    by the window centre) and the window moves uphill until its maximum is inside it: the
+    fine-grid maximum of that lobe, as the ``n_fft``-point FFT finds it unless a third lobe
+    is within the coarse grid's scalloping of it.
+
+    x: complex (m, n). Returns (fine bin int (m,) in the unshifted order of
+    ``_spectrum_unshifted``, magnitudes float (m,) of bins k - 1, k, k + 1)."""
+    m, n = x.shape
+    if not m:
+        z = np.zeros(0)
+        return np.zeros(0, np.int64), z, z, z
+    coarse = min(coarse, n_fft)
+    rows = np.arange(m)
+    cm = np.abs(scipy.fft.ifft(x.astype(np.complex64), n=coarse, axis=-1, workers=1))
+    kc = np.argmax(cm, axis=-1)
+    xd = np.asarray(x, dtype=np.complex128)
+    k, a, b, c = _refine(xd, cm, kc, n_fft, half)   # before cm is changed below
+    # runner-up lobe: the largest coarse bin outside the first lobe's 5 bins (a shoulder of
+    # the first lobe climbs back to it: harmless)
+    first = cm[rows, kc]
+    for o in (-2, -1, 0, 1, 2):
+        cm[rows, (kc + o) % coarse] = 0.0
+    k2c = np.argmax(cm, axis=-1)
+    two = np.flatnonzero(cm[rows, k2c] >= SECOND_LOBE * first)
+    if len(two):
+        k2, a2, b2, c2 = _refine(xd[two], cm[two], k2c[two], n_fft, half)
+        better = b2 > b[two]
+        w = two[better]
+        k[w], a[w], b[w], c[w] = k2[better], a2[better], b2[better], c2[better]
+    return k, a, b, c
+
+
+def _refine(xd: np.ndarray, cm: np.ndarray, kc: np.ndarray, n_fft: int, half: int
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Fine-grid local maximum of |spectrum| of the rows of xd (complex (m, n)) uphill from
+    coarse bin kc (int (m,)) of the coarse magnitudes cm (float (m, coarse)):
+    :func:`fine_peaks`'s (k, |X(k - 1)|, |X(k)|, |X(k + 1)|)."""
+    m, n = xd.shape
+    coarse = cm.shape[1]
+    step = n_fft // coarse
+    rows = np.arange(m)
+    ca, cb, cc = cm[rows, (kc - 1) % coarse], cm[rows, kc], cm[rows, (kc + 1) % coarse]
+    den = ca - 2 * cb + cc
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(den < 0, 0.5 * (ca - cc) / np.where(den < 0, den, 1.0), 0.0)
+    centre = (kc * step + np.round(np.clip(delta, -0.5, 0.5) * step).astype(np.int64)) % n_fft
+    demod, offs = _zoom_tables(n, n_fft, half)
+    todo = rows
+    max_it = n_fft // half + 2
+    for it in range(max_it):
+        if it == 0:             # all rows: no gathers
+            mag = np.abs((xd * demod[centre]) @ offs)
+            j = jb = np.argmax(mag, axis=-1)
+            mag_t = mag
+        else:
+            mag_t = np.abs((xd[todo] * demod[centre[todo]]) @ offs)
+            j = np.argmax(mag_t, axis=-1)
+            mag[todo] = mag_t
+            jb[todo] = j
+        # uphill only when the edge is strictly higher (ties, as in a flat or zero spectrum,
+        # stop here)
+        edge = ((j == 0) & (mag_t[:, 0] > mag_t[:, 1])) | (j == 2 * half)
+        if not edge.any() or it == max_it - 1:
+            break
+        todo = todo[edge]
+        centre[todo] = (centre[todo] + j[edge] - half) % n_fft
+    k = (centre + jb - half) % n_fft
+    b = mag[rows, jb]
+    a = mag[rows, np.clip(jb - 1, 0, 2 * half)]
+    c = mag[rows, np.clip(jb + 1, 0, 2 * half)]
+    return k, a, b, c
+
+
+def _interpolated_sin(k0: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                      n_fft: int) -> np.ndarray:
+    """sin(az) float (m,) of fine-grid peaks (unshifted bin k0 with magnitudes a, b, c at
+    k0 - 1, k0, k0 + 1): :func:`peak_sin`'s parabolic interpolation."""
+    k = (k0 + n_fft // 2) % n_fft                  # index in the fftshift order
+    den = a - 2 * b + c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, 1.0), 0.0)
+    s = 2.0 * (k + delta - n_fft // 2) / n_fft
+    return (s + 1.0) % 2.0 - 1.0
+
+
+def peak_sin_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_sin_batch` through :func:`fine_peaks` (same grid maximum, same
+    interpolation; differs only where another lobe is within the coarse grid's scalloping
+    of the strongest): (sin(az) float (m,), |peak|^2 float (m,))."""
+    k0, a, b, c = fine_peaks(x, n_fft)
+    return _interpolated_sin(k0, a, b, c, n_fft), b * b
+
+
+def peak_power_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_power_batch` through :func:`fine_peaks`, x complex (..., n): (peak
+    power float (...), and the peak's sin(az) float (...) as :func:`peak_sin_fast`)."""
+    shape = x.shape[:-1]
+    k0, a, b, c = fine_peaks(x.reshape(-1, x.shape[-1]), n_fft)
+    return (b * b).reshape(shape), _interpolated_sin(k0, a, b, c, n_fft).reshape(shape)
+
+
+@dataclass(frozen=True)
+class AngleArrays:
+    """Angle components of many cells as flat arrays (one entry per component, cells in
+    order, strongest first within a cell): ``cell`` int (p,) row of the input; ``sin_az``,
+    ``snr_db`` float (p,); ``amplitude`` complex (p,)."""
+
+    cell: np.ndarray
+    sin_az: np.ndarray
+    amplitude: np.ndarray
+    snr_db: np.ndarray
+
+    @property
+    def azimuth_deg(self) -> np.ndarray:
+        return np.degrees(np.arcsin(np.clip(self.sin_az, -1.0, 1.0)))
+
+
+def _steering_rows(s: np.ndarray, n: int) -> np.ndarray:
+    """exp(-j pi v s) for v = 0..n-1 of every s (float (m,)), complex (m, n), from 2 sqrt(n)
+    exponentials per row (exp(-j pi (a b0 + c) s) = exp(-j pi a b0 s) exp(-j pi c s))."""
+    b0 = int(np.ceil(np.sqrt(n)))
+    lo = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(b0)))            # (m, b0)
+    hi = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(-(-n // b0)) * b0))  # (m, n/b0)
+    return (hi[:, :, None] * lo[:, None, :]).reshape(len(s), -1)[:, :n]
+
+
+def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
+                         first_sin: np.ndarray | None = None) -> AngleArrays:
+    """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
+    (no ``n_fft``-point FFT); rows with a second component go through
+    :func:`estimate_angles` one by one, as there. ``first_sin``: float (n,) the rows'
+    strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
+    xs = np.asarray(x, dtype=np.complex128)
+    n_rows, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if not n_rows:
+        z = np.zeros(0)
+        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
+    s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
+    st1 = _steering_rows(s1, n)
+    a1 = np.sum(np.conj(st1) * xs, axis=1) / n
+    p1 = np.abs(a1) ** 2
+    more = np.zeros(n_rows, bool)
+    if params.max_targets > 1:
+        res = xs - a1[:, None] * st1
+        s2, _ = peak_sin_fast(res, params.n_fft)
+        st2 = _steering_rows(s2, n)
+        p2 = np.abs(np.sum(np.conj(st2) * res, axis=1) / n) ** 2
+        with np.errstate(divide="ignore"):
+            snr2 = 10 * np.log10(p2 * n / noise)
+            more = (snr2 >= params.min_snr_db) & (
+                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+    snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
+    multi = np.flatnonzero(more)
+    if not len(multi):
+        return AngleArrays(np.arange(n_rows), s1, a1, snr1)
+    cell, sin_az, amp, snr = [], [], [], []
+    for i in multi:
+        for c in estimate_angles(xs[i], float(noise[i]), params):
+            cell.append(i)
+            sin_az.append(c.sin_az)
+            amp.append(c.amplitude)
+            snr.append(c.snr_db)
+    single = np.flatnonzero(~more)
+    cell_a = np.concatenate([single, np.array(cell, np.int64)])
+    order = np.argsort(cell_a, kind="stable")
+    return AngleArrays(cell_a[order], np.concatenate([s1[single], sin_az])[order],
+                       np.concatenate([a1[single], np.array(amp, complex)])[order],
+                       np.concatenate([snr1[single], snr])[order])
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams

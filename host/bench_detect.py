@@ -11,8 +11,10 @@ cost on the link and on the host. Prints four tables:
 3. link: bytes per frame and Mbit/s at 111 frames/s of the record stream for ``full`` with
    10, 100, 1000 detections (measured on encoded, packetized frames) vs the radar cube
    (goal: fits the paper's measured 766 Mbit/s);
-4. host time per frame for 1000 detections on one core: DMA bytes -> records (decoder) and
-   records -> point cloud (goal <= 5 ms).
+4. host time per frame for 10, 100, 1000 detections on one core, CPU and wall, the replaced
+   code ("old") beside the current one in the same run: DMA bytes -> records (decoder) and
+   records -> point cloud (goal <= 5 ms for 1000). Table 1 also gives the azimuth errors of
+   both, and in how many scenes old and new clouds agree.
 
     python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
 
@@ -27,10 +29,10 @@ import math
 import os
 import time
 from collections.abc import Callable
+from dataclasses import fields
 
 import numpy as np
 
-from host.angle import AngleParams
 from host.cfar import CfarParams
 from host.evaluate import match_targets
 from host.pipeline import DetectionParams, process_cube
@@ -58,9 +60,12 @@ UDP_PACKET_WORDS = {"full": 1022, "paper-fpga": 4093}
 
 
 def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
-                dcfg: DetectConfig) -> tuple[PointCloud, PointCloud, int]:
+                dcfg: DetectConfig, reference: bool = False
+                ) -> tuple[PointCloud, PointCloud, int] | tuple[PointCloud, PointCloud, int,
+                                                                PointCloud, PointCloud]:
     """Point clouds of one ADC frame through the host CFAR (cube) and the on-chip detector
-    (records, as bytes through the decoder), and the FPGA's detection count."""
+    (records, as bytes through the decoder), and the FPGA's detection count; with
+    ``reference`` also both clouds through the replaced host code (``*_reference``)."""
     chain = PipelineParams(output_mode=1, detect=dcfg)
     out = run_chain(adc, cfg, chain)                   # mode 1: the cube and the records
     gain = chain_gain(cfg, chain)
@@ -69,8 +74,14 @@ def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
     frames = [f for p in packetize_stream([out.records], chain.packet_words)
               for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
     f = frames[0]
-    fpga = process_records(record_arrays(f.records, cfg.n_virtual, gain), cfg, params)
-    return host, fpga, f.detections
+    arr = record_arrays(f.records, cfg.n_virtual, gain)
+    fpga = process_records(arr, cfg, params)
+    if not reference:
+        return host, fpga, f.detections
+    host_ref = process_cube(out.cube().astype(np.complex64) / gain, cfg, params,
+                            reference=True)
+    return host, fpga, f.detections, host_ref, process_records(arr, cfg, params,
+                                                               reference=True)
 
 
 def random_scene(preset: str, seed: int) -> Scene:
@@ -95,11 +106,20 @@ def detection_rows(scenes: list[Scene]) -> dict[str, float]:
     n = host_found = fpga_found = both = fpga_only = 0
     err_host: list[float] = []
     err_fpga: list[float] = []
+    az: dict[str, list[float]] = {"host": [], "fpga": [], "host_ref": [], "fpga_ref": []}
+    same = 0
     for sc in scenes:
         cfg = sc.config
         params = DetectionParams()
         dcfg = fpga_detect_config(cfg, params.cfar)
-        host, fpga, _ = _both_paths(simulate_scene(sc).samples, cfg, params, dcfg)
+        host, fpga, _, host_ref, fpga_ref = _both_paths(  # type: ignore[misc]
+            simulate_scene(sc).samples, cfg, params, dcfg, reference=True)
+        same += _same_cloud(fpga, fpga_ref) and _same_cloud(host, host_ref)
+        for name, cloud in (("host", host), ("fpga", fpga), ("host_ref", host_ref),
+                            ("fpga_ref", fpga_ref)):
+            az[name] += [abs(m.azimuth_err_deg) for m in match_targets(cloud, sc.targets,
+                                                                       cfg)[0]
+                         if m.index >= 0]
         mh, _ = match_targets(host, sc.targets, cfg)
         mf, _ = match_targets(fpga, sc.targets, cfg)
         for a, b in zip(mh, mf, strict=True):
@@ -111,7 +131,9 @@ def detection_rows(scenes: list[Scene]) -> dict[str, float]:
             if a.index >= 0 and b.index >= 0:
                 err_host.append(abs(a.range_err_m))
                 err_fpga.append(abs(b.range_err_m))
-    return {"targets": n, "host": host_found, "fpga": fpga_found,
+    azm = {f"az_{k}": float(np.mean(v)) if v else float("nan") for k, v in az.items()}
+    return {**azm, "same_clouds": same, "scenes": len(scenes),
+            "targets": n, "host": host_found, "fpga": fpga_found,
             "agree": 100.0 * both / max(host_found, 1), "fpga_only": fpga_only,
             "rerr_host": float(np.mean(err_host)) if err_host else float("nan"),
             "rerr_fpga": float(np.mean(err_fpga)) if err_fpga else float("nan")}
@@ -180,34 +202,53 @@ def link_rows(preset: str, counts: tuple[int, ...]) -> list[tuple[str, int, floa
     return rows
 
 
-def _best_ms(fn: Callable[[], object], repeat: int) -> float:
-    best = math.inf
+def _same_cloud(a: PointCloud, b: PointCloud, tol: float = 1e-6) -> bool:
+    """Same points (bins, flags exactly; float fields within ``tol``)."""
+    if len(a) != len(b):
+        return False
+    for f in fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if x.dtype.kind in "fc":
+            if not np.allclose(x, y, rtol=tol, atol=tol, equal_nan=True):
+                return False
+        elif not np.array_equal(x, y):
+            return False
+    return True
+
+
+def _best_ms(fn: Callable[[], object], repeat: int) -> tuple[float, float]:
+    """(CPU ms, wall ms) of ``fn``, each the best of ``repeat`` runs."""
+    cpu = wall = math.inf
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         fn()
-        best = min(best, time.perf_counter() - t0)
-    return best * 1e3
+        cpu = min(cpu, time.process_time() - c0)
+        wall = min(wall, time.perf_counter() - t0)
+    return cpu * 1e3, wall * 1e3
 
 
-def host_time_rows(preset: str, n: int, repeat: int, n_fft: int = AngleParams.n_fft
-                   ) -> tuple[float, float, int]:
-    """(decode ms, records -> point cloud ms, points) for one frame of ``n`` records, angle
-    FFTs of ``n_fft`` points (the default, or coarser to show what they cost)."""
+def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False
+                   ) -> tuple[tuple[float, float], tuple[float, float], int]:
+    """((CPU, wall) ms of DMA bytes -> record arrays, (CPU, wall) ms of records -> point
+    cloud, points) for one frame of ``n`` synthetic records; ``reference``: through the
+    replaced code (per-record ``decode_frame_reference``, map-based record selection,
+    ``points_from_cells_reference`` with its 1024-point FFTs and per-cell decisions)."""
     cfg = get_preset(preset)
-    params = DetectionParams(angle=AngleParams(n_fft=n_fft))
+    params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
     frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)
     packets = [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[preset])]
     gain = chain_gain(cfg, PipelineParams())
 
     def decode() -> object:
-        dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[preset])
+        dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[preset], reference=reference)
         got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
         return record_arrays(got[0].records, cfg.n_virtual, gain)
 
     arr = decode()
     t_dec = _best_ms(decode, repeat)
-    t_pc = _best_ms(lambda: process_records(arr, cfg, params), repeat)  # type: ignore[arg-type]
+    t_pc = _best_ms(lambda: process_records(arr, cfg, params,  # type: ignore[arg-type]
+                                            reference=reference), repeat)
     return t_dec, t_pc, len(process_records(arr, cfg, params))  # type: ignore[arg-type]
 
 
@@ -226,8 +267,9 @@ def main() -> None:
 
     print("## Detection: --detect fpga (on-chip CFAR, records) vs --detect host (cube)")
     print("| scenes | true targets | found, host | found, fpga | fpga finds of host's | "
-          "fpga only | mean range err host / fpga (m) |")
-    print("|---|---|---|---|---|---|---|")
+          "fpga only | mean range err host / fpga (m) | mean az err host / fpga (deg), "
+          "new | the same, old host code | scenes with old = new clouds |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     groups = [("Table I, full", [table1_scene("full")]),
               (f"{args.scenes} random, paper-fpga",
                [random_scene("paper-fpga", s) for s in range(args.scenes)]),
@@ -238,7 +280,9 @@ def main() -> None:
             continue
         r = detection_rows(scenes)
         print(f"| {name} | {r['targets']} | {r['host']} | {r['fpga']} | {r['agree']:.1f} % | "
-              f"{r['fpga_only']} | {r['rerr_host']:.2f} / {r['rerr_fpga']:.2f} |")
+              f"{r['fpga_only']} | {r['rerr_host']:.2f} / {r['rerr_fpga']:.2f} | "
+              f"{r['az_host']:.3f} / {r['az_fpga']:.3f} | {r['az_host_ref']:.3f} / "
+              f"{r['az_fpga_ref']:.3f} | {r['same_clouds']} of {r['scenes']} |")
 
     print(f"\n## False alarms, {args.noise_frames} noise-only paper-fpga frames (fixed-point "
           f"chain; per reportable cell)")
@@ -255,17 +299,18 @@ def main() -> None:
     for what, b, mbps in link_rows("full", (10, 100, 1000)):
         print(f"| {what} | {b:,} | {mbps:,.1f} | {'yes' if mbps <= LINK_MBPS else 'no'} |")
 
-    print("\n## Host time per full frame, 1000 detections, one core (best of "
-          f"{args.repeat})")
-    print("| step | ms |")
-    print("|---|---|")
-    t_dec, t_pc, pts = host_time_rows("full", 1000, args.repeat)
-    print(f"| DMA bytes -> records (decoder) | {t_dec:.1f} |")
-    print(f"| records -> point cloud ({pts} points) | {t_pc:.1f} |")
-    print(f"| total | {t_dec + t_pc:.1f} |")
-    _, t_256, pts = host_time_rows("full", 1000, args.repeat, n_fft=256)
-    print(f"| records -> point cloud, 256-point angle FFTs instead of "
-          f"{AngleParams.n_fft} ({pts} points) | {t_256:.1f} |")
+    print(f"\n## Host time per full frame, one core (best of {args.repeat}; CPU = "
+          f"process_time, wall = perf_counter; old = the replaced code, same run)")
+    print("| detections | step | old CPU ms | new CPU ms | old wall ms | new wall ms | "
+          "CPU speed-up |")
+    print("|---|---|---|---|---|---|---|")
+    for n in (10, 100, 1000):
+        od, op, _ = host_time_rows("full", n, args.repeat, reference=True)
+        nd_, np_, pts = host_time_rows("full", n, args.repeat)
+        for step, o, w in (("DMA bytes -> records", od, nd_),
+                           (f"records -> point cloud ({pts} points)", op, np_)):
+            print(f"| {n} | {step} | {o[0]:.2f} | {w[0]:.2f} | {o[1]:.2f} | {w[1]:.2f} | "
+                  f"{o[0] / max(w[0], 1e-9):.1f}x |")
 
 
 if __name__ == "__main__":

@@ -33,7 +33,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from host.angle import AngleParams, estimate_angles_batch, peak_power_batch
+from host.angle import (
+    AngleParams,
+    estimate_angles_batch,
+    estimate_angles_fast,
+    peak_power_batch,
+    peak_power_fast,
+)
 from host.cfar import (
     CfarParams,
     cfar_threshold,
@@ -48,6 +54,7 @@ from model.config import RadarConfig, dbm_to_w
 from model.reference import (
     radar_cube,
     range_doppler_power,
+    signed_bin,
     signed_bins,
     tdm_phase_compensation,
 )
@@ -250,13 +257,15 @@ def peak_offsets(logp: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.stack([dr, dd], axis=1).reshape(len(cells), 2)
 
 
-def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
-                      noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
-                      params: DetectionParams, frame: int = 0) -> PointCloud:
-    """Point cloud of detected cells (steps 3 to 5 of the module docstring), whether they
-    come from a cube (:func:`process_cube`) or from the FPGA's records
-    (``host.record_points``). Vectorised over the cells: the angle FFTs of all cells and
-    TDM hypotheses run as batches.
+def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
+                                noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
+                                params: DetectionParams, frame: int = 0) -> PointCloud:
+    """The implementation :func:`points_from_cells` replaced (1024-point angle FFTs of
+    every cell and TDM hypothesis, per-cell Python unfolding decision); kept for the
+    benchmark's old-vs-new timing and the tests. Point cloud of detected cells (steps 3 to
+    5 of the module docstring), whether they come from a cube (:func:`process_cube`) or
+    from the FPGA's records (``host.record_points``). Vectorised over the cells: the angle
+    FFTs of all cells and TDM hypotheses run as batches.
 
     cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
@@ -307,16 +316,146 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
         r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
 
 
+def _tdm_tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
+    """:func:`_tdm_comp`'s phasors per TX, complex (..., num_tx): the phase depends on the
+    channel's TX only, so one complex exponential per TX gives the same values."""
+    k = np.asarray(k)
+    k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
+    k = signed_bin(k, cfg.n_doppler)
+    return np.exp(-2j * np.pi * np.multiply.outer(k, np.arange(cfg.num_tx))
+                  / (cfg.n_doppler * cfg.num_tx))
+
+
+def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """x complex (n, n_virtual) times :func:`_tdm_comp` of k (int (n,) or (n, h)) without
+    forming the per-channel phasors: complex (n, n_virtual) or (n, h, n_virtual)."""
+    ph = _tdm_tx_phasors(cfg, k)                                   # (n, [h,] num_tx)
+    n = len(x)
+    xt = x.reshape(n, *([1] * (ph.ndim - 2)), cfg.num_tx, cfg.num_rx)
+    return (xt * ph[..., None]).reshape(*ph.shape[:-1], cfg.n_virtual)
+
+
+def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.ndarray,
+                 snr_db: np.ndarray, params: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_choose_fold` of every cell at once: (alias order int (n,), ambiguous bool (n,)).
+    class_power: float (n, num_tx) (``_class_powers``; (n, 0) when the TDM test does not
+    run); velocity_mps, snr_db: float (n,)."""
+    n = len(velocity_mps)
+    v = np.asarray(velocity_mps, dtype=float)
+    period = 2.0 * cfg.max_velocity_mps
+    lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
+    hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
+    m_lo = int(min(lo.min(initial=0), 0))
+    m_hi = int(max(hi.max(initial=0), 0))
+    ms = np.arange(m_lo, m_hi + 1)                                       # (h,)
+    hyp = (ms[None, :] >= lo[:, None]) & (ms[None, :] <= hi[:, None])    # (n, h)
+    none = ~hyp.any(axis=1)
+    hyp[none, ms.tolist().index(0)] = True                               # "or [0]"
+    count = hyp.sum(axis=1)
+    ntx = cfg.num_tx
+    if ntx > 1 and params.unfold_velocity and class_power.shape[1] == ntx:
+        run = count > 1
+        cls = ms % ntx                                                   # (h,)
+        present = np.zeros((n, ntx), bool)
+        for c in range(ntx):
+            present[:, c] = (hyp & (cls == c)[None, :]).any(axis=1)
+        p = np.where(present, class_power, -np.inf)
+        margin = 10 ** (params.unfold_margin_db / 10)
+        rows = np.arange(n)
+
+        def beats(best: np.ndarray) -> np.ndarray:
+            others = p.copy()
+            others[rows, best] = -np.inf
+            mo = others.max(axis=1)
+            return (mo == -np.inf) | (p[rows, best] >= margin * mo)
+
+        best = np.argmax(p, axis=1)
+        beats_all = beats(best)
+        back = (best != 0) & ~(beats_all & (snr_db >= params.unfold_min_snr_db))
+        best = np.where(back & present[:, 0], 0, best)
+        beats_all = np.where(back, beats(best), beats_all)
+        keep = run & beats_all
+        hyp = np.where(keep[:, None], hyp & (cls[None, :] == best[:, None]), hyp)
+        count = hyp.sum(axis=1)
+    dist = np.where(hyp, np.abs(v[:, None] + 2.0 * ms[None, :] * cfg.max_velocity_mps),
+                    np.inf)
+    m = ms[np.argmin(dist, axis=1)]
+    return m, (count > 1) | (m != 0)
+
+
+def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
+                      noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
+                      params: DetectionParams, frame: int = 0) -> PointCloud:
+    """Point cloud of detected cells (steps 3 to 5 of the module docstring), whether they
+    come from a cube (:func:`process_cube`) or from the FPGA's records
+    (``host.record_points``). Vectorised over the cells: the TDM hypotheses' phasors, their
+    angle peaks (coarse FFT + fine-grid search, ``host.angle.fine_peaks``, the same peaks as
+    ``AngleParams.n_fft``-point FFTs), the unfolding decision (:func:`choose_folds`) and
+    the angles run on all cells at once.
+
+    cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
+    (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
+    power: float (n,) non-coherent power sum_v |x_v|^2; noise: float (n,) mean noise power
+    per cell of the non-coherent map; offsets: float (n, 2) fractional (range, Doppler)
+    offsets of the peak from the cell centre, bins.
+    """
+    n = len(cells)
+    if not n:
+        return PointCloud.empty()
+    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
+    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
+    x = np.asarray(snapshots)
+    noise = np.asarray(noise, dtype=float)
+    dr, dd = offsets[:, 0], offsets[:, 1]
+    sb = signed_bins(nd)[d].astype(np.int64)
+    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    measured = (sb + dd) * cfg.velocity_bin_mps
+    # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
+    if cfg.num_tx > 1 and params.unfold_velocity:
+        c = np.arange(cfg.num_tx)
+        xc = _tdm_compensate(cfg, x, sb[:, None] + c[None, :] * nd)    # (n, num_tx, n_v)
+        class_power, class_sin = peak_power_fast(xc, params.angle.n_fft)
+    else:
+        class_power = np.zeros((n, 0))
+    fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
+    k = sb + fold * nd
+    # step 4: angles of the TDM-compensated channel vectors (the phasors of k are those of
+    # its class k mod num_tx n_doppler: the class's vector and peak serve)
+    if class_power.shape[1]:
+        rows, cls = np.arange(n), fold % cfg.num_tx
+        ang = estimate_angles_fast(xc[rows, cls], noise / nv, params.angle,
+                                   first_sin=class_sin[rows, cls])
+    else:
+        ang = estimate_angles_fast(_tdm_compensate(cfg, x, k), noise / nv, params.angle)
+    velocity = (k + dd) * cfg.velocity_bin_mps
+    # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
+    coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
+    range_m = (r + dr - coupling) * cfg.range_bin_m
+    scallop = _window_response(nr, dr, params.range_window) * _window_response(
+        nd, dd, params.doppler_window)
+    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
+    # step 5: one point per angle component
+    cell = ang.cell
+    az = ang.azimuth_deg
+    amp = np.abs(ang.amplitude)
+    amp_adc = amp / (cg * scallop[cell])
+    rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
+    return PointCloud.from_polar(
+        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), ang.snr_db,
+        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
+
+
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
-                 frame: int = 0) -> PointCloud:
-    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units)."""
+                 frame: int = 0, reference: bool = False) -> PointCloud:
+    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units).
+    ``reference``: through :func:`points_from_cells_reference` (benchmark comparison)."""
     params = params or DetectionParams()
     cfg.check_cube(cube)
     cells, noise, nci = detect_cells(cube, cfg, params)
     offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
     r, d = cells[:, 0], cells[:, 1]
-    return points_from_cells(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params,
-                             frame)
+    fn = points_from_cells_reference if reference else points_from_cells
+    return fn(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params, frame)
 
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,

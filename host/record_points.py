@@ -25,8 +25,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from host.cfar import detection_mask, local_peaks, sidelobe_masked
-from host.pipeline import DetectionParams, gaussian_offset, points_from_cells
+from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
+from host.pipeline import (
+    DetectionParams,
+    gaussian_offset,
+    points_from_cells,
+    points_from_cells_reference,
+)
 from host.pointcloud import PointCloud
 from host.records import RecordArrays
 from model.config import RadarConfig
@@ -59,8 +64,9 @@ def record_offsets(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bo
     )
     for axis, (lm, lp) in enumerate(neighbours):
         both = (lm > 0) & (lp > 0)
-        for i in np.flatnonzero(both):
-            out[i, axis] = gaussian_offset(np.log(lm[i]), np.log(c[i]), np.log(lp[i]))
+        if both.any():
+            out[both, axis] = gaussian_offset(np.log(lm[both]), np.log(c[both]),
+                                              np.log(lp[both]))
         only_p = (lp > 0) & ~both
         only_m = (lm > 0) & ~both
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -71,10 +77,84 @@ def record_offsets(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bo
     return out
 
 
+def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
+               order: np.ndarray, env: np.ndarray, pos_q: np.ndarray, pos_all: np.ndarray
+               ) -> np.ndarray:
+    """max over cells j with key_all[j] == key_q[i] of weight[j] * env[(pos_q[i] -
+    pos_all[j]) mod len(env)], float (m,) (0 when there is none); ``order``: int, the
+    permutation that sorts key_all."""
+    ks = key_all[order]
+    lo = np.searchsorted(ks, key_q, "left")
+    hi = np.searchsorted(ks, key_q, "right")
+    lens = hi - lo
+    q = np.repeat(np.arange(len(key_q)), lens)
+    first = np.repeat(np.cumsum(lens) - lens, lens)
+    j = order[lo[q] + np.arange(len(q)) - first]
+    val = weight[j] * env[(pos_q[q] - pos_all[j]) % len(env)]
+    out = np.zeros(len(key_q))
+    np.maximum.at(out, q, val)
+    return out
+
+
+def sparse_sidelobe_masked(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
+                           margin_db: float, nonzero: tuple[np.ndarray, np.ndarray] | None = None
+                           ) -> np.ndarray:
+    """``host.cfar.sidelobe_masked`` of a map that is 0 except at detected cells (the
+    records' map): only detected cells of the same column / row can mask, so the test runs
+    over those pairs instead of whole columns and rows (same result). pmap: float
+    (n_range, n_doppler); cells: int (m, 2); ``nonzero``: (rows, columns) of pmap's
+    non-zero cells when the caller knows them. Returns bool (m,)."""
+    nr, nd = pmap.shape
+    env_r = sidelobe_envelope(nr, windowed[0]) * 10 ** (margin_db / 10)
+    env_d = sidelobe_envelope(nd, windowed[1]) * 10 ** (margin_db / 10)
+    rr, dd = np.nonzero(pmap) if nonzero is None else nonzero
+    w = pmap[rr, dd]
+    r, d = cells[:, 0], cells[:, 1]
+    col = _group_max(d, dd, w, np.argsort(dd, kind="stable"), env_r, r, rr)
+    row = _group_max(r, rr, w, np.argsort(rr, kind="stable"), env_d, d, dd)
+    p = pmap[r, d]
+    return (col > p) | (row > p)
+
+
 def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
                    ) -> tuple[np.ndarray, np.ndarray]:
-    """Indices (int (m,)) of the records that become points (steps 1 to 3) and the map of
-    detected powers, float (n_range, n_doppler) (0 where nothing was detected)."""
+    """Indices (int (m,)) of the records that become points (steps 1 to 3), in (range,
+    Doppler) order, and the map of detected powers, float (n_range, n_doppler) (0 where
+    nothing was detected). Works on the records alone (a 3x3 gather per record, pairs of
+    records in a row or column), with the result of ``host.cfar.local_peaks`` and
+    ``host.cfar.sidelobe_masked`` on the map (:func:`select_records_reference`)."""
+    nr, nd = cfg.n_range, cfg.n_doppler
+    pmap = np.zeros((nr, nd))
+    index = np.full((nr, nd), -1, np.int64)
+    pmap[arr.range_bin, arr.doppler_bin] = arr.power
+    index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
+    lo, hi = cfg.detection_bins
+    r, d = arr.range_bin, arr.doppler_bin
+    own = (index[r, d] == np.arange(len(arr))) & (pmap[r, d] > 0)     # pmap's non-zero cells
+    nonzero = (r[own], d[own])
+    i = np.flatnonzero(own & (r >= lo) & (r < hi))
+    r, d = r[i], d[i]
+    p = pmap[r, d]
+    mx = p.copy()
+    for a in (-1, 0, 1):
+        for b in (-1, 0, 1):
+            if a or b:
+                np.maximum(mx, pmap[(r + a) % nr, (d + b) % nd], out=mx)
+    peak = p >= mx
+    i, r, d = i[peak], r[peak], d[peak]
+    order = np.argsort(r * nd + d, kind="stable")
+    i, cells = i[order], np.stack([r[order], d[order]], axis=1)
+    windowed = (params.range_window, params.doppler_window)
+    if params.sidelobe_margin_db is not None and len(cells):
+        i = i[~sparse_sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db,
+                                      nonzero)]
+    return i, pmap
+
+
+def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
+                             ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`select_records` on the whole map (``host.cfar.local_peaks``,
+    ``host.cfar.sidelobe_masked``): the specification, and the benchmark's old path."""
     nr, nd = cfg.n_range, cfg.n_doppler
     pmap = np.zeros((nr, nd))
     index = np.full((nr, nd), -1, np.int64)
@@ -89,15 +169,19 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
 
 
 def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
-                    frame: int = 0) -> PointCloud:
+                    frame: int = 0, reference: bool = False) -> PointCloud:
     """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
-    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``."""
+    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``.
+    ``reference``: run the replaced implementation (``points_from_cells_reference``; for the
+    benchmark's old-vs-new timing)."""
     params = params or DetectionParams()
     if arr.snapshot.shape[1:] != (cfg.n_virtual,):
         raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
                          f"{cfg.n_virtual} virtual channels")
-    idx, pmap = select_records(arr, cfg, params)
+    select = select_records_reference if reference else select_records
+    idx, pmap = select(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
-    return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
+    fn = points_from_cells_reference if reference else points_from_cells
+    return fn(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                              offsets, cfg, params, frame)

@@ -23,7 +23,13 @@ from host.stream import PacketDecoder
 from model.axis_packetizer import unpack_iq
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
-from model.detect_records import Record, Trailer, decode_frame, record_words
+from model.detect_records import (
+    Record,
+    Trailer,
+    decode_frame,
+    decode_frame_reference,
+    record_words,
+)
 
 DEFAULT_MAX_DETECTIONS = 256
 """MAX_DETECTIONS the host asks the FPGA for unless told otherwise (records per frame)."""
@@ -82,16 +88,19 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
     """DMA packets of the record stream -> :class:`DetectionFrame` per frame.
 
     ``dcfg``: the detector's configuration (lanes, TX, MAX_DETECTIONS fix the frame length);
-    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``.
+    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``;
+    ``reference``: decode with the per-record loop (``decode_frame_reference``; benchmark).
     """
 
-    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2) -> None:
+    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2,
+                 reference: bool = False) -> None:
         super().__init__(dcfg.num_rx, dcfg.frame_words, packet_words, reorder_window)
         self.dcfg = dcfg
+        self._decode = decode_frame_reference if reference else decode_frame
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
                     problems: list[str]) -> DetectionFrame:
-        dec = decode_frame(words, self.dcfg.num_tx)
+        dec = self._decode(words, self.dcfg.num_tx)
         rw = record_words(self.dcfg.num_tx, self.dcfg.num_rx)
         # leading records whose words all arrived (a lost packet zero-fills its words)
         bad = np.flatnonzero(~valid)

@@ -151,6 +151,69 @@ def decode_frame(words: np.ndarray, num_tx: int) -> RecordFrame:
     """Records of one frame's record stream (uint32 ``(n, num_rx)``, padding allowed).
 
     Never raises on bad data: a bad tag, a missing trailer or a count mismatch is reported
+    in ``errors``. Vectorised: the headers sit at a fixed stride, so all of them are read
+    at once up to the first word that is not a record header (same output as
+    :func:`decode_frame_reference`)."""
+    w = np.asarray(words, dtype=np.uint32)
+    num_rx = w.shape[1]
+    hw = hdr_words(num_rx)
+    rw = hw + num_tx
+    n_words = len(w)
+    # candidate header positions: pos + hw <= n_words
+    n_pos = (n_words - hw) // rw + 1 if n_words >= hw else 0
+    pos = np.arange(n_pos) * rw
+    tags = w[pos, 0] >> 24 if n_pos else np.zeros(0, np.uint32)
+    # a record is complete when its snapshot fits too
+    stop = (tags != TAG_RECORD) | (pos + rw > n_words)
+    first = int(np.argmax(stop)) if stop.any() else n_pos
+    recs = _records_at(w, pos[:first], hw, num_tx)
+    errors: list[str] = []
+    if first < n_pos:
+        p = int(pos[first])
+        tag = int(tags[first])
+        if tag == TAG_TRAILER:
+            lanes = w[p:p + hw].reshape(-1)
+            tr = Trailer(records=int(lanes[1]), detections=int(lanes[2]),
+                         truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
+                         frame_id=int(lanes[3]), max_detections=int(lanes[4]))
+            if tr.records != len(recs):
+                errors.append(f"trailer counts {tr.records} records, found {len(recs)}")
+            return RecordFrame(recs, tr, errors)
+        if tag != TAG_RECORD:
+            errors.append(f"word {p}: bad record tag 0x{tag:02x}")
+        else:
+            errors.append(f"word {p}: record cut short")
+    errors.append("no trailer")
+    return RecordFrame(recs, None, errors)
+
+
+def _records_at(w: np.ndarray, pos: np.ndarray, hw: int, num_tx: int) -> list[Record]:
+    """Records whose headers start at word indices ``pos`` (int (n,)) of ``w`` (uint32
+    (n_words, num_rx)), all fields read in one gather."""
+    if not len(pos):
+        return []
+    num_rx = w.shape[1]
+    hdr = w[pos[:, None] + np.arange(hw)[None, :]].reshape(len(pos), -1)[:, :HDR_LANES]
+    hdr = hdr.astype(np.int64)
+    snaps = w[pos[:, None] + hw + np.arange(num_tx)[None, :]]      # (n, num_tx, num_rx)
+    rb = ((hdr[:, 0] >> 12) & 0xFFF).tolist()
+    db = (hdr[:, 0] & 0xFFF).tolist()
+    power = (hdr[:, 2] | (hdr[:, 3] << 32)).astype(np.uint64).tolist()
+    noise = (hdr[:, 4] | (hdr[:, 5] << 32)).astype(np.uint64).tolist()
+    cells = (hdr[:, 1] & 0xFFFF).tolist()
+    index = (hdr[:, 1] >> 16).tolist()
+    fid = hdr[:, 6].tolist()
+    return [Record(range_bin=a, doppler_bin=b, power=c, noise_sum=d, cells=e,
+                   snapshot=snaps[i].reshape(num_tx, num_rx), index=f, frame_id=g)
+            for i, (a, b, c, d, e, f, g) in enumerate(zip(rb, db, power, noise, cells, index,
+                                                          fid, strict=True))]
+
+
+def decode_frame_reference(words: np.ndarray, num_tx: int) -> RecordFrame:
+    """The per-record loop :func:`decode_frame` replaced (same output; kept as its
+    specification for the tests and the benchmark's old-vs-new timing).
+
+    Never raises on bad data: a bad tag, a missing trailer or a count mismatch is reported
     in ``errors``."""
     w = np.asarray(words, dtype=np.uint32)
     num_rx = w.shape[1]
