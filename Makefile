@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
-        gnn-eval clean help view bench-view test-detect-long \
+        gnn-eval clean help view bench-view test-detect-long test-full \
         formal coverage mutate mutate-ci
 all: test
 
@@ -25,6 +25,8 @@ help:
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
+	@echo "make test-full       one full-size frame, FRAME_STORE=1 top + AXI4 memory, bit-exact"
+	@echo "make test-detect-long  detector blocks and the mode-1 top at every parameter set"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
@@ -144,3 +146,10 @@ bench-view: $(STAMP)
 test-detect-long: $(STAMP)
 	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain \
 	  tb/radar_pipeline/test_radar_pipeline_detect.py tests/test_detect_fpga.py
+
+# One full-size frame (4 TX x 16 RX, 256 x 256) through the FRAME_STORE = 1 top and the C++
+# harness's AXI4 memory, every DMA byte against the model (not in `make test`: the 16-lane
+# build takes about ten minutes)
+.PHONY: test-full
+test-full: $(STAMP)
+	FULL_FRAME=1 $(RUN) pytest -q -n 0 -s tb/radar_pipeline/test_harness.py -k full_frame_store

@@ -362,6 +362,11 @@ FPGA_CLOCK_HZ = 100e6
 """The fabric clock of the RTL (the paper's 100 MHz, Hz): ADC samples are paced against it,
 and the benchmarks turn cycle counts into frame rates and bandwidths with it."""
 
+FULL_AXI_DATA_W = 512
+"""AXI_DATA_W (bits) of the external frame store of the ``full`` top (FRAME_STORE = 1): the
+ZCU106 PL DDR4 through MIG, 512-bit user interface at the 100 MHz fabric clock
+(docs/frame_store.md). The RTL frame source, the synthesis jobs and the tests use it."""
+
 
 def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
     """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,

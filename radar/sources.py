@@ -30,7 +30,7 @@ import numpy as np
 
 from host.records import DetectionFrame, RecordDecoder
 from model.axis_packetizer import packetize_stream, words_to_bytes
-from model.config import FPGA_CLOCK_HZ, RadarConfig
+from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, RadarConfig
 from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain, record_frames, scaled_cube
 from model.reference import radar_cube
@@ -41,10 +41,6 @@ SOURCES: dict[str, type[FrameSource]] = {}
 RTL_SIM_MAX_FRAME_BITS = 16 * 2**20
 """Largest corner-turn frame the RTL source keeps on chip (paper-fpga: 2 Mib); a larger one
 (full: 128 Mib) runs with FRAME_STORE = 1, the corner turn in external memory, as on the board."""
-
-FULL_AXI_DATA_W = 512
-"""AXI_DATA_W of the external frame store when the RTL source needs it (the ZCU106 PL DDR4
-through MIG: 512-bit user interface at the 100 MHz fabric clock, docs/frame_store.md)."""
 
 
 class SourceError(Exception):

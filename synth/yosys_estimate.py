@@ -31,6 +31,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from model.config import FULL_AXI_DATA_W
+
 ROOT = Path(__file__).resolve().parent.parent
 RTL = ROOT / "rtl"
 TOP_FILE = RTL / "top" / "radar_pipeline.sv"
@@ -90,9 +92,6 @@ def _fft_dsp(n: int, lanes: int, window: bool, data_w: int = 16, guard_w: int = 
     return lanes * (per_twiddle * twiddles + (2 if window else 0))
 
 
-FULL_AXI_DATA_W = 512
-"""m_axi_mem width of the ``full`` top (FRAME_STORE = 1), the width the RTL frame source
-uses (``radar.sources.FULL_AXI_DATA_W``; a test keeps the two equal)."""
 
 # xczu7ev (ZCU106) capacity, the denominators of the utilization percentages.
 XCZU7EV: dict[str, float] = {"LUT": 230400, "FF": 460800, "DSP": 1728, "BRAM": 312, "URAM": 96}

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
+from model.config import FULL_AXI_DATA_W
 from synth.vivado_flow import TCL, job_tcl, parse_utilization
 from synth.yosys_estimate import (
-    FULL_AXI_DATA_W,
     RTL,
     XCZU7EV,
     Job,
@@ -133,9 +133,6 @@ def test_dsp_goal_paper_fpga() -> None:
 def test_full_top_uses_the_rtl_sources_frame_store() -> None:
     """The full top is synthesized as the RTL frame source runs it: FRAME_STORE = 1 with the
     same AXI width."""
-    from radar.sources import FULL_AXI_DATA_W as SOURCE_AXI_W
-
-    assert FULL_AXI_DATA_W == SOURCE_AXI_W
     full, paper = _top("full").params, _top("paper-fpga").params
     assert full["FRAME_STORE"] == 1 and full["AXI_DATA_W"] == FULL_AXI_DATA_W
     assert full["NUM_RX"] == 16 and full["NUM_TX"] == 4 and full["N_RANGE"] == 256

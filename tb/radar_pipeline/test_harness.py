@@ -12,6 +12,9 @@ model and against the cocotb path, on the small 4-TX parameter set of
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numpy as np
 import pytest
 from test_radar_pipeline import CONFIGS, adc_frames, assert_packets_equal
@@ -121,3 +124,27 @@ def test_harness_mode1_paper_fpga_records() -> None:
     assert got == [np.ascontiguousarray(p, "<u4").tobytes() for p in want]
     assert status["record_frames"] == 2 and status["detections"] > 0, status
     assert status["status_truncated"] == 0, status
+
+
+@pytest.mark.skipif(os.environ.get("FULL_FRAME", "0") in ("", "0"),
+                    reason="one full-size frame through the 16-lane FRAME_STORE = 1 top: "
+                           "`make test-full` (build about ten minutes, run about a minute)")
+def test_harness_full_frame_store() -> None:
+    """The paper's full system, one `full` frame (4 TX x 16 RX, 256 x 256) through the
+    FRAME_STORE = 1 top (512-bit AXI4 to the harness's memory with latency and 30 % stalls),
+    the ADC at its real 32.5 MSPS against the 100 MHz clock: every DMA byte equals the
+    model's, nothing flagged."""
+    from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, get_preset
+    from model.radar_pipeline import PipelineParams
+
+    cfg = get_preset("full")
+    chain = PipelineParams(frame_store=True, axi_data_w=FULL_AXI_DATA_W)
+    frames = adc_frames("full", cfg, 1, seed=5)
+    adc_gap = 1.0 - cfg.sample_rate_hz / FPGA_CLOCK_HZ
+    chirp_gap = round((cfg.chirp_period_s - cfg.sampled_chirp_s) * FPGA_CLOCK_HZ)
+    run = run_harness(frames, cfg, chain, seed=9, frame_store=True, mem_latency=40,
+                      mem_stall=0.3, adc_gap=adc_gap, chirp_gap=chirp_gap)
+    assert_packets_equal(run.packets, dma_packets(frames, cfg, chain), "full frame store")
+    st = run.status
+    assert st["mem_protocol_errors"] == 0 and st["frames_out"] == 1, st
+    print(f"full frame: {run.cycles} clocks in {run.wall_s:.1f} s", file=sys.stderr)
