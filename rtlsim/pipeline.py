@@ -69,6 +69,23 @@ class PipelineTB(AxisTB):
         return [await self.recv_packet(timeout_cycles)
                 for _ in range(n_frames * self.packets_per_frame)]
 
+    async def reset_then_recv(self, after_cycles: int, n_frames: int) -> list[np.ndarray]:
+        """Mid-stream reset: ``after_cycles`` clocks from now, reset for 8 clocks while the
+        source keeps its queue (the frames behind the interrupted one), drop what the sink
+        holds, then return the packets of the next ``n_frames`` frames (AssertionError with
+        the status when nothing comes out)."""
+        from cocotb.triggers import ClockCycles, SimTimeoutError
+
+        await ClockCycles(self.dut.clk, after_cycles)
+        self.dut.rst.value = 1
+        await ClockCycles(self.dut.clk, 8)
+        self.dut.rst.value = 0
+        self.sink.clear()
+        try:
+            return await self.recv_frames(n_frames, 2 * self.frame_timeout_cycles())
+        except SimTimeoutError:
+            raise AssertionError(f"no output after reset, status {self.status()}") from None
+
     def status(self) -> dict[str, int]:
         """Current status flags and counters."""
         return self.read_status(STATUS_SIGNALS)

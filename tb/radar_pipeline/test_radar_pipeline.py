@@ -200,17 +200,7 @@ async def reset_mid_stream(dut) -> None:
     tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
     for adc in frames:
         await tb.send_frame(adc)
-    for _ in range(cfg.n_chirps * cfg.n_range):  # half way through frame 0
-        await RisingEdge(tb.dut.clk)
-    tb.dut.rst.value = 1
-    for _ in range(8):
-        await RisingEdge(tb.dut.clk)
-    tb.dut.rst.value = 0
-    tb.sink.clear()
-    try:
-        got = await tb.recv_frames(2, 2 * tb.frame_timeout_cycles())
-    except SimTimeoutError:
-        raise AssertionError(f"no output after reset, status {tb.status()}") from None
+    got = await tb.reset_then_recv(cfg.n_chirps * cfg.n_range, 2)  # half way through frame 0
     assert_packets_equal(got, dma_packets(frames[1:], cfg, chain), "after reset")
     status = tb.status()
     assert status["frames_out"] == 2 and status["frames_damaged"] == 0, status

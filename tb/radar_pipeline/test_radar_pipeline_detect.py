@@ -18,7 +18,6 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import RisingEdge, SimTimeoutError
 from test_radar_pipeline import (
     SMALL4,
     adc_frames,
@@ -133,17 +132,7 @@ async def reset_mid_stream(dut) -> None:
     tb.set_backpressure_generator(random_pause(0.2, 5))
     for adc in frames:
         await tb.send_frame(adc)
-    for _ in range(cfg.n_chirps * cfg.n_range):  # half way through frame 0
-        await RisingEdge(tb.dut.clk)
-    tb.dut.rst.value = 1
-    for _ in range(8):
-        await RisingEdge(tb.dut.clk)
-    tb.dut.rst.value = 0
-    tb.sink.clear()
-    try:
-        got = await tb.recv_frames(2, 2 * tb.frame_timeout_cycles())
-    except SimTimeoutError:
-        raise AssertionError(f"no output after reset, status {tb.status()}") from None
+    got = await tb.reset_then_recv(cfg.n_chirps * cfg.n_range, 2)  # half way through frame 0
     assert_packets_equal(got, dma_packets(frames[1:], cfg, chain), "mode 1 after reset")
     status = tb.status()
     assert status["record_frames"] == 2 and status["status_truncated"] == 0, status
