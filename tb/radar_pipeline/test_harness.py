@@ -128,7 +128,7 @@ def test_harness_mode1_paper_fpga_records() -> None:
 
 @pytest.mark.skipif(os.environ.get("FULL_FRAME", "0") in ("", "0"),
                     reason="one full-size frame through the 16-lane FRAME_STORE = 1 top: "
-                           "`make test-full` (build about ten minutes, run about a minute)")
+                           "`make test-full` (about 2 minutes with the build)")
 def test_harness_full_frame_store() -> None:
     """The paper's full system, one `full` frame (4 TX x 16 RX, 256 x 256) through the
     FRAME_STORE = 1 top (512-bit AXI4 to the harness's memory with latency and 30 % stalls),
