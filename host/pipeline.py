@@ -276,11 +276,11 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     n = len(cells)
     if not n:
         return PointCloud.empty()
-    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
+    nd, nv = cfg.n_doppler, cfg.n_virtual
     r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
     x = np.asarray(snapshots)
     noise = np.asarray(noise, dtype=float)
-    dr, dd = offsets[:, 0], offsets[:, 1]
+    dd = offsets[:, 1]
     sb = signed_bins(nd)[d].astype(np.int64)
     cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
     measured = (sb + dd) * cfg.velocity_bin_mps
@@ -296,6 +296,26 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     k = sb + fold * nd
     # step 4: angles of the TDM-compensated channel vectors
     comps = estimate_angles_batch(x * _tdm_comp(cfg, k), noise / nv, params.angle)
+    # step 5: one point per angle component
+    cell = np.array([i for i, cs in enumerate(comps) for _ in cs], dtype=np.int64)
+    flat = [c for cs in comps for c in cs]
+    return _cloud(cfg, params, r, offsets, k, ambiguous, cell,
+                  np.array([c.azimuth_deg for c in flat]),
+                  np.array([c.amplitude for c in flat], dtype=complex),
+                  np.array([c.snr_db for c in flat]), frame)
+
+
+def _cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.ndarray,
+           k: np.ndarray, ambiguous: np.ndarray, cell: np.ndarray, az: np.ndarray,
+           amplitude: np.ndarray, snr_db: np.ndarray, frame: int) -> PointCloud:
+    """Step 5, one point per angle component: range (Doppler coupling removed), velocity of
+    the unfolded bin ``k``, power and RCS (window scalloping and coherent gain undone).
+
+    Per cell (n,): r range bin, k unfolded signed Doppler bin, ambiguous flag; offsets
+    float (n, 2) bins. Per component (m,): ``cell`` its cell index, ``az`` deg,
+    ``amplitude`` complex (LSB), ``snr_db``."""
+    nr, nd = cfg.n_range, cfg.n_doppler
+    dr, dd = offsets[:, 0], offsets[:, 1]
     velocity = (k + dd) * cfg.velocity_bin_mps
     # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
@@ -303,17 +323,12 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     scallop = _window_response(nr, dr, params.range_window) * _window_response(
         nd, dd, params.doppler_window)
     cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
-    # step 5: one point per angle component
-    cell = np.array([i for i, cs in enumerate(comps) for _ in cs], dtype=np.int64)
-    flat = [c for cs in comps for c in cs]
-    az = np.array([c.azimuth_deg for c in flat])
-    amp = np.abs(np.array([c.amplitude for c in flat], dtype=complex))
-    snr = np.array([c.snr_db for c in flat])
+    amp = np.abs(amplitude)
     amp_adc = amp / (cg * scallop[cell])
     rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
     return PointCloud.from_polar(
-        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr, rcs,
-        r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
+        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr_db,
+        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
 
 
 def _tdm_tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
@@ -402,11 +417,11 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
     n = len(cells)
     if not n:
         return PointCloud.empty()
-    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
+    nd, nv = cfg.n_doppler, cfg.n_virtual
     r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
     x = np.asarray(snapshots)
     noise = np.asarray(noise, dtype=float)
-    dr, dd = offsets[:, 0], offsets[:, 1]
+    dd = offsets[:, 1]
     sb = signed_bins(nd)[d].astype(np.int64)
     cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
     measured = (sb + dd) * cfg.velocity_bin_mps
@@ -427,22 +442,8 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
                                    first_sin=class_sin[rows, cls])
     else:
         ang = estimate_angles_fast(_tdm_compensate(cfg, x, k), noise / nv, params.angle)
-    velocity = (k + dd) * cfg.velocity_bin_mps
-    # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
-    coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
-    range_m = (r + dr - coupling) * cfg.range_bin_m
-    scallop = _window_response(nr, dr, params.range_window) * _window_response(
-        nd, dd, params.doppler_window)
-    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
-    # step 5: one point per angle component
-    cell = ang.cell
-    az = ang.azimuth_deg
-    amp = np.abs(ang.amplitude)
-    amp_adc = amp / (cg * scallop[cell])
-    rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
-    return PointCloud.from_polar(
-        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), ang.snr_db,
-        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
+    return _cloud(cfg, params, r, offsets, k, ambiguous, ang.cell, ang.azimuth_deg,
+                  ang.amplitude, ang.snr_db, frame)
 
 
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
