@@ -8,13 +8,19 @@ packets reported, never raised) with ``model.detect_records.decode_frame`` on ea
 payload. A frame with a lost packet is *damaged* (``complete`` False); the records that
 arrived intact before the first missing word are still offered (``usable_records``).
 
-:func:`record_arrays` turns a frame's records into the arrays the host processing needs
-(``host.record_points``).
+The decoder reads a frame's records straight into arrays (:func:`decode_record_fields`, the
+same fields as ``model.detect_records.decode_frame``, no per-record Python object);
+``DetectionFrame.records`` is a :class:`RecordList` over them that builds a
+``model.detect_records.Record`` only when one is looked at. :func:`record_arrays` turns a
+frame's records into the arrays the host processing needs (``host.record_points``); on a
+:class:`RecordList` (or a slice of one) it does not build any ``Record``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -24,10 +30,13 @@ from model.axis_packetizer import unpack_iq
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.detect_records import (
+    HDR_LANES,
+    TAG_RECORD,
+    TAG_TRAILER,
     Record,
     Trailer,
     decode_frame,
-    decode_frame_reference,
+    hdr_words,
     record_words,
 )
 
@@ -51,19 +60,151 @@ def fpga_detect_config(cfg: RadarConfig, cfar: CfarParams, kind: str = "ca",
                         report=cfg.detection_bins)
 
 
+@dataclass(frozen=True)
+class RecordFields:
+    """The fields of n records as arrays (``model.detect_records.Record``'s, record k in
+    row k): ``range_bin``, ``doppler_bin``, ``cells``, ``index``, ``frame_id``: int64 (n,);
+    ``power``, ``noise_sum``: uint64 (n,) (the 64-bit header fields); ``snapshot``: uint32
+    (n, num_tx, num_rx) packed {Q, I}."""
+
+    range_bin: np.ndarray
+    doppler_bin: np.ndarray
+    power: np.ndarray
+    noise_sum: np.ndarray
+    cells: np.ndarray
+    index: np.ndarray
+    frame_id: np.ndarray
+    snapshot: np.ndarray
+
+    def __len__(self) -> int:
+        return int(len(self.range_bin))
+
+    def take(self, sl: slice) -> RecordFields:
+        """Rows ``sl`` (views)."""
+        return RecordFields(*(getattr(self, f)[sl] for f in self.__dataclass_fields__))
+
+    def noise(self) -> np.ndarray:
+        """float64 (n,) the CFAR's noise estimates noise_sum / max(cells, 1), each the
+        correctly rounded quotient as ``Record.noise`` (Python int / int) gives it."""
+        cells = np.maximum(self.cells, 1)
+        out = self.noise_sum.astype(np.float64) / cells
+        big = np.flatnonzero(self.noise_sum >= np.uint64(1 << 53))   # not exact in float64
+        for i in big:
+            out[i] = int(self.noise_sum[i]) / int(cells[i])
+        return out
+
+
+def empty_fields(num_tx: int, num_rx: int) -> RecordFields:
+    """:class:`RecordFields` of no record."""
+    z = np.zeros(0, np.int64)
+    u = np.zeros(0, np.uint64)
+    return RecordFields(z, z, u, u, z, z, z, np.zeros((0, num_tx, num_rx), np.uint32))
+
+
+class RecordList(Sequence[Record]):
+    """The records of :class:`RecordFields` as a read-only sequence of
+    ``model.detect_records.Record`` (built on access; a slice is a RecordList again)."""
+
+    def __init__(self, fields: RecordFields) -> None:
+        self.fields = fields
+
+    def __len__(self) -> int:
+        return len(self.fields)
+
+    @overload
+    def __getitem__(self, i: int) -> Record: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> RecordList: ...
+
+    def __getitem__(self, i: int | slice) -> Record | RecordList:
+        if isinstance(i, slice):
+            return RecordList(self.fields.take(i))
+        f = self.fields
+        i = range(len(f))[i]                   # IndexError, negative indices
+        return Record(range_bin=int(f.range_bin[i]), doppler_bin=int(f.doppler_bin[i]),
+                      power=int(f.power[i]), noise_sum=int(f.noise_sum[i]),
+                      cells=int(f.cells[i]), snapshot=f.snapshot[i], index=int(f.index[i]),
+                      frame_id=int(f.frame_id[i]))
+
+    def __iter__(self) -> Iterator[Record]:
+        return (self[i] for i in range(len(self)))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    def __repr__(self) -> str:
+        return f"RecordList({len(self)} records)"
+
+
+def _trailer(lanes: np.ndarray) -> Trailer:
+    """The trailer of its header lanes (uint32 (>= 5,)), as ``model.detect_records``."""
+    return Trailer(records=int(lanes[1]), detections=int(lanes[2]),
+                   truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
+                   frame_id=int(lanes[3]), max_detections=int(lanes[4]))
+
+
+def decode_record_fields(words: np.ndarray, num_tx: int
+                         ) -> tuple[RecordFields, Trailer | None, list[str]]:
+    """``model.detect_records.decode_frame`` into arrays: (records, trailer or None,
+    errors), the same records, trailer and error messages (tests), without building a
+    ``Record`` per detection. words: uint32 (n_words, num_rx), padding allowed; never
+    raises on bad data."""
+    w = np.asarray(words, dtype=np.uint32)
+    num_rx = w.shape[1]
+    hw = hdr_words(num_rx)
+    rw = hw + num_tx
+    n_words = len(w)
+    n_pos = (n_words - hw) // rw + 1 if n_words >= hw else 0
+    pos = np.arange(n_pos) * rw
+    tags = w[pos, 0] >> 24 if n_pos else np.zeros(0, np.uint32)
+    stop = (tags != TAG_RECORD) | (pos + rw > n_words)
+    first = int(np.argmax(stop)) if stop.any() else n_pos
+    n = first
+    if n:
+        # all records are one (n, rw, num_rx) block: header lanes, then num_tx snapshot words
+        block = w[:n * rw].reshape(n, rw, num_rx)
+        lane = block[:, :hw].reshape(n, hw * num_rx)[:, :HDR_LANES].astype(np.int64)
+        u = lane.astype(np.uint64)
+        fields = RecordFields(
+            range_bin=(lane[:, 0] >> 12) & 0xFFF, doppler_bin=lane[:, 0] & 0xFFF,
+            power=u[:, 2] | (u[:, 3] << np.uint64(32)),
+            noise_sum=u[:, 4] | (u[:, 5] << np.uint64(32)),
+            cells=lane[:, 1] & 0xFFFF, index=lane[:, 1] >> 16, frame_id=lane[:, 6],
+            snapshot=block[:, hw:])
+    else:
+        fields = empty_fields(num_tx, num_rx)
+    errors: list[str] = []
+    if first < n_pos:
+        p = int(pos[first])
+        tag = int(tags[first])
+        if tag == TAG_TRAILER:
+            tr = _trailer(w[p:p + hw].reshape(-1))
+            if tr.records != n:
+                errors.append(f"trailer counts {tr.records} records, found {n}")
+            return fields, tr, errors
+        if tag != TAG_RECORD:
+            errors.append(f"word {p}: bad record tag 0x{tag:02x}")
+        else:
+            errors.append(f"word {p}: record cut short")
+    errors.append("no trailer")
+    return fields, None, errors
+
+
 @dataclass
 class DetectionFrame:
     """One frame of the record stream.
 
     ``records``: decoded records in CFAR order (``model.detect_records.Record``; snapshot
-    uint32 (num_tx, num_rx) packed {Q, I}); ``trailer``: None when it did not arrive;
+    uint32 (num_tx, num_rx) packed {Q, I}), a :class:`RecordList` over arrays unless the
+    decoder runs with ``reference``; ``trailer``: None when it did not arrive;
     ``problems``: packet and record errors (empty when ``complete``); ``valid``: bool
     (frame_words,) True where the payload word arrived intact; ``usable_records``: how many
     leading records arrived intact (all of them in a complete frame).
     """
 
     frame_id: int
-    records: list[Record]
+    records: Sequence[Record]
     trailer: Trailer | None
     problems: list[str]
     valid: np.ndarray
@@ -89,37 +230,46 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
 
     ``dcfg``: the detector's configuration (lanes, TX, MAX_DETECTIONS fix the frame length);
     ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``;
-    ``reference``: decode with the per-record loop (``decode_frame_reference``; benchmark).
+    ``reference``: decode into ``Record`` objects (``model.detect_records.decode_frame``, the
+    path :func:`decode_record_fields` replaced; the benchmark's old-vs-new timing).
     """
 
     def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2,
                  reference: bool = False) -> None:
         super().__init__(dcfg.num_rx, dcfg.frame_words, packet_words, reorder_window)
         self.dcfg = dcfg
-        self._decode = decode_frame_reference if reference else decode_frame
+        self.reference = reference
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
                     problems: list[str]) -> DetectionFrame:
-        dec = self._decode(words, self.dcfg.num_tx)
+        records: Sequence[Record]
+        if self.reference:
+            dec = decode_frame(words, self.dcfg.num_tx)
+            records, trailer, dec_errors = dec.records, dec.trailer, dec.errors
+            frame_ids = {r.frame_id for r in records}
+        else:
+            fields, trailer, dec_errors = decode_record_fields(words, self.dcfg.num_tx)
+            records = RecordList(fields)
+            frame_ids = set(np.unique(fields.frame_id).tolist())
         rw = record_words(self.dcfg.num_tx, self.dcfg.num_rx)
         # leading records whose words all arrived (a lost packet zero-fills its words)
         bad = np.flatnonzero(~valid)
-        intact = len(dec.records) if not len(bad) else min(len(dec.records), int(bad[0]) // rw)
+        intact = len(records) if not len(bad) else min(len(records), int(bad[0]) // rw)
         errors = list(problems)
         if not errors:  # record errors matter only when the packets were all intact
-            errors.extend(f"frame {fid}: {e}" for e in dec.errors)
-            tr = dec.trailer
+            errors.extend(f"frame {fid}: {e}" for e in dec_errors)
+            tr = trailer
             if tr is not None and tr.frame_id != fid:
                 errors.append(f"frame {fid}: trailer carries frame id {tr.frame_id}")
             if tr is not None and tr.max_detections != self.dcfg.max_detections:
                 errors.append(f"frame {fid}: trailer says MAX_DETECTIONS "
                               f"{tr.max_detections}, decoder expects "
                               f"{self.dcfg.max_detections}")
-            ids = {r.frame_id for r in dec.records} - {fid}
+            ids = frame_ids - {fid}
             if ids:
                 errors.append(f"frame {fid}: records carry frame id(s) {sorted(ids)[:4]}")
-        trailer = dec.trailer if valid.all() else None
-        return DetectionFrame(frame_id=fid, records=dec.records, trailer=trailer,
+        trailer = trailer if valid.all() else None
+        return DetectionFrame(frame_id=fid, records=records, trailer=trailer,
                               problems=errors, valid=valid, usable_records=intact)
 
 
@@ -145,9 +295,33 @@ class RecordArrays:
         return int(len(self.range_bin))
 
 
-def record_arrays(records: list[Record], n_virtual: int, gain: float = 1.0) -> RecordArrays:
+def record_arrays(records: Sequence[Record], n_virtual: int, gain: float = 1.0
+                  ) -> RecordArrays:
     """Arrays of ``records`` (see :class:`RecordArrays`); ``gain``: the chain's gain over
-    the float reference (``model.radar_pipeline.chain_gain``)."""
+    the float reference (``model.radar_pipeline.chain_gain``). On a :class:`RecordList`
+    straight from its arrays (same values as from its ``Record`` objects: tests)."""
+    if isinstance(records, RecordList):
+        return fields_arrays(records.fields, n_virtual, gain)
+    return record_arrays_reference(records, n_virtual, gain)
+
+
+def fields_arrays(fields: RecordFields, n_virtual: int, gain: float = 1.0) -> RecordArrays:
+    """:func:`record_arrays` of :class:`RecordFields`."""
+    n = len(fields)
+    if n and fields.snapshot.shape[1] * fields.snapshot.shape[2] != n_virtual:
+        raise ValueError(f"records carry {fields.snapshot.shape[1]} x "
+                         f"{fields.snapshot.shape[2]} channels, expected {n_virtual}")
+    snap = unpack_iq(fields.snapshot).reshape(n, n_virtual)
+    g2 = gain * gain
+    return RecordArrays(fields.range_bin, fields.doppler_bin,
+                        fields.power.astype(np.float64) / g2, fields.noise() / g2,
+                        (snap / gain).astype(np.complex64))
+
+
+def record_arrays_reference(records: Sequence[Record], n_virtual: int, gain: float = 1.0
+                            ) -> RecordArrays:
+    """:func:`record_arrays` from ``Record`` objects (the implementation the array decode
+    replaced; benchmark and tests)."""
     n = len(records)
     rb = np.fromiter((r.range_bin for r in records), dtype=np.int64, count=n)
     db = np.fromiter((r.doppler_bin for r in records), dtype=np.int64, count=n)
