@@ -150,10 +150,34 @@ def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 
         z = np.zeros(0)
         return np.zeros(0, np.int64), z, z, z
     coarse = min(coarse, n_fft)
-    rows = np.arange(m)
     cm = np.abs(scipy.fft.ifft(x.astype(np.complex64), n=coarse, axis=-1, workers=1))
+    return _peaks_from_coarse(np.asarray(x, dtype=np.complex128), cm, n_fft, half)
+
+
+def fine_peaks_lean(xd: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`fine_peaks` (same result) of xd, complex128 (m, n), with one copy less: the
+    single-precision rows are written into the zero-padded FFT buffer directly and the
+    coarse FFT runs in place."""
+    m, n = xd.shape
+    if not m:
+        z = np.zeros(0)
+        return np.zeros(0, np.int64), z, z, z
+    coarse = min(coarse, n_fft)
+    buf = np.zeros((m, coarse), np.complex64)
+    buf[:, :min(n, coarse)] = xd[:, :coarse]          # what ifft(x, n=coarse) transforms
+    cm = np.abs(scipy.fft.ifft(buf, axis=-1, workers=1, overwrite_x=True))
+    return _peaks_from_coarse(xd, cm, n_fft, half)
+
+
+def _peaks_from_coarse(xd: np.ndarray, cm: np.ndarray, n_fft: int, half: int
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`fine_peaks` of xd (complex128 (m, n)) from its coarse magnitudes cm (float
+    (m, coarse); changed here)."""
+    m = len(xd)
+    coarse = cm.shape[1]
+    rows = np.arange(m)
     kc = np.argmax(cm, axis=-1)
-    xd = np.asarray(x, dtype=np.complex128)
     k, a, b, c = _refine(xd, cm, kc, n_fft, half)   # before cm is changed below
     # runner-up lobe: the largest coarse bin outside the first lobe's 5 bins (a shoulder of
     # the first lobe climbs back to it: harmless)
@@ -231,6 +255,13 @@ def peak_sin_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     return _interpolated_sin(k0, a, b, c, n_fft), b * b
 
 
+def peak_power_lean(xd: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`peak_power_fast` of rows xd, complex128 (m, n), through
+    :func:`fine_peaks_lean`: (peak power float (m,), sin(az) float (m,))."""
+    k0, a, b, c = fine_peaks_lean(xd, n_fft)
+    return b * b, _interpolated_sin(k0, a, b, c, n_fft)
+
+
 def peak_power_fast(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`peak_power_batch` through :func:`fine_peaks`, x complex (..., n): (peak
     power float (...), and the peak's sin(az) float (...) as :func:`peak_sin_fast`)."""
@@ -264,6 +295,31 @@ def _steering_rows(s: np.ndarray, n: int) -> np.ndarray:
     return (hi[:, :, None] * lo[:, None, :]).reshape(len(s), -1)[:, :n]
 
 
+def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.ndarray,
+                a1: np.ndarray, p1: np.ndarray, more: np.ndarray) -> AngleArrays:
+    """The :class:`AngleArrays` of rows xs (complex (n, n_ch)): the first component (sin
+    s1, amplitude a1, power p1, float/complex (n,)) where ``more`` (bool (n,)) is False,
+    :func:`estimate_angles` of the row where it is True."""
+    n_rows, n = xs.shape
+    snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
+    multi = np.flatnonzero(more)
+    if not len(multi):
+        return AngleArrays(np.arange(n_rows), s1, a1, snr1)
+    cell, sin_az, amp, snr = [], [], [], []
+    for i in multi:
+        for c in estimate_angles(xs[i], float(noise[i]), params):
+            cell.append(i)
+            sin_az.append(c.sin_az)
+            amp.append(c.amplitude)
+            snr.append(c.snr_db)
+    single = np.flatnonzero(~more)
+    cell_a = np.concatenate([single, np.array(cell, np.int64)])
+    order = np.argsort(cell_a, kind="stable")
+    return AngleArrays(cell_a[order], np.concatenate([s1[single], sin_az])[order],
+                       np.concatenate([a1[single], np.array(amp, complex)])[order],
+                       np.concatenate([snr1[single], snr])[order])
+
+
 def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
                          first_sin: np.ndarray | None = None) -> AngleArrays:
     """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
@@ -290,23 +346,52 @@ def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: A
             snr2 = 10 * np.log10(p2 * n / noise)
             more = (snr2 >= params.min_snr_db) & (
                 10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
-    snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
-    multi = np.flatnonzero(more)
-    if not len(multi):
-        return AngleArrays(np.arange(n_rows), s1, a1, snr1)
-    cell, sin_az, amp, snr = [], [], [], []
-    for i in multi:
-        for c in estimate_angles(xs[i], float(noise[i]), params):
-            cell.append(i)
-            sin_az.append(c.sin_az)
-            amp.append(c.amplitude)
-            snr.append(c.snr_db)
-    single = np.flatnonzero(~more)
-    cell_a = np.concatenate([single, np.array(cell, np.int64)])
-    order = np.argsort(cell_a, kind="stable")
-    return AngleArrays(cell_a[order], np.concatenate([s1[single], sin_az])[order],
-                       np.concatenate([a1[single], np.array(amp, complex)])[order],
-                       np.concatenate([snr1[single], snr])[order])
+    return _components(xs, noise, params, s1, a1, p1, more)
+
+
+def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
+                             first_sin: np.ndarray | None = None) -> AngleArrays:
+    """:func:`estimate_angles_fast` (same components) with the search for a second
+    component screened: the residual r after the first component can hold one only if its
+    projection power p2 = |s^H r / n|^2 (|s_v| = 1) passes both gates, and by
+    Cauchy-Schwarz p2 <= ||r||^2 / n; rows whose bound fails a gate (a strong single target:
+    the residual is noise more than ``dynamic_range_db`` below it; or a weak residual) skip
+    the residual's angle search, the others run it as there.
+
+    x: complex (n, n_channels); noise_per_channel: float (n,); first_sin: float (n,) the
+    rows' strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
+    xs = np.asarray(x, dtype=np.complex128)
+    n_rows, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if not n_rows:
+        z = np.zeros(0)
+        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
+    s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
+    st1 = _steering_rows(s1, n)
+    a1 = np.sum(np.conj(st1) * xs, axis=1) / n
+    p1 = np.abs(a1) ** 2
+    more = np.zeros(n_rows, bool)
+    if params.max_targets > 1:
+        res = xs - a1[:, None] * st1
+        # upper bound of p2 (1e-9: far above the rounding of either side)
+        bound = np.einsum("ij,ij->i", res.real, res.real) + np.einsum("ij,ij->i", res.imag,
+                                                                       res.imag)
+        bound *= (1.0 + 1e-9) / n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            maybe = (10 * np.log10(bound * n / noise) >= params.min_snr_db) & (
+                10 * np.log10(p1 / np.maximum(bound, 1e-300)) <= params.dynamic_range_db)
+        rows = np.flatnonzero(maybe)
+        if len(rows):
+            r = res[rows]
+            s2, _ = peak_sin_fast(r, params.n_fft)
+            st2 = _steering_rows(s2, n)
+            p2 = np.abs(np.sum(np.conj(st2) * r, axis=1) / n) ** 2
+            with np.errstate(divide="ignore"):
+                snr2 = 10 * np.log10(p2 * n / noise[rows])
+                more[rows] = (snr2 >= params.min_snr_db) & (
+                    10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
+                    <= params.dynamic_range_db)
+    return _components(xs, noise, params, s1, a1, p1, more)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams

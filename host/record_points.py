@@ -17,24 +17,35 @@ own CFAR (``host.pipeline`` module docstring), on the records alone:
    neighbours along an axis were detected; with one detected neighbour the window's
    two-bin amplitude ratio (Hann: delta = (2a - 1) / (a + 1), rectangular:
    a / (1 + a), a = |X_neighbour| / |X_peak|); with none, 0 (the cell centre);
-5. TDM compensation, velocity unfolding, angle estimation and the point cloud:
-   :func:`host.pipeline.points_from_cells`, the same code as the cube path.
+5. TDM compensation, velocity unfolding, angle estimation and the point cloud: the same
+   points as :func:`host.pipeline.points_from_cells` (the cube path's code), computed by
+   :func:`points_from_snapshots` with less work: the TDM test runs only the alias classes
+   that hold a velocity hypothesis of the cell (what ``host.pipeline.choose_folds`` looks
+   at), and the search for a second angle component only where a Cauchy-Schwarz bound
+   leaves room for one (``host.angle.estimate_angles_screened``).
+
+:func:`process_records` is the public entry (records -> point cloud; the live view, the
+CLI); :func:`process_records_reference` is the path it replaced (benchmark, tests).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from host.angle import estimate_angles_screened, peak_power_lean
 from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
 from host.pipeline import (
     DetectionParams,
+    _cloud,
+    _tdm_compensate,
+    choose_folds,
     gaussian_offset,
     points_from_cells,
-    points_from_cells_reference,
 )
 from host.pointcloud import PointCloud
 from host.records import RecordArrays
 from model.config import RadarConfig
+from model.reference import signed_bins
 
 
 def _two_bin_offset(ratio: np.ndarray, windowed: bool) -> np.ndarray:
@@ -168,20 +179,101 @@ def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: Detect
     return index[cells[:, 0], cells[:, 1]], pmap
 
 
-def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
-                    frame: int = 0, reference: bool = False) -> PointCloud:
-    """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
-    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``.
-    ``reference``: run the replaced implementation (``points_from_cells_reference``; for the
-    benchmark's old-vs-new timing)."""
-    params = params or DetectionParams()
+def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, params: DetectionParams
+                       ) -> np.ndarray:
+    """Alias classes c = m mod num_tx that hold a velocity hypothesis m of each cell (the
+    hypotheses of ``host.pipeline.choose_folds``: |v + 2 m vmax| <= max_speed, m = 0 when
+    none is), bool (n, num_tx); velocity_mps: float (n,) measured (aliased). Only these
+    classes' powers enter the unfolding decision."""
+    v = np.asarray(velocity_mps, dtype=float)
+    period = 2.0 * cfg.max_velocity_mps
+    lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
+    hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
+    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
+    hyp = (ms[None, :] >= lo[:, None]) & (ms[None, :] <= hi[:, None])
+    hyp[~hyp.any(axis=1), ms.tolist().index(0)] = True
+    present = np.zeros((len(v), cfg.num_tx), bool)
+    for c in range(cfg.num_tx):
+        present[:, c] = hyp[:, ms % cfg.num_tx == c].any(axis=1)
+    return present
+
+
+def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
+                          noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
+                          params: DetectionParams, frame: int = 0) -> PointCloud:
+    """``host.pipeline.points_from_cells`` (steps 3 to 5 there; same arguments, same
+    points) with less work: angle peaks (``host.angle.fine_peaks``) only of the TDM alias
+    classes in :func:`hypothesis_classes` (the others do not enter ``choose_folds``), and
+    the second-component search screened (``host.angle.estimate_angles_screened``).
+
+    cells: int (n, 2) (range_bin, doppler_bin natural order); snapshots: complex
+    (n, n_virtual); power, noise: float (n,); offsets: float (n, 2) bins."""
+    n = len(cells)
+    if not n:
+        return PointCloud.empty()
+    nd, nv, ntx = cfg.n_doppler, cfg.n_virtual, cfg.num_tx
+    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
+    x = np.asarray(snapshots)
+    noise = np.asarray(noise, dtype=float)
+    sb = signed_bins(nd)[d].astype(np.int64)
+    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    measured = (sb + offsets[:, 1]) * cfg.velocity_bin_mps
+    if ntx > 1 and params.unfold_velocity:
+        ci, cc = np.nonzero(hypothesis_classes(cfg, measured, params))   # (cell, class) pairs
+        # complex128 before the gather: the same products as x * phasor, one cast per cell
+        xc = _tdm_compensate(cfg, x.astype(np.complex128)[ci], sb[ci] + cc * nd)  # (p, n_v)
+        pw, sn = peak_power_lean(xc, params.angle.n_fft)
+        class_power = np.zeros((n, ntx))         # absent classes: masked by choose_folds
+        class_power[ci, cc] = pw
+        pair = np.full((n, ntx), -1, np.int64)
+        pair[ci, cc] = np.arange(len(ci))
+        fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
+        # the fold's class always holds a hypothesis: its vector and peak were computed
+        sel = pair[np.arange(n), fold % ntx]
+        ang = estimate_angles_screened(xc[sel], noise / nv, params.angle, first_sin=sn[sel])
+    else:
+        fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, cell_snr_db, params)
+        ang = estimate_angles_screened(_tdm_compensate(cfg, x, sb + fold * nd), noise / nv,
+                                       params.angle)
+    return _cloud(cfg, params, r, offsets, sb + fold * nd, ambiguous, ang.cell,
+                  ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
+
+
+def _check_channels(arr: RecordArrays, cfg: RadarConfig) -> None:
     if arr.snapshot.shape[1:] != (cfg.n_virtual,):
         raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
                          f"{cfg.n_virtual} virtual channels")
-    select = select_records_reference if reference else select_records
-    idx, pmap = select(arr, cfg, params)
+
+
+def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
+                    frame: int = 0, reference: bool = False) -> PointCloud:
+    """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
+    -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``:
+    record selection (steps 1 to 3), peak offsets (step 4), :func:`points_from_snapshots`.
+    The public records -> point cloud function (CLI, live view). ``reference``: run the
+    replaced implementation (:func:`process_records_reference`; benchmark, tests)."""
+    params = params or DetectionParams()
+    _check_channels(arr, cfg)
+    if reference:
+        return process_records_reference(arr, cfg, params, frame)
+    idx, pmap = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
-    fn = points_from_cells_reference if reference else points_from_cells
-    return fn(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
+    return points_from_snapshots(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
+                                 offsets, cfg, params, frame)
+
+
+def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
+                              params: DetectionParams | None = None, frame: int = 0
+                              ) -> PointCloud:
+    """The implementation :func:`process_records` replaced (``host.pipeline.
+    points_from_cells``: every TDM alias class's angle peaks, every cell's second-component
+    search); same points (tests). The map-based selection and 1024-point FFTs before it are
+    ``select_records_reference`` and ``host.pipeline.points_from_cells_reference``."""
+    params = params or DetectionParams()
+    _check_channels(arr, cfg)
+    idx, pmap = select_records(arr, cfg, params)
+    cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
+    offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
+    return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                              offsets, cfg, params, frame)
