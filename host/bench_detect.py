@@ -35,7 +35,7 @@ import numpy as np
 
 from host.cfar import CfarParams
 from host.evaluate import match_targets
-from host.pipeline import DetectionParams, process_cube
+from host.pipeline import DetectionParams, _tdm_comp, process_cube
 from host.pointcloud import PointCloud
 from host.record_points import process_records
 from host.records import RecordDecoder, fpga_detect_config, record_arrays
@@ -44,7 +44,7 @@ from model.config import RadarConfig, get_preset
 from model.detect_chain import DetectConfig
 from model.detect_records import Record, encode_frame
 from model.radar_pipeline import PipelineParams, chain_gain, run_chain
-from model.reference import tdm_phase_compensation
+from model.reference import signed_bins
 from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_scene, thermal_noise
 
@@ -163,11 +163,14 @@ def false_alarm_rows(preset: str, frames: int, pfas: tuple[float, ...]
     return out
 
 
-def synthetic_records(cfg: RadarConfig, n: int, seed: int = 0) -> list[Record]:
+def synthetic_records(cfg: RadarConfig, n: int, seed: int = 0, varied: bool = False
+                      ) -> list[Record]:
     """``n`` records of isolated point targets (worst case for the host: no two in one 3x3
     neighbourhood is not guaranteed, but each is a peak of its own): a TDM-phased plane wave
     at a random angle, 40 dB over unit-variance noise per channel, the CFAR noise estimate
-    of that noise, in fixed-point LSB."""
+    of that noise, in fixed-point LSB. ``varied``: a mix closer to a real frame: SNR per
+    channel uniform in 0..45 dB, velocity aliased by a random alias order (-2..1, the TDM
+    test must unfold it), and every 8th record two targets at different angles."""
     rng = np.random.default_rng(seed)
     cells = rng.choice(cfg.n_range * cfg.n_doppler, n, replace=False)
     sigma = 3.0
@@ -176,9 +179,18 @@ def synthetic_records(cfg: RadarConfig, n: int, seed: int = 0) -> list[Record]:
     for k, c in enumerate(np.sort(cells)):
         r, d = divmod(int(c), cfg.n_doppler)
         s = rng.uniform(-0.9, 0.9)
-        x = 100 * sigma * np.exp(-1j * np.pi * v * s) * np.conj(tdm_phase_compensation(cfg, d))
+        amp, fold = 100 * sigma, 0
+        if varied:
+            amp = sigma * 10 ** (rng.uniform(0, 45) / 20)
+            fold = int(rng.integers(-2, 2))
+        kk = int(signed_bins(cfg.n_doppler)[d]) + fold * cfg.n_doppler
+        tdm = np.conj(_tdm_comp(cfg, kk))
+        x = amp * np.exp(-1j * np.pi * v * s) * tdm
+        if varied and k % 8 == 7:
+            x = x + 0.5 * amp * np.exp(-1j * np.pi * v * rng.uniform(-0.9, 0.9)) * tdm
         x = x + rng.normal(0, sigma / math.sqrt(2), (cfg.n_virtual, 2)) @ np.array([1, 1j])
-        x = np.round(x.real) + 1j * np.round(x.imag)
+        x = np.clip(np.round(x.real), -32768, 32767) + 1j * np.clip(np.round(x.imag), -32768,
+                                                                     32767)
         out.append(Record(range_bin=r, doppler_bin=d, power=int(np.sum(np.abs(x) ** 2)),
                           noise_sum=int(round(100 * cfg.n_virtual * sigma**2)), cells=100,
                           snapshot=pack_iq(x).reshape(cfg.num_tx, cfg.num_rx), index=k))
