@@ -296,22 +296,31 @@ def _steering_rows(s: np.ndarray, n: int) -> np.ndarray:
 
 
 def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.ndarray,
-                a1: np.ndarray, p1: np.ndarray, more: np.ndarray) -> AngleArrays:
+                a1: np.ndarray, p1: np.ndarray, more: np.ndarray, batched: bool = False
+                ) -> AngleArrays:
     """The :class:`AngleArrays` of rows xs (complex (n, n_ch)): the first component (sin
     s1, amplitude a1, power p1, float/complex (n,)) where ``more`` (bool (n,)) is False,
-    :func:`estimate_angles` of the row where it is True."""
+    :func:`estimate_angles` of the row where it is True (``batched``: of all those rows at
+    once, :func:`estimate_angles_rows`)."""
     n_rows, n = xs.shape
     snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
     multi = np.flatnonzero(more)
     if not len(multi):
         return AngleArrays(np.arange(n_rows), s1, a1, snr1)
-    cell, sin_az, amp, snr = [], [], [], []
-    for i in multi:
-        for c in estimate_angles(xs[i], float(noise[i]), params):
-            cell.append(i)
-            sin_az.append(c.sin_az)
-            amp.append(c.amplitude)
-            snr.append(c.snr_db)
+    cell: list = []
+    sin_az: list = []
+    amp: list = []
+    snr: list = []
+    if batched:
+        got = estimate_angles_rows(xs[multi], noise[multi], params)
+        cell, sin_az, amp, snr = multi[got.cell], got.sin_az, got.amplitude, got.snr_db
+    else:
+        for i in multi:
+            for c in estimate_angles(xs[i], float(noise[i]), params):
+                cell.append(i)
+                sin_az.append(c.sin_az)
+                amp.append(c.amplitude)
+                snr.append(c.snr_db)
     single = np.flatnonzero(~more)
     cell_a = np.concatenate([single, np.array(cell, np.int64)])
     order = np.argsort(cell_a, kind="stable")
@@ -356,7 +365,8 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
     projection power p2 = |s^H r / n|^2 (|s_v| = 1) passes both gates, and by
     Cauchy-Schwarz p2 <= ||r||^2 / n; rows whose bound fails a gate (a strong single target:
     the residual is noise more than ``dynamic_range_db`` below it; or a weak residual) skip
-    the residual's angle search, the others run it as there.
+    the residual's angle search, the others run it as there. Rows with several components
+    go through :func:`estimate_angles_rows` (all at once) instead of one by one.
 
     x: complex (n, n_channels); noise_per_channel: float (n,); first_sin: float (n,) the
     rows' strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
@@ -391,7 +401,7 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
                 more[rows] = (snr2 >= params.min_snr_db) & (
                     10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
                     <= params.dynamic_range_db)
-    return _components(xs, noise, params, s1, a1, p1, more)
+    return _components(xs, noise, params, s1, a1, p1, more, batched=True)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
@@ -428,6 +438,80 @@ def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: 
         else:
             out.append([AngleComponent(float(s1[i]), complex(a1[i]), float(snr1[i]))])
     return out
+
+
+def _steer(s: np.ndarray, n: int) -> np.ndarray:
+    """:func:`steering` of every s (float (m,)), complex (m, n), the same expression."""
+    return np.exp((-1j * np.pi * np.arange(n))[None, :] * s[:, None])
+
+
+def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
+                         ) -> AngleArrays:
+    """:func:`estimate_angles` of every row of x, complex (m, n), noise_per_channel float
+    (m,), run on all rows in step (the same components: the same peaks, from the batched
+    ``n_fft``-point FFT of :func:`peak_sin_batch`, the same gates, refinement passes in
+    the same order and the same de-duplication), as flat :class:`AngleArrays`."""
+    xs = np.asarray(x, dtype=np.complex128)
+    m, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    kmax = params.max_targets
+    s_c = np.zeros((m, kmax))
+    a_c = np.zeros((m, kmax), complex)
+    count = np.zeros(m, np.int64)
+    first = np.zeros(m)
+    residual = xs.copy()
+    live = np.arange(m)                     # rows still adding components, all with t comps
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for t in range(kmax):
+            if not len(live):
+                break
+            s, _ = peak_sin_batch(residual[live], params.n_fft)
+            a = np.sum(np.conj(_steer(s, n)) * residual[live], axis=1) / n
+            power = np.abs(a) ** 2
+            snr_db = 10 * np.log10(power * n / noise[live])
+            stop = np.zeros(len(live), bool)
+            if t:
+                stop = (snr_db < params.min_snr_db) | (
+                    10 * np.log10(first[live] / power) > params.dynamic_range_db)
+            keep = ~stop
+            live, s, a, power = live[keep], s[keep], a[keep], power[keep]
+            s_c[live, t], a_c[live, t] = s, a
+            count[live] = t + 1
+            first[live] = np.where(first[live] != 0, first[live], power)
+            if t:
+                xl = xs[live]
+                for _ in range(params.refine_iterations):
+                    for j in range(t + 1):
+                        others = np.zeros((len(live), n), complex)
+                        for i in range(t + 1):
+                            if i != j:
+                                others = others + a_c[live, i][:, None] * _steer(s_c[live, i],
+                                                                                 n)
+                        r = xl - others
+                        sj, _ = peak_sin_batch(r, params.n_fft)
+                        s_c[live, j] = sj
+                        a_c[live, j] = np.sum(np.conj(_steer(sj, n)) * r, axis=1) / n
+            total = np.zeros((len(live), n), complex)
+            for i in range(t + 1):
+                total = total + a_c[live, i][:, None] * _steer(s_c[live, i], n)
+            residual[live] = xs[live] - total
+        snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
+    cell, sin_az, amp, snr = [], [], [], []
+    for row in range(m):
+        k = int(count[row])
+        # strongest first (a stable sort, as sorted()), then drop collapsed components
+        order = sorted(range(k), key=lambda i: -abs(a_c[row, i]))
+        kept: list[int] = []
+        for i in order:
+            if all(abs(s_c[row, i] - s_c[row, u]) > 0.5 / n for u in kept):
+                kept.append(i)
+        for i in kept:
+            cell.append(row)
+            sin_az.append(float(s_c[row, i]))
+            amp.append(complex(a_c[row, i]))
+            snr.append(float(snr_c[row, i]))
+    return AngleArrays(np.array(cell, np.int64), np.array(sin_az), np.array(amp, complex),
+                       np.array(snr))
 
 
 def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams

@@ -12,11 +12,15 @@ cost on the link and on the host. Prints four tables:
    10, 100, 1000 detections (measured on encoded, packetized frames) vs the radar cube
    (goal: fits the paper's measured 766 Mbit/s);
 4. host time per frame for 10, 100, 1000 detections on one core, CPU and wall, the replaced
-   code ("old") beside the current one in the same run: DMA bytes -> records (decoder) and
-   records -> point cloud (goal <= 5 ms for 1000). Table 1 also gives the azimuth errors of
-   both, and in how many scenes old and new clouds agree.
+   code ("old": ``Record`` objects, ``process_records_reference``) beside the current one
+   (arrays, ``process_records``) in the same run: DMA bytes -> records (decoder), records ->
+   point cloud, and both (goal <= 5 ms for 1000), on strong isolated targets and on a mixed
+   frame (``synthetic_records(varied=True)``). One core: the process is pinned to one CPU
+   and the BLAS / OpenMP pools get one thread (set before numpy loads). Table 1 also gives
+   the azimuth errors of both, and in how many scenes old and new clouds agree.
 
     python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
+                                [--repeat 5] [--host-only]
 
 Uses the bit-accurate model of the chain (mode 0 cube, mode 1 records). Reported, never
 asserted in tests.
@@ -24,10 +28,15 @@ asserted in tests.
 
 from __future__ import annotations
 
-import argparse
-import math
 import os
-import time
+
+if __name__ == "__main__":     # one core: one-thread BLAS / OpenMP pools, before numpy loads
+    for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import time  # noqa: E402
 from collections.abc import Callable
 from dataclasses import fields
 
@@ -38,7 +47,7 @@ from host.evaluate import match_targets
 from host.pipeline import DetectionParams, _tdm_comp, process_cube
 from host.pointcloud import PointCloud
 from host.record_points import process_records
-from host.records import RecordDecoder, fpga_detect_config, record_arrays
+from host.records import RecordArrays, RecordDecoder, fpga_detect_config, record_arrays
 from model.axis_packetizer import pack_iq, packetize, packetize_stream, words_to_bytes
 from model.config import RadarConfig, get_preset
 from model.detect_chain import DetectConfig
@@ -239,29 +248,43 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> tuple[float, float]:
     return cpu * 1e3, wall * 1e3
 
 
-def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False
-                   ) -> tuple[tuple[float, float], tuple[float, float], int]:
-    """((CPU, wall) ms of DMA bytes -> record arrays, (CPU, wall) ms of records -> point
-    cloud, points) for one frame of ``n`` synthetic records; ``reference``: through the
-    replaced code (per-record ``decode_frame_reference``, map-based record selection,
-    ``points_from_cells_reference`` with its 1024-point FFTs and per-cell decisions)."""
+def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
+                   varied: bool = False
+                   ) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float],
+                              int]:
+    """((CPU, wall) ms of DMA bytes -> record arrays, of records -> point cloud, of both
+    in one go, points) for one frame of ``n`` synthetic records (``varied``: see
+    :func:`synthetic_records`); ``reference``: through the replaced code (``Record``
+    objects from ``model.detect_records.decode_frame``, ``record_arrays_reference``,
+    ``process_records_reference``)."""
     cfg = get_preset(preset)
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
-    frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)
+    frame = encode_frame(synthetic_records(cfg, n, varied=varied), n, cfg.num_tx, cfg.num_rx,
+                         n)
     packets = [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[preset])]
     gain = chain_gain(cfg, PipelineParams())
 
-    def decode() -> object:
+    def decode() -> RecordArrays:
         dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[preset], reference=reference)
         got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
-        return record_arrays(got[0].records, cfg.n_virtual, gain)
+        return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
+
+    def cloud(arr: RecordArrays) -> PointCloud:
+        return process_records(arr, cfg, params, reference=reference)
 
     arr = decode()
     t_dec = _best_ms(decode, repeat)
-    t_pc = _best_ms(lambda: process_records(arr, cfg, params,  # type: ignore[arg-type]
-                                            reference=reference), repeat)
-    return t_dec, t_pc, len(process_records(arr, cfg, params))  # type: ignore[arg-type]
+    t_pc = _best_ms(lambda: cloud(arr), repeat)
+    t_all = _best_ms(lambda: cloud(decode()), repeat)
+    return t_dec, t_pc, t_all, len(cloud(arr))
+
+
+def calibration_ms(repeat: int) -> float:
+    """CPU ms of 10^6 complex128 multiplications (this machine's speed and load at the
+    time; 1.0 to 1.5 ms on an unloaded recent x86 core)."""
+    a = np.ones(1_000_000, complex)
+    return _best_ms(lambda: a * a, repeat)[0]
 
 
 def main() -> None:
@@ -271,12 +294,21 @@ def main() -> None:
                     help="random full scenes (about 6 s each on this machine)")
     ap.add_argument("--noise-frames", type=int, default=40, help="noise-only paper-fpga frames")
     ap.add_argument("--repeat", type=int, default=5, help="timing runs; best is reported")
+    ap.add_argument("--host-only", action="store_true",
+                    help="only table 4 (host time per frame), a minute instead of ~15")
     args = ap.parse_args()
     try:
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})   # one core
     except (AttributeError, OSError):
         pass
 
+    if not args.host_only:
+        other_tables(args)
+    host_table(args)
+
+
+def other_tables(args: argparse.Namespace) -> None:
+    """Tables 1 to 3 (module docstring)."""
     print("## Detection: --detect fpga (on-chip CFAR, records) vs --detect host (cube)")
     print("| scenes | true targets | found, host | found, fpga | fpga finds of host's | "
           "fpga only | mean range err host / fpga (m) | mean az err host / fpga (deg), "
@@ -311,18 +343,29 @@ def main() -> None:
     for what, b, mbps in link_rows("full", (10, 100, 1000)):
         print(f"| {what} | {b:,} | {mbps:,.1f} | {'yes' if mbps <= LINK_MBPS else 'no'} |")
 
+
+
+def host_table(args: argparse.Namespace) -> None:
+    """Table 4 (module docstring)."""
     print(f"\n## Host time per full frame, one core (best of {args.repeat}; CPU = "
-          f"process_time, wall = perf_counter; old = the replaced code, same run)")
-    print("| detections | step | old CPU ms | new CPU ms | old wall ms | new wall ms | "
+          f"process_time, wall = perf_counter; old = the replaced code, same run; "
+          f"10^6 complex multiplications take {calibration_ms(args.repeat):.2f} ms CPU here)")
+    print("| detections | frame | step | old CPU ms | new CPU ms | old wall ms | new wall ms | "
           "CPU speed-up |")
-    print("|---|---|---|---|---|---|---|")
-    for n in (10, 100, 1000):
-        od, op, _ = host_time_rows("full", n, args.repeat, reference=True)
-        nd_, np_, pts = host_time_rows("full", n, args.repeat)
-        for step, o, w in (("DMA bytes -> records", od, nd_),
-                           (f"records -> point cloud ({pts} points)", op, np_)):
-            print(f"| {n} | {step} | {o[0]:.2f} | {w[0]:.2f} | {o[1]:.2f} | {w[1]:.2f} | "
-                  f"{o[0] / max(w[0], 1e-9):.1f}x |")
+    print("|---|---|---|---|---|---|---|---|")
+    for varied in (False, True):
+        for n in (10, 100, 1000):
+            od, op, oa, _ = host_time_rows("full", n, args.repeat, reference=True,
+                                           varied=varied)
+            nd_, np_, na, pts = host_time_rows("full", n, args.repeat, varied=varied)
+            kind = "mixed" if varied else "strong"
+            for step, o, w in (("DMA bytes -> records", od, nd_),
+                               (f"records -> point cloud ({pts} points)", op, np_),
+                               ("DMA bytes -> point cloud", oa, na)):
+                print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {w[0]:.2f} | {o[1]:.2f} | "
+                      f"{w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
+    print(f"\nCPU calibration after the runs: {calibration_ms(args.repeat):.2f} ms per 10^6 "
+          f"complex multiplications")
 
 
 if __name__ == "__main__":
