@@ -281,8 +281,8 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
 
 
 def calibration_ms(repeat: int) -> float:
-    """CPU ms of 10^6 complex128 multiplications (this machine's speed and load at the
-    time; 1.0 to 1.5 ms on an unloaded recent x86 core)."""
+    """CPU ms of 10^6 complex128 multiplications: this machine's speed and load at the time
+    (to compare runs on differently loaded machines)."""
     a = np.ones(1_000_000, complex)
     return _best_ms(lambda: a * a, repeat)[0]
 
