@@ -30,6 +30,8 @@ CLI); :func:`process_records_reference` is the path it replaced (benchmark, test
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from host.angle import estimate_angles_screened, peak_power_lean
@@ -107,6 +109,15 @@ def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
     return out
 
 
+@lru_cache(maxsize=16)
+def _envelope(n: int, windowed: bool, margin_db: float) -> np.ndarray:
+    """``host.cfar.sidelobe_envelope`` times the margin, float (n,), computed once per
+    setting (read-only)."""
+    env = sidelobe_envelope(n, windowed) * 10 ** (margin_db / 10)
+    env.flags.writeable = False
+    return env
+
+
 def sparse_sidelobe_masked(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
                            margin_db: float, nonzero: tuple[np.ndarray, np.ndarray] | None = None
                            ) -> np.ndarray:
@@ -116,8 +127,8 @@ def sparse_sidelobe_masked(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[
     (n_range, n_doppler); cells: int (m, 2); ``nonzero``: (rows, columns) of pmap's
     non-zero cells when the caller knows them. Returns bool (m,)."""
     nr, nd = pmap.shape
-    env_r = sidelobe_envelope(nr, windowed[0]) * 10 ** (margin_db / 10)
-    env_d = sidelobe_envelope(nd, windowed[1]) * 10 ** (margin_db / 10)
+    env_r = _envelope(nr, windowed[0], margin_db)
+    env_d = _envelope(nd, windowed[1], margin_db)
     rr, dd = np.nonzero(pmap) if nonzero is None else nonzero
     w = pmap[rr, dd]
     r, d = cells[:, 0], cells[:, 1]
@@ -136,12 +147,12 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     ``host.cfar.sidelobe_masked`` on the map (:func:`select_records_reference`)."""
     nr, nd = cfg.n_range, cfg.n_doppler
     pmap = np.zeros((nr, nd))
-    index = np.full((nr, nd), -1, np.int64)
-    pmap[arr.range_bin, arr.doppler_bin] = arr.power
-    index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
+    index1 = np.zeros((nr, nd), np.int64)     # record index + 1 (zeros: pages never touched
+    pmap[arr.range_bin, arr.doppler_bin] = arr.power          # cost nothing)
+    index1[arr.range_bin, arr.doppler_bin] = np.arange(1, len(arr) + 1)
     lo, hi = cfg.detection_bins
     r, d = arr.range_bin, arr.doppler_bin
-    own = (index[r, d] == np.arange(len(arr))) & (pmap[r, d] > 0)     # pmap's non-zero cells
+    own = (index1[r, d] == np.arange(1, len(arr) + 1)) & (pmap[r, d] > 0)  # pmap's non-zeros
     nonzero = (r[own], d[own])
     i = np.flatnonzero(own & (r >= lo) & (r < hi))
     r, d = r[i], d[i]
