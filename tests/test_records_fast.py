@@ -302,6 +302,7 @@ def test_process_records_is_the_reference_on_synthetic_frames(preset: str) -> No
                  synthetic_records(cfg, big, seed=2, varied=True)):
         arr = record_arrays(recs, cfg.n_virtual, 37.0)
         for params in (DetectionParams(), DetectionParams(max_speed_mps=30.0),
+                       DetectionParams(max_speed_mps=5.0),     # cells with no hypothesis
                        DetectionParams(unfold_velocity=False, sidelobe_margin_db=None)):
             new = process_records(arr, cfg, params, frame=3)
             _same_cloud(new, process_records(arr, cfg, params, frame=3, reference=True))
