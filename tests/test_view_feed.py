@@ -145,7 +145,7 @@ def test_preset_learnt_from_the_header():
 
     class Rec(Processor):
         def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:
-            got.append((frame_id, cube.shape, scale, cfg.name))
+            got.append((frame_id, cube.cube().shape, scale, cfg.name))  # lazy: decoded here
 
     ingest = PacketIngest(full, None, health, Rec(full, Feed(), health), gain=1.0,
                           configs=list(PRESETS.values()))
