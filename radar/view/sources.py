@@ -210,7 +210,14 @@ class Processor:
 
     def _process_records(self, job: _RecordJob, skipped: int) -> None:
         cfg, f = job.cfg, job.frame
-        arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, job.gain)
+        records = f.records[:f.usable_records]
+        inside = [r for r in records if r.range_bin < cfg.n_range and r.doppler_bin < cfg.n_doppler]
+        if len(inside) < len(records):  # corrupt words that still looked like records
+            with self.health.lock:
+                self.health.problems.append(
+                    f"frame {job.frame_id}: {len(records) - len(inside)} record(s) outside "
+                    f"the {cfg.n_range} x {cfg.n_doppler} map dropped")
+        arr = record_arrays(inside, cfg.n_virtual, job.gain)
         cloud = process_records(arr, cfg, self.params, frame=job.frame_id)
         objects = self._objects(cloud)
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=job.frame_id, cfg=cfg,
