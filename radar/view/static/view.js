@@ -9,6 +9,9 @@ const state = window.radarView = {
   // benchmark hooks: hold = true stops drawing live messages; lastFrame is the newest frame
   // message drawn; drawFrame(msg) draws one message (radar.view.bench_view times it)
   hold: false, lastFrame: null, drawFrame: null,
+  // benchmark hook: serial = true draws the plots one after another, as before 2026-11-23
+  // (radar.view.bench_view compares the display rates in the same run)
+  serial: false,
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };
 const MARGIN = { l: 55, r: 10, t: 30, b: 40 };
@@ -321,12 +324,22 @@ async function draw(msg) {
     document.getElementById("frame_id").textContent = msg.frame_id;
     const input = document.getElementById("channel");
     input.max = msg.n_virtual - 1;
-    await timed("rd", () => heatmap("plot-rd", msg.rd,
-                                      `range-Doppler, virtual channel ${msg.channel}`, msg));
-    await timed("nci", () => heatmap("plot-nci", msg.nci,
-                                     "range-Doppler, integrated over channels", msg));
-    await timed("cloud", () => pointCloud("plot-cloud", msg));
-    await timed("profile", () => profile("plot-profile", msg));
+    // the four plots at once: Plotly.animate resolves on the next animation frame, so plots
+    // drawn one after another would each wait for a frame of their own (3 frames, 50 ms, a
+    // 20 updates/s ceiling however fast the machine); together they share one
+    const plots = [
+      () => timed("rd", () => heatmap("plot-rd", msg.rd,
+                                      `range-Doppler, virtual channel ${msg.channel}`, msg)),
+      () => timed("nci", () => heatmap("plot-nci", msg.nci,
+                                       "range-Doppler, integrated over channels", msg)),
+      () => timed("cloud", () => pointCloud("plot-cloud", msg)),
+      () => timed("profile", () => profile("plot-profile", msg)),
+    ];
+    if (state.serial) {
+      for (const plot of plots) await plot();
+    } else {
+      await Promise.all(plots.map(plot => plot()));
+    }
     state.frames += 1;
     state.lastSeq = msg.seq;
     state.lastFrame = msg;
@@ -348,12 +361,16 @@ async function drawLoop() {
     if (ws && ws.readyState === WebSocket.OPEN) {
       ws.send(JSON.stringify({ ack: msg.seq ?? null, draw_fps: state.drawFps }));
     }
+    const t0 = performance.now();
     try {
       await draw(msg);
     } catch (err) {
       console.error("radar view: draw failed", err);
     }
-    await new Promise(resolve => requestAnimationFrame(resolve));  // let the browser paint
+    // let the browser paint, unless the draw already waited for an animation frame
+    if (state.serial || performance.now() - t0 < 8) {
+      await new Promise(resolve => requestAnimationFrame(resolve));
+    }
   }
   drawing = false;
 }
