@@ -34,7 +34,6 @@ from host.stream import (
     PacketDecoder,
     cube_frame_words,
     geometry_from_packet,
-    payload_words_to_cube,
 )
 from host.udp import UDP_MAX_PAYLOAD, max_packet_words
 from model.axis_packetizer import packets_per_frame, words_to_bytes
@@ -83,8 +82,22 @@ class PayloadFrame:
         return bool(self.valid.all()) and not self.problems
 
     def cube(self) -> np.ndarray:
-        """complex64 (n_virtual, n_range, n_doppler), LSB (``payload_words_to_cube``)."""
-        return payload_words_to_cube(self.words, self.cfg)
+        """complex64 (n_virtual, n_range, n_doppler), LSB (:func:`words_to_cube`)."""
+        return words_to_cube(self.words, self.cfg)
+
+
+def words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
+    """``host.stream.payload_words_to_cube`` (same result, tested equal), about 2x faster
+    on a ``full`` frame: the 32-bit {Q, I} words are transposed to channel order while
+    still words (one strided copy), then widened contiguously. words: uint32 (frame_words,
+    num_rx) in DMA order -> complex64 (n_virtual, n_range, n_doppler)."""
+    w = np.ascontiguousarray(words, dtype="<u4").reshape(
+        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
+    t[...] = w.transpose(0, 3, 1, 2)
+    iq = np.empty(t.shape + (2,), np.float32)
+    iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
+    return iq.view(np.complex64).reshape(cfg.cube_shape)
 
 
 class CubePayloadDecoder(PacketDecoder[PayloadFrame]):
