@@ -147,6 +147,14 @@ def _corrupt_record_tag(packet: bytes) -> bytes:
     return words.tobytes()
 
 
+def _record_off_the_map(packet: bytes) -> bytes:
+    """The packet with its first record's range bin set to 4095 (tag and packet intact: the
+    frame decodes as complete, the record lies outside the map)."""
+    words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx).copy()
+    words[1, 0] |= 0xFFF << 12
+    return words.tobytes()
+
+
 def test_malformed_record_datagrams_are_counted_never_raised(streams):
     """Garbage, short, odd-length, bad-magic datagrams, a packet of the wrong length, a
     corrupt record inside an intact packet: counted (malformed datagrams, damaged frames),
@@ -199,9 +207,24 @@ def test_record_frames_processed_into_a_view_frame(streams):
             if f is not None and f.frame_id == 1:
                 break
             stop.wait(0.05)
+        # a record whose range bin lies off the map (corrupt bits, intact packet) is dropped
+        _push(ingest, [[_record_off_the_map(streams["plenty"][0][0])]
+                       + streams["plenty"][0][1:]])
+        for _ in range(200):
+            if any("outside" in p for p in health.snapshot()["problems"]):
+                break
+            stop.wait(0.05)
+        _push(ingest, streams["plenty"][1:])
+        for _ in range(200):
+            f = feed.latest()
+            if f is not None and f.frame_id == 1 and f.seq > 2:
+                break
+            stop.wait(0.05)
     finally:
         stop.set()
         t.join()
+    assert any("1 record(s) outside the 64 x 256 map" in p
+               for p in health.snapshot()["problems"]), health.snapshot()["problems"]
     frame = feed.latest()
     assert frame is not None and frame.frame_id == 1 and frame.cube is None
     assert proc.errors == 0, health.snapshot()["problems"]
