@@ -4,8 +4,10 @@ A `radar view` process listens for UDP on loopback; this test sends it the DMA p
 short Table I capture (paper-fpga) over UDP, as the board would, and checks on the page that
 the plots are drawn with data, the counters move, an injected loss and malformed datagrams
 show up, a page reload reconnects, a sender pause and restart is survived, and the page loads
-nothing from outside the server. About 30 s; the waits allow three times that, since the
-regression runs beside Verilator builds on two cores (they guard liveness, not speed).
+nothing from outside the server; and the same for the on-chip detector's record stream (records
+and points drawn, the sticky TRUNCATED flag shown). About 30 s + 20 s on a quiet machine (2 min
+at load 15); the waits allow three times that, since the regression runs beside Verilator
+builds on two cores (they guard liveness, not speed).
 """
 
 from __future__ import annotations

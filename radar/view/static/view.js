@@ -183,6 +183,7 @@ function detectionMap(div, msg) {
   if (c) {
     let lo = Infinity, hi = -Infinity;
     for (const v of c.db) { if (v < lo) lo = v; if (v > hi) hi = v; }
+    if (!c.db.length) { lo = 0; hi = 10; }  // a frame without records
     traces.push({
       type: "scatter", mode: "markers", x: c.v, y: c.range, name: "records",
       marker: { size: 6, color: c.db, cmin: 5 * Math.floor(lo / 5), cmax: 5 * Math.ceil(hi / 5),
