@@ -139,6 +139,17 @@ def test_stream_kind_learnt_from_the_headers(streams, packet_words):
     assert s["stream_kind"] == CUBE and keep.cubes == [5] and s["malformed"] == 0
 
 
+def test_wrong_max_detections_is_said(streams):
+    """A record stream of another MAX_DETECTIONS than --max-detections fits nothing: the
+    health panel says why (once), nothing is shown as a frame of the wrong kind."""
+    ingest, health, keep = _ingest(None, MAX_DET["plenty"], None, learn=True)
+    _push(ingest, streams["few"])
+    s = health.snapshot()
+    said = [p for p in s["problems"] if "fits no cube or record stream" in p]
+    assert len(said) == 1 and "--max-detections" in said[0], s["problems"]
+    assert keep.records == []
+
+
 def _corrupt_record_tag(packet: bytes) -> bytes:
     """The packet with its first record's tag byte destroyed (header word stays valid)."""
     words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx).copy()

@@ -1,15 +1,16 @@
 """Benchmark of ``radar view`` in a real browser (prints a table; not a test).
 
-For each preset a short Table I capture is made (float reference of the FPGA chain, scaled by
-the chain gain and rounded to int16 exactly like the DMA payload), replayed by ``radar view``
-faster than the goal, and watched by headless chromium for ``--duration`` seconds. Reported:
-frames/s decoded by the view, display updates/s drawn by the page (the goal: >= 20 for
-paper-fpga, >= 5 for full; ``records``: the Table I scene's record stream, on-chip detection
-on paper-fpga, through the bit-accurate model, held to paper-fpga's 20), frames the view skipped to stay current, and the view process's
-resident memory (start / end / max, MiB) and the page's JS heap: flat memory means nothing
-queues up. "draw ms" is the page's time to draw one update (all four plots), so the display
-rate an idle machine reaches is about 1000 / draw ms; the load average is printed because the
-machine is shared. ``--minutes 10`` is the 10-minute run of the issue.
+For each preset a short Table I capture is made (float reference of the FPGA chain, scaled
+by the chain gain and rounded to int16 exactly like the DMA payload), replayed by ``radar
+view`` faster than the goal, and watched by headless chromium for ``--duration`` seconds.
+Reported: frames/s decoded by the view, display updates/s drawn by the page (the goal: >= 20
+for paper-fpga, >= 5 for full; ``records``: the Table I scene's record stream, on-chip
+detection on paper-fpga, through the bit-accurate model, held to paper-fpga's 20), frames
+the view skipped to stay current, and the view process's resident memory (start / end / max,
+MiB) and the page's JS heap: flat memory means nothing queues up. "draw ms" is the page's
+time to draw one update (all four plots), so the display rate an idle machine reaches is
+about 1000 / draw ms; the load average is printed because the machine is shared. ``--minutes
+10`` is the 10-minute run of the issue.
 
 Where the time goes, as CPU time per frame (independent of the machine's load): the view
 process's decode, host processing and message preparation (timed here on the capture's first

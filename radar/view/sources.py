@@ -278,6 +278,7 @@ class PacketIngest:
         if kind is not None:
             self._announce()
         self._learn = self._learning()
+        self._unfit_said = False
         self._late_run: list[bytes] = []
         self._late_msgs: list[str] = []
         self._last_id: int | None = None
@@ -335,7 +336,23 @@ class PacketIngest:
         (which counts it as malformed)."""
         fit = self._fit(data)
         if fit is None:
+            if not self._unfit_said:  # once per (re)start: the first datagrams may be junk
+                self._unfit_said = True
+                mx = ""
+                if self.fixed_kind != CUBE and self.detect_config is not None:
+                    try:
+                        mx = (f" (a record stream must have the sender's MAX_DETECTIONS, "
+                              f"here {self.detect_config(self.cfg).max_detections}: "
+                              f"--max-detections)")
+                    except ValueError:
+                        mx = ""
+                with self.health.lock:
+                    self.health.problems.append(
+                        f"datagram of {len(data)} bytes fits no "
+                        f"{self.fixed_kind or 'cube or record'} stream of "
+                        f"{', '.join(c.name for c in self.configs)}{mx}")
             return
+        self._unfit_said = False
         cfg, pw, kind = fit
         self._learn = False
         pw = self.fixed_packet_words or pw
