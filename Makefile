@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
-        gnn-eval clean help view bench-view test-detect-long test-full \
+        gnn-eval clean help view view-records bench-view test-detect-long test-full \
         formal coverage mutate mutate-ci
 all: test
 
@@ -33,6 +33,7 @@ help:
 	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"
 	@echo "make view            live browser view of the Table I replay at http://127.0.0.1:8050/"
+	@echo "make view-records    the same, as the on-chip detector's record stream (--detect fpga)"
 	@echo "make bench-view      browser display updates/s and memory of radar view (table)"
 	@echo "make formal          SymbiYosys proofs of formal/*.sby (k-induction, bmc, cover), table"
 	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
@@ -137,6 +138,16 @@ $(VIEW_CAPTURE): | $(STAMP)
 
 view: $(STAMP) $(VIEW_CAPTURE)
 	$(RUN) radar view --replay $(VIEW_CAPTURE) --gnn --ego-speed 27.78
+
+# the same scene as the on-chip detector's record stream (OUTPUT_MODE = 1)
+VIEW_RECORDS ?= $(OUT)/table1_paper-fpga_records.dmacap
+
+$(VIEW_RECORDS): | $(STAMP)
+	mkdir -p $(dir $@)
+	$(RUN) radar capture --scene table1 --preset paper-fpga --frames 8 --detect fpga --out $@
+
+view-records: $(STAMP) $(VIEW_RECORDS)
+	$(RUN) radar view --replay $(VIEW_RECORDS) --gnn --ego-speed 27.78
 
 bench-view: $(STAMP)
 	$(RUN) python -m radar.view.bench_view

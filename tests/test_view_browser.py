@@ -4,8 +4,10 @@ A `radar view` process listens for UDP on loopback; this test sends it the DMA p
 short Table I capture (paper-fpga) over UDP, as the board would, and checks on the page that
 the plots are drawn with data, the counters move, an injected loss and malformed datagrams
 show up, a page reload reconnects, a sender pause and restart is survived, and the page loads
-nothing from outside the server. About 30 s; the waits allow three times that, since the
-regression runs beside Verilator builds on two cores (they guard liveness, not speed).
+nothing from outside the server; and the same for the on-chip detector's record stream (records
+and points drawn, the sticky TRUNCATED flag shown). About 30 s + 20 s on a quiet machine (2 min
+at load 15); the waits allow three times that, since the regression runs beside Verilator
+builds on two cores (they guard liveness, not speed).
 """
 
 from __future__ import annotations
@@ -28,13 +30,15 @@ pytestmark = pytest.mark.skipif(_REASON is not None, reason=_REASON or "")
 
 class Sender(threading.Thread):
     """Sends the capture's packets over UDP, pass after pass (frame ids start again each
-    pass), about 10 frames/s. ``mode``: "clean", "loss" (one pass with 25 % loss and two
-    malformed datagrams, then clean again), "pause" (nothing)."""
+    pass), paced to ``rate_bps`` (the default: about 10 cube frames/s). ``mode``: "clean",
+    "loss" (one pass with 25 % loss and two malformed datagrams, then clean again), "pause"
+    (nothing)."""
 
-    def __init__(self, packets: list[bytes], port: int) -> None:
+    def __init__(self, packets: list[bytes], port: int, rate_bps: float = 25e6) -> None:
         super().__init__(daemon=True)
         self.packets = packets
         self.port = port
+        self.rate_bps = rate_bps
         self.mode = "clean"
         self.passes = 0
         self.stop = threading.Event()
@@ -46,7 +50,7 @@ class Sender(threading.Thread):
                 time.sleep(0.05)
                 continue
             imp = Impairments(loss=0.25, seed=self.passes) if mode == "loss" else None
-            with UdpSender("127.0.0.1", self.port, 25e6, imp) as tx:
+            with UdpSender("127.0.0.1", self.port, self.rate_bps, imp) as tx:
                 if mode == "loss":
                     tx.sock.sendto(b"not a DMA packet", tx.addr)
                     tx.sock.sendto(bytes(48), tx.addr)
@@ -252,4 +256,72 @@ def test_record_frames_in_browser(tmp_path):
     finally:
         stop.set()
         server.stop()
+    assert not errors, f"the page logged errors: {errors[:3]}"
+
+
+@pytest.fixture(scope="module")
+def record_capture(tmp_path_factory) -> Path:
+    """The on-chip detector's records of 2 Table I frames, MAX_DETECTIONS 8 (fewer than the
+    CFAR passes: every frame's trailer says truncated)."""
+    path = tmp_path_factory.mktemp("view") / "table1_records.dmacap"
+    assert radar_main(["capture", "--scene", "table1", "--preset", "paper-fpga",
+                       "--detect", "fpga", "--max-detections", "8", "--frames", "2",
+                       "--out", str(path)]) == 0
+    return path
+
+
+def test_record_stream_in_browser(record_capture, tmp_path):
+    """A detection-record stream over UDP (kind and preset learnt from the headers, the
+    sender's --max-detections given): the records and points render, the counters move,
+    the record rows of the health panel show the on-chip detections and the sticky
+    TRUNCATED flag, malformed datagrams are counted."""
+    from playwright.sync_api import sync_playwright
+
+    _, it = read_capture(record_capture)
+    packets = list(it)
+    view = start_view(["--udp-port", "0", "--max-detections", "8"])
+    # about 20 frames/s: faster would only fill the socket buffer (the kernel drops, unseen)
+    sender = Sender(packets, view.udp_port, rate_bps=20 * 8 * len(packets[0]))
+    errors: list[str] = []
+    try:
+        sender.start()
+        with sync_playwright() as pw:
+            ctx = launch(pw, tmp_path / "profile")
+            page = ctx.new_page()
+            page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
+            page.on("console", lambda m: errors.append(f"console: {m.text}")
+                    if m.type == "error" else None)
+            page.goto(view.url)
+            _wait(page, "window.radarView.frames >= 3", 90_000, errors)
+            drawn = page.evaluate("""() => {
+                const el = id => document.getElementById(id);
+                const rows = [...document.querySelectorAll('tr.rec')];
+                return {records: el('plot-nci').data[0].x.length,
+                        ringed: el('plot-nci').data[1].x.length,
+                        cloud: el('plot-cloud').data[0].x.length,
+                        profile: el('plot-profile').data[0].y.length,
+                        note: el('plot-rd').textContent.includes('records stream: no cube'),
+                        rowsShown: rows.length > 0 && rows.every(r => !r.hidden)};
+            }""")
+            assert drawn["records"] == 8 and drawn["profile"] == 8, drawn
+            assert drawn["cloud"] > 0 and drawn["ringed"] == drawn["cloud"], drawn
+            assert drawn["note"] and drawn["rowsShown"], drawn
+            assert _counter(page, "stream_kind") == "records"
+            assert _counter(page, "records") == "8" and _counter(page, "max_detections") == "8"
+            assert int(_counter(page, "cfar_detections")) > 8
+            assert _counter(page, "truncated") == "SET"
+            assert "alarm" in (page.locator("#h-truncated").get_attribute("class") or "")
+            assert page.locator("#h-truncated").is_visible()
+            before = int(_counter(page, "frames_complete"))
+            _wait(page, f"+document.getElementById('h-frames_complete').textContent > {before + 3}",
+                  45_000, errors)
+            sender.mode = "loss"  # 25 % loss and two malformed datagrams
+            _wait(page, "+document.getElementById('h-malformed').textContent >= 2", 45_000,
+                  errors)
+            page.screenshot(path=str(tmp_path / "radar_view_records.png"))
+            ctx.close()
+        assert view.proc.poll() is None, "the view process survived everything"
+    finally:
+        sender.stop.set()
+        view.stop()
     assert not errors, f"the page logged errors: {errors[:3]}"

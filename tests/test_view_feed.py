@@ -145,7 +145,7 @@ def test_preset_learnt_from_the_header():
 
     class Rec(Processor):
         def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:
-            got.append((frame_id, cube.shape, scale, cfg.name))
+            got.append((frame_id, cube.cube().shape, scale, cfg.name))  # lazy: decoded here
 
     ingest = PacketIngest(full, None, health, Rec(full, Feed(), health), gain=1.0,
                           configs=list(PRESETS.values()))
@@ -316,3 +316,17 @@ def test_page_assets_reference_no_external_url():
         name = r.removeprefix("/static/")
         assert (STATIC_DIR / name).is_file() or name == "plotly.min.js"
     assert plotly_js_path().stat().st_size > 1_000_000
+
+
+@pytest.mark.parametrize("preset", ["paper-fpga", "full"])
+def test_words_to_cube_is_the_host_decode(preset):
+    from host.stream import payload_words_to_cube
+    from radar.view.sources import words_to_cube
+
+    cfg = get_preset(preset)
+    rng = np.random.default_rng(3)
+    words = rng.integers(0, 2**32, (cfg.num_tx * cfg.n_range * cfg.n_doppler, cfg.num_rx),
+                         dtype=np.uint32)
+    got, want = words_to_cube(words, cfg), payload_words_to_cube(words, cfg)
+    assert got.dtype == want.dtype and got.shape == want.shape == cfg.cube_shape
+    assert np.array_equal(got, want)

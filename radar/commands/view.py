@@ -6,6 +6,11 @@ capture or a scene.
     radar view --scene table1 [--preset paper-fpga]          simulated frames
     ... [--host 127.0.0.1] [--port 8050] [--gnn]
 
+The stream is the radar cube or, with on-chip detection (``OUTPUT_MODE = 1``), the
+detector's records: a capture says which in its header (``RDMAREC1``), a UDP stream is
+recognised by its frame length (records need the sender's ``--max-detections``), a scene
+sends records with ``--detect fpga`` (bit-accurate model of the chain).
+
 The page is at http://HOST:PORT/. Binding to an address other than loopback needs
 ``--allow-remote`` (the page has no authentication).
 """
@@ -25,20 +30,27 @@ from typing import Any
 from host.capture import read_capture
 from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
+from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain
 from model.scene import EGO_SPEED_KMH, load_scene
 from model.simulate import simulate_scene
+from radar.commands.detect import add_fpga_options, fpga_config
 from radar.common import CliError, add_detection_options, detection_params
 from radar.sources import get_source
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
 from radar.view.server import ViewServer
 from radar.view.sources import (
+    CUBE,
+    RECORDS,
+    DetectConfigOf,
     PacketIngest,
     Processor,
+    capture_info,
     load_replay,
     replay_loop,
     scene_loop,
+    scene_record_frames,
     udp_loop,
 )
 
@@ -68,6 +80,32 @@ def preset_of_capture(path: Path) -> RadarConfig:
     raise ValueError(f"{path}: no preset has the capture's geometry {info}")
 
 
+def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
+    """The on-chip detector's configuration for a preset from the options (``--fpga-cfar``,
+    ``--max-detections``, the CFAR options); ValueError when they do not fit the preset."""
+    def of(cfg: RadarConfig) -> DetectConfig:
+        try:
+            return fpga_config(args, cfg, detection_params(args, cfg=cfg))
+        except CliError as exc:
+            raise ValueError(str(exc)) from None
+
+    return of
+
+
+def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
+    """The capture's stream kind (its header's magic), checked against ``--detect``."""
+    info = capture_info(path)
+    kind = RECORDS if info.records else CUBE
+    if args.detect == "host" and kind == RECORDS:
+        raise CliError(f"--detect host: {path} is a detection-record capture (RDMAREC1, "
+                       f"MAX_DETECTIONS {info.max_detections}); leave --detect out")
+    if args.detect == "fpga" and kind == CUBE:
+        raise CliError(f"--detect fpga: {path} is a radar-cube capture, not records")
+    if kind == RECORDS:
+        args.max_detections = info.max_detections  # the capture's, not the option's
+    return kind
+
+
 def _gnn(args: argparse.Namespace) -> Callable[..., list[dict[str, Any]]] | None:
     if not args.gnn:
         return None
@@ -86,20 +124,30 @@ def build(args: argparse.Namespace, stop: threading.Event
         raise CliError("--fps: must be >= 0")
     if not 0.0 <= args.loss <= 1.0:
         raise CliError("--loss: probability must be in [0, 1]")
+    kind: str | None = {"host": CUBE, "fpga": RECORDS, None: None}[args.detect]
+    detect_config = detect_config_of(args)
     try:
         if args.replay:
             path = Path(args.replay)
+            kind = _kind_of_replay(args, path)
             cfg = get_preset(args.preset) if args.preset else preset_of_capture(path)
-            packet_words, frames = load_replay(path, cfg)
-            desc = f"replay {path.name}"
+            frame_words = detect_config(cfg).frame_words if kind == RECORDS else None
+            packet_words, frames = load_replay(path, cfg, frame_words)
+            desc = f"replay {path.name}" + (" (records)" if kind == RECORDS else "")
         elif args.scene:
             scene = load_scene(args.scene, args.preset)
             cfg = scene.config
-            desc = f"scene {scene.name}"
+            desc = f"scene {scene.name}" + (" (on-chip detection)" if kind == RECORDS else "")
+            kind = kind or CUBE
+            if kind == RECORDS:
+                detect_config(cfg)  # the detector options fit the preset
         else:
             cfg = get_preset(args.preset or "full")
             packet_words = args.packet_words
             desc = f"UDP {args.udp_host}:{args.udp_port}"
+            if kind == RECORDS:
+                for c in [cfg] if args.preset else PRESETS.values():
+                    detect_config(c)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
     # the Table I scene's ego speed for its simulation; a capture or a link does not say
@@ -108,24 +156,39 @@ def build(args: argparse.Namespace, stop: threading.Event
     processor = Processor(cfg, feed, health, detection_params(args), _gnn(args), ego, source=desc)
     threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
                                 daemon=True)]
-    if args.scene:
-        if args.frames < 1:
-            raise CliError("--frames: must be >= 1")
-
-        source = get_source(args.backend)
+    if args.frames < 1:
+        raise CliError("--frames: must be >= 1")
+    if args.scene and kind == CUBE:
+        source = get_source(args.backend or "float")
 
         def make_cube(k: int):  # noqa: ANN202 - complex (n_virtual, n_range, n_doppler)
             return source.cube(simulate_scene(scene, frame_index=k).samples, cfg)
 
+        health.on_kind(CUBE)
         threads.append(threading.Thread(target=scene_loop, name="view-scene", daemon=True,
                                         args=(make_cube, args.frames, processor, health,
                                               stop, args.fps)))
+        return feed, health, threads, desc
+    if args.scene:
+        if (args.backend or "model") != "model":
+            raise CliError(f"--backend {args.backend}: on-chip detection (--detect fpga) of a "
+                           f"scene runs the bit-accurate model (--backend model)")
+        dcfg = detect_config(cfg)
+        chain = PipelineParams(output_mode=1, detect=dcfg)
+        gain = chain_gain(cfg, chain)
+        ingest = PacketIngest(cfg, chain.packet_words, health, processor, gain, kind=RECORDS,
+                              detect_config=lambda _: dcfg)
+        threads.append(threading.Thread(
+            target=replay_loop, name="view-scene", daemon=True,
+            args=(scene_record_frames(scene, chain, args.frames), ingest, stop, args.fps,
+                  True, args.loss, args.seed)))
         return feed, health, threads, desc
     gain = chain_gain(cfg, PipelineParams())  # the FFT scaling only, not PACKET_WORDS
     try:
         # a UDP stream without --preset: the preset is learnt from the packet headers too
         learn = None if args.replay or args.preset else list(PRESETS.values())
-        ingest = PacketIngest(cfg, packet_words, health, processor, gain, configs=learn)
+        ingest = PacketIngest(cfg, packet_words, health, processor, gain, configs=learn,
+                              kind=kind, detect_config=detect_config)
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
     if args.replay:
@@ -217,8 +280,14 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v.add_argument("--seed", type=int, default=0, help="seed of --loss")
     v.add_argument("--frames", type=int, default=16,
                    help="scene: frames simulated before the scene repeats (default 16)")
-    v.add_argument("--backend", choices=("model", "float"), default="float",
-                   help="scene: float reference (default, fast) or bit-accurate model")
+    v.add_argument("--backend", choices=("model", "float"), default=None,
+                   help="scene: float reference (default, fast) or bit-accurate model (the "
+                        "only one with --detect fpga, and its default)")
+    v.add_argument("--detect", choices=("host", "fpga"), default=None,
+                   help="the stream's kind: host = the radar cube (the host runs the CFAR), "
+                        "fpga = the on-chip detector's records (OUTPUT_MODE = 1). Default: "
+                        "a capture's header says; a UDP stream is recognised by its frame "
+                        "length (records of --max-detections); a scene sends the cube")
     v.add_argument("--gnn", action="store_true",
                    help="classify objects with the GNN (shipped checkpoint), draw boxes")
     v.add_argument("--ego-speed", type=float, default=None,
@@ -226,5 +295,6 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(default: 27.78 for --scene table1, else 0)")
     v.add_argument("--duration", type=float, default=None,
                    help="stop after this many seconds (default: run until Ctrl-C)")
+    add_fpga_options(v)
     add_detection_options(v)
     v.set_defaults(func=cmd_view)

@@ -2,10 +2,11 @@
 
 A :class:`ViewFrame` is source-neutral: a cube stream fills ``cube`` (channel maps) and
 ``nci`` (integrated map) and the processed ``cloud``; a detection-record stream (on-chip
-detection, DESIGN.md section 3.4) fills only ``cloud`` (and ``nci`` if it carries one) and the
-page hides the maps it has no data for. Sources call :meth:`Feed.publish`; the server's
-clients read :meth:`Feed.latest`. There is never more than one frame waiting: a newer one
-replaces it (frames faster than the browsers draw are dropped, oldest first).
+detection, DESIGN.md section 3.4) fills ``cloud`` and ``records`` (no cube, no maps): the
+page draws the records in the range-Doppler plane and over range instead. Sources call
+:meth:`Feed.publish`; the server's clients read :meth:`Feed.latest`. There is never more
+than one frame waiting: a newer one replaces it (frames faster than the browsers draw are
+dropped, oldest first).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from host.pointcloud import PointCloud
+from host.records import RecordArrays
 from model.config import RadarConfig
 
 
@@ -30,6 +32,8 @@ class ViewFrame:
     ``nci``: float (n_range, n_doppler) power summed over channels, LSB^2, or None.
     ``cloud``: the frame's detections. ``objects``: GNN objects (``gnn.infer.detect_objects``
     dicts: class, score, x_m, y_m, length_m, width_m, heading_deg).
+    ``records``: a record stream's records (every cell the FPGA's CFAR passed, with its
+    integrated power and noise estimate, host float units), or None (cube stream).
     """
 
     seq: int
@@ -40,6 +44,7 @@ class ViewFrame:
     nci: np.ndarray | None = None
     objects: list[dict[str, Any]] = field(default_factory=list)
     source: str = ""
+    records: RecordArrays | None = None
 
 
 class Feed:

@@ -11,21 +11,33 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
-from host.stream import Frame, StreamStats
+from host.stream import StreamStats
 
 RATE_WINDOW_S = 2.0
 """Frames/s and datagrams/s are averaged over this window, s."""
 
 
-def missing_packets(frame: Frame, packet_words: int) -> int:
+class LinkFrame(Protocol):
+    """What the counters read of a decoded frame (a cube frame or a record frame)."""
+
+    frame_id: int
+    problems: list[str]
+    valid: np.ndarray
+
+    @property
+    def complete(self) -> bool: ...
+
+
+def missing_packets(frame: LinkFrame, packet_words: int) -> int:
     """Packets of ``frame`` with at least one word missing (lost or corrupt).
 
-    ``frame.valid``: bool (num_tx, n_range, n_doppler), which flattens to DMA word order;
-    packet k carries words [k * packet_words, (k + 1) * packet_words)."""
+    ``frame.valid``: bool, any shape that flattens to DMA word order (a cube frame's
+    (num_tx, n_range, n_doppler), a record frame's (frame_words,)); packet k carries words
+    [k * packet_words, (k + 1) * packet_words)."""
     valid = frame.valid.reshape(-1)
     starts = np.arange(0, valid.size, packet_words)
     return int((np.minimum.reduceat(valid.astype(np.uint8), starts) == 0).sum())
@@ -50,6 +62,17 @@ class LinkHealth:
     last_frame_id: int | None = None
     detections: int = 0
     objects: int = 0
+    stream_kind: str = ""
+    """"cube", "records" (the on-chip detector's record stream) or "" (nothing learnt yet)."""
+    cfar_detections: int | None = None
+    """Record stream: cells the FPGA's CFAR passed in the newest frame (its trailer)."""
+    records: int | None = None
+    """Record stream: records the newest frame carried (at most MAX_DETECTIONS)."""
+    max_detections: int | None = None
+    truncated: bool = False
+    """Sticky: some frame had more detections than MAX_DETECTIONS (trailer flag, this frame's
+    or the hardware's sticky one)."""
+    frames_truncated: int = 0
     problems: deque[str] = field(default_factory=lambda: deque(maxlen=8))
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
     _frame_times: deque[float] = field(default_factory=lambda: deque(maxlen=4096), repr=False)
@@ -82,7 +105,7 @@ class LinkHealth:
             self._base.late_packets += stats.late_packets
             self.stream_restarts += 1
 
-    def on_frame(self, frame: Frame, packet_words: int, n_packets: int,
+    def on_frame(self, frame: LinkFrame, packet_words: int, n_packets: int,
                  id_gap: int) -> None:
         """A decoded frame; ``id_gap``: frames missing entirely before it (by frame id)."""
         lost = missing_packets(frame, packet_words)
@@ -97,6 +120,27 @@ class LinkHealth:
             self.frames_lost += id_gap
             self.packets_lost += lost + id_gap * n_packets
             self.last_frame_id = frame.frame_id
+
+    def on_kind(self, kind: str, max_detections: int | None = None) -> None:
+        """The stream is a radar cube ("cube") or the detector's records ("records",
+        ``max_detections`` records per frame at most)."""
+        with self.lock:
+            self.stream_kind = kind
+            self.max_detections = max_detections if kind == "records" else None
+
+    def on_record_frame(self, records: int, detections: int, truncated: bool,
+                        truncated_sticky: bool) -> None:
+        """A record frame's trailer figures (``records`` sent, ``detections`` the CFAR
+        passed, its ``truncated`` flag and the hardware's sticky one)."""
+        with self.lock:
+            self.records = records
+            self.cfar_detections = detections
+            self.frames_truncated += int(truncated)
+            if (truncated or truncated_sticky) and not self.truncated:
+                self.problems.append(f"TRUNCATED: more than MAX_DETECTIONS "
+                                     f"{self.max_detections} cells passed the CFAR "
+                                     f"({detections} in one frame)")
+            self.truncated |= truncated or truncated_sticky
 
     def on_cube_frame(self) -> None:
         """A frame that arrived without packets (simulated scene)."""
@@ -137,6 +181,9 @@ class LinkHealth:
                 "hw_overflow": self.hw_overflow, "hw_framing": self.hw_framing,
                 "last_frame_id": self.last_frame_id,
                 "detections": self.detections, "objects": self.objects,
+                "stream_kind": self.stream_kind, "cfar_detections": self.cfar_detections,
+                "records": self.records, "max_detections": self.max_detections,
+                "truncated": self.truncated, "frames_truncated": self.frames_truncated,
                 "link_idle_s": None if idle is None else round(idle, 1),
                 "problems": list(self.problems),
             }

@@ -20,7 +20,9 @@ from typing import Any
 
 import numpy as np
 
+from host.records import RecordArrays
 from model.config import RadarConfig
+from model.reference import signed_bins
 from radar.view.feed import ViewFrame
 
 MAX_AXIS = 128
@@ -108,6 +110,19 @@ def _r(a: np.ndarray, nd: int = 3) -> list[float]:
     return [round(float(v), nd) for v in a]
 
 
+def record_cells(rec: RecordArrays, cfg: RadarConfig) -> dict[str, list[float]]:
+    """A record stream's cells (every record, n of them) as the page draws them in the
+    range-Doppler plane and over range: range m, radial velocity m/s (the cell's signed
+    Doppler bin, as the heat maps' axis), integrated power dB and CFAR SNR dB (power over
+    the noise estimate), each a list of n."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        db = 10 * np.log10(np.maximum(rec.power, 1e-20))
+        snr = 10 * np.log10(np.maximum(rec.power, 1e-20) / np.maximum(rec.noise, 1e-20))
+    return {"range": _r(rec.range_bin * cfg.range_bin_m),
+            "v": _r(signed_bins(cfg.n_doppler)[rec.doppler_bin] * cfg.velocity_bin_mps),
+            "db": _r(db, 1), "snr": _r(snr, 1)}
+
+
 def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dict[str, Any]:
     """The message for one frame with virtual channel ``channel`` (clamped to the array)."""
     cfg = frame.cfg
@@ -118,7 +133,7 @@ def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dic
         "source": frame.source, "channel": ch, "n_virtual": cfg.n_virtual,
         "limits": {"max_range_m": round(cfg.max_range_m, 2),
                    "max_velocity_mps": round(cfg.max_velocity_mps, 3)},
-        "rd": None, "nci": None, "profile": None,
+        "rd": None, "nci": None, "profile": None, "cells": None,
         "points": {"x": _r(cloud.x_m), "y": _r(cloud.y_m),
                    "v": _r(cloud.radial_velocity_mps), "snr": _r(cloud.snr_db, 1),
                    "range": _r(cloud.range_m)},
@@ -132,11 +147,20 @@ def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dic
     if frame.nci is not None:
         msg["nci"] = heatmap(frame.nci, cfg)
         prof = 10 * np.log10(np.maximum(frame.nci.sum(axis=1), 1e-20))
-        msg["profile"] = {"range_m": _axes(cfg, cfg.n_range, cfg.n_doppler)[0],
+        msg["profile"] = {"kind": "cube", "range_m": _axes(cfg, cfg.n_range, cfg.n_doppler)[0],
                           "db": _r(prof, 2),
                           "det_range_m": _r(cloud.range_m),
                           "det_db": _r(prof[np.clip(cloud.range_bin, 0, cfg.n_range - 1)]
                                        if len(cloud) else np.zeros(0), 2)}
+    if frame.records is not None:
+        msg["cells"] = cells = record_cells(frame.records, cfg)
+        if frame.nci is None:  # the profile the records allow: their powers over range
+            best = np.full(cfg.n_range, min(cells["db"], default=0.0))
+            np.maximum.at(best, frame.records.range_bin, np.asarray(cells["db"]))
+            msg["profile"] = {"kind": "records", "range_m": cells["range"], "db": cells["db"],
+                              "det_range_m": _r(cloud.range_m),
+                              "det_db": _r(best[np.clip(cloud.range_bin, 0, cfg.n_range - 1)]
+                                           if len(cloud) else np.zeros(0), 1)}
     for o in frame.objects:
         xs, ys = box_outline(o)
         msg["boxes"].append({"x": xs, "y": ys, "cls": o["class"],

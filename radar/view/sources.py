@@ -1,14 +1,16 @@
 """Where the view's frames come from, each on its own thread.
 
 - :class:`PacketIngest`: DMA packets (UDP datagrams or a replayed capture) -> decoded frames,
-  link counters, sender-restart detection. Never raises on bad data.
-- :class:`Processor`: newest decoded cube -> host processing (CFAR, angles, point cloud,
-  optional GNN) -> :class:`radar.view.feed.ViewFrame`. A cube that arrives while the previous
-  one is still being processed replaces the waiting one (counted as "not shown").
-- :func:`udp_loop`, :func:`replay_loop`, :func:`scene_loop`: the three producers.
-
-A detection-record stream (on-chip detection) plugs in as another producer that builds
-:class:`ViewFrame` objects with ``cloud`` set and ``cube=None`` and calls ``Feed.publish``.
+  link counters, sender-restart detection. Never raises on bad data. The stream is a radar
+  cube (``OUTPUT_MODE = 0``: :class:`CubePayloadDecoder`, the cube decoded lazily) or the
+  on-chip detector's records (``OUTPUT_MODE = 1``: ``host.records.RecordDecoder``), given or
+  learnt from the packet headers (the frame length, which differs between the two).
+- :class:`Processor`: newest decoded frame -> host processing (cube: CFAR, angles, point
+  cloud; records: ``host.record_points``; optional GNN) -> :class:`radar.view.feed.ViewFrame`.
+  A frame that arrives while the previous one is still being processed replaces the waiting
+  one (counted as "not shown").
+- :func:`udp_loop`, :func:`replay_loop`, :func:`scene_loop`: the producers (a scene with
+  on-chip detection is replayed from its record packets, :func:`scene_record_frames`).
 """
 
 from __future__ import annotations
@@ -17,23 +19,40 @@ import random
 import socket
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from host.capture import read_capture
-from host.pipeline import DetectionParams, process_cube
-from host.stream import Frame, StreamDecoder, geometry_from_packet
+from host.capture import CaptureInfo, read_capture
+from host.pipeline import DetectionParams, detect_cells, peak_offsets, points_from_cells
+from host.record_points import process_records
+from host.records import DetectionFrame, RecordDecoder, record_arrays
+from host.stream import (
+    PacketDecoder,
+    cube_frame_words,
+    geometry_from_packet,
+)
 from host.udp import UDP_MAX_PAYLOAD, max_packet_words
+from model.axis_packetizer import packets_per_frame, words_to_bytes
 from model.config import RadarConfig
-from model.radar_pipeline import PipelineParams, chain_gain
+from model.detect_chain import DetectConfig
+from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
+from model.scene import Scene
+from model.simulate import simulate_scene
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
 
 IDLE_RESTART_S = 1.0
 """No datagram for this long: open frames are closed and the next packet starts afresh."""
+
+CUBE, RECORDS = "cube", "records"
+"""Stream kinds: the radar cube (OUTPUT_MODE = 0) and detection records (OUTPUT_MODE = 1)."""
+
+DetectConfigOf = Callable[[RadarConfig], DetectConfig]
+"""The on-chip detector's configuration for a preset (fixes a record frame's length)."""
 
 
 def channel_power_sum(cube: np.ndarray) -> np.ndarray:
@@ -45,11 +64,75 @@ def channel_power_sum(cube: np.ndarray) -> np.ndarray:
     return np.einsum("vrd,vrd->rd", iq, iq).reshape(*cube.shape[1:], 2).sum(axis=-1)
 
 
-class Processor:
-    """Host processing of the newest cube on a worker thread.
+@dataclass
+class PayloadFrame:
+    """A radar-cube frame as it left the decoder: its payload, decoded into the cube only
+    when the view shows it (:meth:`cube`), so frames dropped to stay current cost no
+    decode. ``words``: uint32 (frame_words, num_rx) in DMA order, zeros where missing;
+    ``valid``: bool (frame_words,); ``problems``: as ``host.stream.Frame``."""
 
-    ``gain``: divide cubes by it before processing (the FPGA chain's gain; 1 for model
-    cubes). ``detect_objects``: cloud, ego speed -> GNN objects, or None for no GNN.
+    frame_id: int
+    words: np.ndarray
+    valid: np.ndarray
+    problems: list[str]
+    cfg: RadarConfig
+
+    @property
+    def complete(self) -> bool:
+        return bool(self.valid.all()) and not self.problems
+
+    def cube(self) -> np.ndarray:
+        """complex64 (n_virtual, n_range, n_doppler), LSB (:func:`words_to_cube`)."""
+        return words_to_cube(self.words, self.cfg)
+
+
+def words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
+    """``host.stream.payload_words_to_cube`` (same result, tested equal), about 2x faster
+    on a ``full`` frame: the 32-bit {Q, I} words are transposed to channel order while
+    still words (one strided copy), then widened contiguously. words: uint32 (frame_words,
+    num_rx) in DMA order -> complex64 (n_virtual, n_range, n_doppler)."""
+    w = np.ascontiguousarray(words, dtype="<u4").reshape(
+        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
+    t[...] = w.transpose(0, 3, 1, 2)
+    iq = np.empty(t.shape + (2,), np.float32)
+    iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
+    return iq.view(np.complex64).reshape(cfg.cube_shape)
+
+
+class CubePayloadDecoder(PacketDecoder[PayloadFrame]):
+    """``host.stream.StreamDecoder`` with the cube decode left to the consumer
+    (:class:`PayloadFrame`): same framing, counters and problems."""
+
+    def __init__(self, cfg: RadarConfig, packet_words: int, reorder_window: int = 2) -> None:
+        super().__init__(cfg.num_rx, cube_frame_words(cfg), packet_words, reorder_window)
+        self.cfg = cfg
+
+    def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
+                    problems: list[str]) -> PayloadFrame:
+        return PayloadFrame(fid, words, valid, problems, self.cfg)
+
+
+@dataclass
+class _CubeJob:
+    frame_id: int
+    cube: np.ndarray | PayloadFrame
+    scale: float
+    cfg: RadarConfig
+
+
+@dataclass
+class _RecordJob:
+    frame_id: int
+    frame: DetectionFrame
+    gain: float
+    cfg: RadarConfig
+
+
+class Processor:
+    """Host processing of the newest frame on a worker thread.
+
+    ``detect_objects``: cloud, ego speed -> GNN objects, or None for no GNN.
     """
 
     def __init__(self, cfg: RadarConfig, feed: Feed, health: LinkHealth,
@@ -64,21 +147,30 @@ class Processor:
         self.ego_speed_mps = ego_speed_mps
         self.source = source
         self._cond = threading.Condition()
-        self._slot: tuple[int, np.ndarray, float, RadarConfig] | None = None
+        self._slot: _CubeJob | _RecordJob | None = None
         self._skipped = 0
         self.errors = 0
 
-    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0,
-               cfg: RadarConfig | None = None) -> None:
-        """Hand over a cube complex (n_virtual, n_range, n_doppler) of configuration ``cfg``
-        (default: :attr:`cfg`); ``cube * scale`` is in reference units. The processor owns
-        the cube from now on (scaled in place on its own thread, so the ingest thread stays
-        free for the link)."""
+    def _put(self, job: _CubeJob | _RecordJob) -> None:
         with self._cond:
             if self._slot is not None:
                 self._skipped += 1
-            self._slot = (frame_id, cube, scale, cfg or self.cfg)
+            self._slot = job
             self._cond.notify()
+
+    def submit(self, frame_id: int, cube: np.ndarray | PayloadFrame, scale: float = 1.0,
+               cfg: RadarConfig | None = None) -> None:
+        """Hand over a cube complex (n_virtual, n_range, n_doppler) of configuration ``cfg``
+        (default: :attr:`cfg`), or a :class:`PayloadFrame` to decode it from; ``cube *
+        scale`` is in reference units. The processor owns the cube from now on (decoded and
+        scaled in place on its own thread, so the ingest thread stays free for the link)."""
+        self._put(_CubeJob(frame_id, cube, scale, cfg or self.cfg))
+
+    def submit_records(self, frame: DetectionFrame, gain: float,
+                       cfg: RadarConfig | None = None) -> None:
+        """Hand over a record frame (its intact leading records are processed); ``gain``:
+        the chain's gain over the float reference (``record_arrays``)."""
+        self._put(_RecordJob(frame.frame_id, frame, gain, cfg or self.cfg))
 
     def run(self, stop: threading.Event) -> None:
         while not stop.is_set():
@@ -89,27 +181,60 @@ class Processor:
                     self._cond.wait(0.2)
                 if self._slot is None:
                     continue
-                (frame_id, cube, scale, cfg), self._slot = self._slot, None
+                job, self._slot = self._slot, None
                 skipped, self._skipped = self._skipped, 0
             self.feed.taken()
             try:
-                if scale != 1.0:
-                    cube *= np.float32(scale) if cube.dtype == np.complex64 else scale
-                self._process(frame_id, cube, skipped, cfg)
+                if isinstance(job, _RecordJob):
+                    self._process_records(job, skipped)
+                else:
+                    cube = job.cube.cube() if isinstance(job.cube, PayloadFrame) else job.cube
+                    if job.scale != 1.0:
+                        cube *= (np.float32(job.scale) if cube.dtype == np.complex64
+                                 else job.scale)
+                    self._process(job.frame_id, cube, skipped, job.cfg)
             except Exception as exc:  # noqa: BLE001 - a bad frame must not stop the view
                 self.errors += 1
                 with self.health.lock:
-                    self.health.problems.append(f"frame {frame_id}: processing failed: {exc}")
+                    self.health.problems.append(f"frame {job.frame_id}: processing failed: "
+                                                f"{exc}")
+
+    def _objects(self, cloud: Any) -> list[dict[str, Any]]:
+        return (self.detect_objects(cloud, ego_speed_mps=self.ego_speed_mps)
+                if self.detect_objects is not None and len(cloud) else [])
 
     def _process(self, frame_id: int, cube: np.ndarray, skipped: int,
                  cfg: RadarConfig | None = None) -> None:
         cfg = cfg or self.cfg
-        cloud = process_cube(cube, cfg, self.params, frame=frame_id)
-        objects = (self.detect_objects(cloud, ego_speed_mps=self.ego_speed_mps)
-                   if self.detect_objects is not None and len(cloud) else [])
+        cfg.check_cube(cube)
+        # host.pipeline.process_cube's steps, keeping the integrated map it computes for
+        # the display (computing it again would cost a pass over the whole cube)
+        cells, noise, nci = detect_cells(cube, cfg, self.params)
+        offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
+        r, d = cells[:, 0], cells[:, 1]
+        cloud = points_from_cells(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg,
+                                  self.params, frame_id)
+        objects = self._objects(cloud)
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=frame_id, cfg=cfg,
-                          cloud=cloud, cube=cube, nci=channel_power_sum(cube),
-                          objects=objects, source=self.source)
+                          cloud=cloud, cube=cube, nci=nci, objects=objects,
+                          source=self.source)
+        self.health.on_shown(len(cloud), len(objects), skipped)
+        self.feed.publish(frame)
+
+    def _process_records(self, job: _RecordJob, skipped: int) -> None:
+        cfg, f = job.cfg, job.frame
+        records = f.records[:f.usable_records]
+        inside = [r for r in records if r.range_bin < cfg.n_range and r.doppler_bin < cfg.n_doppler]
+        if len(inside) < len(records):  # corrupt words that still looked like records
+            with self.health.lock:
+                self.health.problems.append(
+                    f"frame {job.frame_id}: {len(records) - len(inside)} record(s) outside "
+                    f"the {cfg.n_range} x {cfg.n_doppler} map dropped")
+        arr = record_arrays(inside, cfg.n_virtual, job.gain)
+        cloud = process_records(arr, cfg, self.params, frame=job.frame_id)
+        objects = self._objects(cloud)
+        frame = ViewFrame(seq=self.feed.next_seq(), frame_id=job.frame_id, cfg=cfg,
+                          cloud=cloud, records=arr, objects=objects, source=self.source)
         self.health.on_shown(len(cloud), len(objects), skipped)
         self.feed.publish(frame)
 
@@ -120,26 +245,40 @@ class PacketIngest:
     A sender that restarts (frame ids start again) is recognised by a whole frame's worth
     of packets in a row belonging to frames already closed; then, or after
     :data:`IDLE_RESTART_S` without datagrams (:meth:`idle`), a fresh decoder takes over.
-    ``gain``: the chain's cube gain (decoded cubes are divided by it).
+    ``gain``: the chain's cube gain (decoded cubes are divided by it; records likewise).
     ``packet_words``: the stream's PACKET_WORDS, or None to learn it (as ``radar receive``
     does) from the header of the first datagram after each (re)start; the decoder waiting
     for that datagram assumes the most that fit a UDP datagram. ``configs``: the presets the
     stream may be of (default: ``cfg`` only); with more than one, the preset is learnt from
     the headers too (``cfg`` first), and ``gain`` follows the learnt preset.
+    ``kind``: :data:`CUBE`, :data:`RECORDS`, or None to learn it from the headers as well
+    (a datagram that fits a cube frame of a preset is a cube stream, else one that fits a
+    record frame of ``detect_config(preset)``); ``detect_config``: needed for records.
     """
 
     def __init__(self, cfg: RadarConfig, packet_words: int | None, health: LinkHealth,
                  processor: Processor, gain: float, use_damaged: bool = True,
-                 configs: Sequence[RadarConfig] | None = None) -> None:
+                 configs: Sequence[RadarConfig] | None = None, kind: str | None = CUBE,
+                 detect_config: DetectConfigOf | None = None) -> None:
+        if kind not in (CUBE, RECORDS, None):
+            raise ValueError(f"stream kind {kind!r}: not {CUBE!r}, {RECORDS!r} or None")
+        if kind != CUBE and detect_config is None:
+            raise ValueError("a record stream needs the detector's configuration")
         self.cfg = cfg
         self.configs = [cfg] + [c for c in configs or [] if c != cfg]
         self.fixed_packet_words = packet_words
+        self.fixed_kind = kind
+        self.kind = kind or CUBE
+        self.detect_config = detect_config
         self.health = health
         self.processor = processor
         self.gain = gain
         self.use_damaged = use_damaged
         self.decoder = self._new_decoder()  # ValueError on a bad geometry
+        if kind is not None:
+            self._announce()
         self._learn = self._learning()
+        self._unfit_said = False
         self._late_run: list[bytes] = []
         self._late_msgs: list[str] = []
         self._last_id: int | None = None
@@ -151,21 +290,70 @@ class PacketIngest:
         """PACKET_WORDS the current decoder expects."""
         return self.decoder.packet_words
 
-    def _new_decoder(self, packet_words: int | None = None) -> StreamDecoder:
+    def _frame_words(self, cfg: RadarConfig, kind: str) -> int:
+        if kind == RECORDS:
+            assert self.detect_config is not None
+            return self.detect_config(cfg).frame_words
+        return cube_frame_words(cfg)
+
+    def _new_decoder(self, packet_words: int | None = None
+                     ) -> CubePayloadDecoder | RecordDecoder:
         pw = packet_words or self.fixed_packet_words or max_packet_words(self.cfg.num_rx)
-        return StreamDecoder(self.cfg, pw)
+        self._decoder_key = (self.cfg, self.kind, pw)
+        if self.kind == RECORDS:
+            assert self.detect_config is not None
+            return RecordDecoder(self.detect_config(self.cfg), pw)
+        return CubePayloadDecoder(self.cfg, pw)
+
+    def _announce(self) -> None:
+        mx = (self.detect_config(self.cfg).max_detections
+              if self.kind == RECORDS and self.detect_config else None)
+        self.health.on_kind(self.kind, mx)
 
     def _learning(self) -> bool:
-        return self.fixed_packet_words is None or len(self.configs) > 1
+        return (self.fixed_packet_words is None or len(self.configs) > 1
+                or self.fixed_kind is None)
+
+    def _fit(self, data: bytes) -> tuple[RadarConfig, int, str] | None:
+        """(preset, PACKET_WORDS, kind) this datagram's header fits, or None."""
+        kinds = [self.fixed_kind] if self.fixed_kind else [CUBE, RECORDS]
+        for kind in kinds:
+            def words_of(c: RadarConfig, kind: str = kind) -> int:
+                try:
+                    return self._frame_words(c, kind)
+                except ValueError:  # a detector setting this preset refuses: fits nothing
+                    return 0
+            try:
+                cfg, pw = geometry_from_packet(data, self.configs, words_of)
+            except ValueError:
+                continue
+            return cfg, pw, kind
+        return None
 
     def _learn_geometry(self, data: bytes) -> None:
-        """Preset and PACKET_WORDS from this datagram's header, when it is a packet of one of
-        :attr:`configs`; a datagram that is not stays with the decoder (which counts it as
-        malformed)."""
-        try:
-            cfg, pw = geometry_from_packet(data, self.configs)
-        except ValueError:
+        """Preset, PACKET_WORDS and stream kind from this datagram's header, when it is a
+        packet of one of :attr:`configs`; a datagram that is not stays with the decoder
+        (which counts it as malformed)."""
+        fit = self._fit(data)
+        if fit is None:
+            if not self._unfit_said:  # once per (re)start: the first datagrams may be junk
+                self._unfit_said = True
+                mx = ""
+                if self.fixed_kind != CUBE and self.detect_config is not None:
+                    try:
+                        mx = (f" (a record stream must have the sender's MAX_DETECTIONS, "
+                              f"here {self.detect_config(self.cfg).max_detections}: "
+                              f"--max-detections)")
+                    except ValueError:
+                        mx = ""
+                with self.health.lock:
+                    self.health.problems.append(
+                        f"datagram of {len(data)} bytes fits no "
+                        f"{self.fixed_kind or 'cube or record'} stream of "
+                        f"{', '.join(c.name for c in self.configs)}{mx}")
             return
+        self._unfit_said = False
+        cfg, pw, kind = fit
         self._learn = False
         pw = self.fixed_packet_words or pw
         if cfg != self.cfg:
@@ -173,7 +361,9 @@ class PacketIngest:
             self.gain = chain_gain(cfg, PipelineParams())
             with self.health.lock:
                 self.health.problems.append(f"stream is of preset {cfg.name}")
-        if cfg != self.decoder.cfg or pw != self.decoder.packet_words:
+        self.kind = kind
+        self._announce()
+        if (cfg, kind, pw) != self._decoder_key:
             self.health.retire_decoder(self.decoder.stats)
             self.decoder = self._new_decoder(pw)
 
@@ -265,11 +455,17 @@ class PacketIngest:
         self._last_id = fid
         return gap
 
-    def _frame(self, f: Frame) -> None:
+    def _frame(self, f: PayloadFrame | DetectionFrame) -> None:
         self.health.on_frame(f, self.packet_words, self.decoder.n_packets, self._id_gap(
             f.frame_id))
-        if f.complete or self.use_damaged:
-            self.processor.submit(f.frame_id, f.cube, scale=1.0 / self.gain, cfg=self.cfg)
+        if isinstance(f, DetectionFrame):
+            tr = f.trailer
+            self.health.on_record_frame(len(f.records), f.detections, f.truncated,
+                                        bool(tr and tr.truncated_sticky))
+            if f.complete or self.use_damaged:
+                self.processor.submit_records(f, self.gain, cfg=self.cfg)
+        elif f.complete or self.use_damaged:
+            self.processor.submit(f.frame_id, f, scale=1.0 / self.gain, cfg=self.cfg)
 
 
 def udp_loop(sock: socket.socket, ingest: PacketIngest, stop: threading.Event,
@@ -293,47 +489,85 @@ def udp_loop(sock: socket.socket, ingest: PacketIngest, stop: threading.Event,
         ingest.push(data)
 
 
-def load_replay(path: Path, cfg: RadarConfig) -> tuple[int, list[list[bytes]]]:
-    """(packet_words, packets grouped by frame) of a capture; ValueError when it does not
-    match the preset or is damaged."""
+def load_replay(path: Path, cfg: RadarConfig, frame_words: int | None = None
+                ) -> tuple[int, list[list[bytes]]]:
+    """(packet_words, packets grouped by frame) of a capture whose frames are ``frame_words``
+    payload words long (default: the cube's); ValueError when it does not match the preset
+    or is damaged."""
     info, packets = read_capture(path)
     if not info.matches(cfg):
         raise ValueError(f"{path}: capture geometry {info} does not match preset "
                          f"{cfg.name!r} (use --preset)")
-    pkts = list(packets)
-    n = StreamDecoder(cfg, info.packet_words).n_packets
-    frames = [pkts[i:i + n] for i in range(0, len(pkts), n)]
+    n = packets_per_frame(frame_words or cube_frame_words(cfg), info.packet_words)
+    frames = group_frames(packets, n)
     if not frames:
         raise ValueError(f"{path}: capture holds no packets")
     return info.packet_words, frames
 
 
-def replay_loop(frames: list[list[bytes]], ingest: PacketIngest, stop: threading.Event,
+def capture_info(path: Path) -> CaptureInfo:
+    """A capture's header (stream kind, geometry); ValueError when it is not a capture."""
+    info, packets = read_capture(path)
+    close = getattr(packets, "close", None)
+    if close:
+        close()
+    return info
+
+
+def group_frames(packets: Iterable[bytes], n_packets: int) -> list[list[bytes]]:
+    """Consecutive packets, ``n_packets`` per frame."""
+    pkts = list(packets)
+    return [pkts[i:i + n_packets] for i in range(0, len(pkts), n_packets)]
+
+
+def scene_record_frames(scene: Scene, chain: PipelineParams, n_frames: int
+                        ) -> Iterator[list[bytes]]:
+    """The on-chip detector's record stream of frames 0..n_frames-1 of a simulated scene:
+    the bit-accurate model of the chain in ``OUTPUT_MODE = 1`` (``chain``: output_mode 1,
+    its ``detect`` configuration) and the packetizer framing, as wire bytes grouped by
+    frame, one frame at a time (each frame's chain starts from reset: the trailer's
+    hardware-sticky truncation flag covers that frame; the view keeps its own sticky flag)."""
+    cfg = scene.config
+    for k in range(n_frames):
+        packets = dma_packets([simulate_scene(scene, frame_index=k).samples], cfg, chain, k)
+        yield [words_to_bytes(p) for p in packets]
+
+
+def replay_loop(frames: Iterable[list[bytes]], ingest: PacketIngest, stop: threading.Event,
                 fps: float, loop: bool = True, loss: float = 0.0, seed: int = 0) -> None:
     """Feed a capture's packets frame by frame at ``fps`` frames/s (0: as fast as they
     decode); ``loss``: probability of dropping each packet (as ``radar replay --loss``).
-    Each pass after the first is a sender restart (frame ids start again)."""
+    Each pass after the first is a sender restart (frame ids start again). ``frames``: the
+    packets of each frame (a list, or an iterator taken as it produces them on the first
+    pass and kept for the next ones)."""
+
+    def schedule() -> Iterator[tuple[bool, list[bytes]]]:
+        """(a pass after the first starts here, packets) of each frame to send."""
+        kept: list[list[bytes]] = []
+        for f in frames:
+            kept.append(f)
+            yield False, f
+        while loop and kept:
+            for i, f in enumerate(kept):
+                yield i == 0, f
+
     rng = random.Random(seed)
     t0 = time.monotonic()
-    k = 0
-    passes = 0
-    while not stop.is_set():
-        if passes and k % len(frames) == 0:
+    for k, (restart, packets) in enumerate(schedule(), 1):
+        if stop.is_set():
+            return
+        if restart:
             ingest.restart()
-        for p in frames[k % len(frames)]:
+        for p in packets:
             if loss and rng.random() < loss:
                 continue
             ingest.push(p)
-        k += 1
-        if k % len(frames) == 0:
-            passes += 1
-            if not loop:
-                ingest.restart()
-                return
         if fps > 0:
             ahead = t0 + k / fps - time.monotonic()
             if ahead > 0:
                 stop.wait(ahead)
+    if not stop.is_set():
+        ingest.restart()  # the end of a replay that does not loop: close what is open
 
 
 def scene_loop(make_cube: Callable[[int], np.ndarray], n_frames: int, processor: Processor,

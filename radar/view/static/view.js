@@ -9,6 +9,9 @@ const state = window.radarView = {
   // benchmark hooks: hold = true stops drawing live messages; lastFrame is the newest frame
   // message drawn; drawFrame(msg) draws one message (radar.view.bench_view times it)
   hold: false, lastFrame: null, drawFrame: null,
+  // benchmark hook: serial = true draws the plots one after another, as before 2026-11-23
+  // (radar.view.bench_view compares the display rates in the same run)
+  serial: false,
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };
 const MARGIN = { l: 55, r: 10, t: 30, b: 40 };
@@ -18,9 +21,10 @@ const AXIS = { ticklabeloverflow: "allow", tickangle: 0, automargin: false };
 function axis(title, extra) { return { ...AXIS, title: { text: title }, ...extra }; }
 const HEALTH_KEYS = ["frames_per_s", "frames_complete", "frames_damaged", "frames_lost",
   "frames_not_shown", "packets_lost", "malformed", "late_packets", "datagrams",
-  "stream_restarts", "hw_overflow", "hw_framing", "detections", "objects"];
+  "stream_restarts", "hw_overflow", "hw_framing", "detections", "objects", "stream_kind",
+  "cfar_detections", "records", "max_detections", "truncated", "frames_truncated"];
 const ALARMS = new Set(["frames_damaged", "frames_lost", "packets_lost", "malformed",
-  "hw_overflow", "hw_framing"]);
+  "hw_overflow", "hw_framing", "truncated", "frames_truncated"]);
 let channel = 0;
 let ws = null;
 
@@ -165,26 +169,47 @@ function noMap(div, title) {
   return update(div, [], {
     title: { text: title, font: { size: 13 } }, margin: MARGIN,
     xaxis: { visible: false }, yaxis: { visible: false },
-    annotations: [{ text: "no per-channel map in a detection-record stream", showarrow: false,
+    annotations: [{ text: "records stream: no cube (no per-channel map)", showarrow: false,
                     xref: "paper", yref: "paper", x: 0.5, y: 0.5 }],
   }, "no map");
 }
 
 function detectionMap(div, msg) {
-  // the cells the FPGA's CFAR passed on the integrated map, coloured by SNR
-  const p = msg.points, vmax = msg.limits.max_velocity_mps, r = msg.limits.max_range_m;
-  return update(div, [{
-    type: "scatter", mode: "markers", x: p.v, y: p.range, name: "detections",
-    marker: { size: 8, color: p.snr, cmin: 0, cmax: 40, colorscale: "Viridis",
-              line: { width: 1, color: "#222" },
-              colorbar: { title: { text: "SNR dB" }, ticklabeloverflow: "allow" } },
-    hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>SNR %{marker.color:.1f} dB<extra></extra>",
-  }], {
-    title: { text: "range-Doppler detections (record stream: no map)", font: { size: 13 } },
+  // what the FPGA's CFAR passed, on the range-Doppler plane: every record (cell) coloured by
+  // its integrated power, the points made from them (peaks) ringed
+  const p = msg.points, c = msg.cells, vmax = msg.limits.max_velocity_mps;
+  const r = msg.limits.max_range_m;
+  const traces = [];
+  if (c) {
+    let lo = Infinity, hi = -Infinity;
+    for (const v of c.db) { if (v < lo) lo = v; if (v > hi) hi = v; }
+    if (!c.db.length) { lo = 0; hi = 10; }  // a frame without records
+    traces.push({
+      type: "scatter", mode: "markers", x: c.v, y: c.range, name: "records",
+      marker: { size: 6, color: c.db, cmin: 5 * Math.floor(lo / 5), cmax: 5 * Math.ceil(hi / 5),
+                colorscale: "Viridis",
+                colorbar: { title: { text: "dB" }, ticklabeloverflow: "allow" } },
+      text: c.snr.map(s => `CFAR SNR ${s} dB`),
+      hovertemplate: "v %{x:.2f} m/s<br>r %{y:.1f} m<br>%{marker.color:.1f} dB, %{text}"
+                     + "<extra></extra>",
+    });
+  }
+  traces.push({
+    type: "scatter", mode: "markers", x: p.v, y: p.range, name: "points",
+    marker: c ? { size: 12, color: "rgba(0,0,0,0)", line: { width: 2, color: "#c62828" } }
+      : { size: 8, color: p.snr, cmin: 0, cmax: 40, colorscale: "Viridis",
+          line: { width: 1, color: "#222" },
+          colorbar: { title: { text: "SNR dB" }, ticklabeloverflow: "allow" } },
+    hovertemplate: "point: v %{x:.2f} m/s<br>r %{y:.1f} m<extra></extra>",
+  });
+  const scale = c ? traces[0].marker.cmin + "," + traces[0].marker.cmax : "snr";
+  return update(div, traces, {
+    title: { text: c ? "range-Doppler: the FPGA's detections (records; no cube)"
+                     : "range-Doppler detections (record stream: no map)", font: { size: 13 } },
     margin: MARGIN, showlegend: false,
     xaxis: axis("radial velocity (m/s)", { range: [-vmax, vmax] }),
     yaxis: axis("range (m)", { range: [0, r] }),
-  }, ["detections", r, vmax]);
+  }, ["detections", r, vmax, scale]);
 }
 
 function pointCloud(div, msg) {
@@ -219,7 +244,7 @@ function pointCloud(div, msg) {
 
 function profile(div, msg) {
   const pr = msg.profile;
-  if (!pr) {  // a detection-record stream: each detection's SNR over its range
+  if (!pr) {  // a detection-record stream without records: each point's SNR over its range
     const p = msg.points, r = msg.limits.max_range_m;
     const top = 10 * Math.ceil(Math.max(10, ...p.snr) / 10) + 5;
     return update(div, [{ type: "scatter", mode: "markers", x: p.range, y: p.snr,
@@ -231,20 +256,27 @@ function profile(div, msg) {
       xaxis: axis("range (m)", { range: [0, r] }), yaxis: axis("SNR (dB)", { range: [0, top] }),
     }, ["records", r, top]);
   }
+  const records = pr.kind === "records";
   // y range on a 10 dB grid: the axes stay put from frame to frame
   let lo = Infinity, hi = -Infinity;
   for (const v of pr.db) { if (v < lo) lo = v; if (v > hi) hi = v; }
+  if (!pr.db.length) { lo = 0; hi = 10; }
   const yr = [10 * Math.floor(lo / 10) - 5, 10 * Math.ceil(hi / 10) + 5];
-  const xr = [pr.range_m[0], pr.range_m[pr.range_m.length - 1]];
+  const xr = records ? [0, msg.limits.max_range_m]
+    : [pr.range_m[0], pr.range_m[pr.range_m.length - 1]];
   return update(div, [
-    { type: "scatter", mode: "lines", x: pr.range_m, y: pr.db, name: "integrated" },
+    records ? { type: "scatter", mode: "markers", x: pr.range_m, y: pr.db, name: "records",
+                marker: { color: "#1565c0", size: 5 } }
+      : { type: "scatter", mode: "lines", x: pr.range_m, y: pr.db, name: "integrated" },
     { type: "scatter", mode: "markers", x: pr.det_range_m, y: pr.det_db, name: "detections",
       marker: { color: "#c62828", size: 7, symbol: "x" } },
   ], {
-    title: { text: "range profile (all channels, all Doppler bins)", font: { size: 13 } },
+    title: { text: records ? "records: integrated power over range (points: x)"
+                           : "range profile (all channels, all Doppler bins)",
+             font: { size: 13 } },
     margin: MARGIN, showlegend: false, uirevision: "profile",
     xaxis: axis("range (m)", { range: xr }), yaxis: axis("power (dB)", { range: yr }),
-  }, [xr, yr]);
+  }, [pr.kind, xr, yr]);
 }
 
 function showHealth(h) {
@@ -252,9 +284,12 @@ function showHealth(h) {
   for (const k of HEALTH_KEYS) {
     const td = document.getElementById("h-" + k);
     const v = h[k];
-    td.textContent = typeof v === "boolean" ? (v ? "SET" : "clear") : String(v);
+    td.textContent = typeof v === "boolean" ? (v ? "SET" : "clear")
+      : v === null || v === "" ? "-" : String(v);
     td.classList.toggle("alarm", ALARMS.has(k) && Boolean(v));
   }
+  // the record stream's rows (on-chip detections, records, truncation) only when it is one
+  for (const tr of document.querySelectorAll("tr.rec")) tr.hidden = h.stream_kind !== "records";
   const ul = document.getElementById("problems");
   ul.replaceChildren(...h.problems.slice(-6).map(t => {
     const li = document.createElement("li"); li.textContent = t; return li;
@@ -290,12 +325,22 @@ async function draw(msg) {
     document.getElementById("frame_id").textContent = msg.frame_id;
     const input = document.getElementById("channel");
     input.max = msg.n_virtual - 1;
-    await timed("rd", () => heatmap("plot-rd", msg.rd,
-                                      `range-Doppler, virtual channel ${msg.channel}`, msg));
-    await timed("nci", () => heatmap("plot-nci", msg.nci,
-                                     "range-Doppler, integrated over channels", msg));
-    await timed("cloud", () => pointCloud("plot-cloud", msg));
-    await timed("profile", () => profile("plot-profile", msg));
+    // the four plots at once: Plotly.animate resolves on the next animation frame, so plots
+    // drawn one after another would each wait for a frame of their own (3 frames, 50 ms, a
+    // 20 updates/s ceiling however fast the machine); together they share one
+    const plots = [
+      () => timed("rd", () => heatmap("plot-rd", msg.rd,
+                                      `range-Doppler, virtual channel ${msg.channel}`, msg)),
+      () => timed("nci", () => heatmap("plot-nci", msg.nci,
+                                       "range-Doppler, integrated over channels", msg)),
+      () => timed("cloud", () => pointCloud("plot-cloud", msg)),
+      () => timed("profile", () => profile("plot-profile", msg)),
+    ];
+    if (state.serial) {
+      for (const plot of plots) await plot();
+    } else {
+      await Promise.all(plots.map(plot => plot()));
+    }
     state.frames += 1;
     state.lastSeq = msg.seq;
     state.lastFrame = msg;
@@ -317,12 +362,16 @@ async function drawLoop() {
     if (ws && ws.readyState === WebSocket.OPEN) {
       ws.send(JSON.stringify({ ack: msg.seq ?? null, draw_fps: state.drawFps }));
     }
+    const t0 = performance.now();
     try {
       await draw(msg);
     } catch (err) {
       console.error("radar view: draw failed", err);
     }
-    await new Promise(resolve => requestAnimationFrame(resolve));  // let the browser paint
+    // let the browser paint, unless the draw already waited for an animation frame
+    if (state.serial || performance.now() - t0 < 8) {
+      await new Promise(resolve => requestAnimationFrame(resolve));
+    }
   }
   drawing = false;
 }
