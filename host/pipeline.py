@@ -450,13 +450,21 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
                  frame: int = 0, reference: bool = False) -> PointCloud:
     """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler) (LSB units).
     ``reference``: through :func:`points_from_cells_reference` (benchmark comparison)."""
+    return process_cube_nci(cube, cfg, params, frame, reference)[0]
+
+
+def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
+                     frame: int = 0, reference: bool = False
+                     ) -> tuple[PointCloud, np.ndarray]:
+    """:func:`process_cube` that also returns the integrated power map it computed, float
+    (n_range, n_doppler), LSB^2 (a display needs it; computing it again costs a cube pass)."""
     params = params or DetectionParams()
     cfg.check_cube(cube)
     cells, noise, nci = detect_cells(cube, cfg, params)
     offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
     r, d = cells[:, 0], cells[:, 1]
     fn = points_from_cells_reference if reference else points_from_cells
-    return fn(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params, frame)
+    return fn(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg, params, frame), nci
 
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,

@@ -86,14 +86,16 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
 def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
     """Frame payload, uint32 (frame_words, num_rx) in DMA order -> radar cube complex64
     (n_virtual, n_range, n_doppler). Same result as ``model.reference.dma_order_to_cube(
-    model.axis_packetizer.payload_to_cube(...))`` but transposes the int16 I/Q pairs before
-    widening them (about 4x faster on a ``full`` frame)."""
-    iq = np.ascontiguousarray(words, dtype="<u4").view("<i2").reshape(
-        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx, 2).transpose(0, 3, 1, 2, 4)
-    cube = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.complex64)
-    cube.real = iq[..., 0]  # I: low half of the word (little-endian)
-    cube.imag = iq[..., 1]  # Q: high half
-    return cube.reshape(cfg.cube_shape)
+    model.axis_packetizer.payload_to_cube(...))``, several times faster on a ``full`` frame: the
+    32-bit {Q, I} words are transposed to channel order while still words (one strided
+    copy), then widened contiguously."""
+    w = np.ascontiguousarray(words, dtype="<u4").reshape(
+        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
+    t[...] = w.transpose(0, 3, 1, 2)
+    iq = np.empty(t.shape + (2,), np.float32)
+    iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
+    return iq.view(np.complex64).reshape(cfg.cube_shape)
 
 
 @dataclass

@@ -316,17 +316,3 @@ def test_page_assets_reference_no_external_url():
         name = r.removeprefix("/static/")
         assert (STATIC_DIR / name).is_file() or name == "plotly.min.js"
     assert plotly_js_path().stat().st_size > 1_000_000
-
-
-@pytest.mark.parametrize("preset", ["paper-fpga", "full"])
-def test_words_to_cube_is_the_host_decode(preset):
-    from host.stream import payload_words_to_cube
-    from radar.view.sources import words_to_cube
-
-    cfg = get_preset(preset)
-    rng = np.random.default_rng(3)
-    words = rng.integers(0, 2**32, (cfg.num_tx * cfg.n_range * cfg.n_doppler, cfg.num_rx),
-                         dtype=np.uint32)
-    got, want = words_to_cube(words, cfg), payload_words_to_cube(words, cfg)
-    assert got.dtype == want.dtype and got.shape == want.shape == cfg.cube_shape
-    assert np.array_equal(got, want)

@@ -27,13 +27,14 @@ from typing import Any
 import numpy as np
 
 from host.capture import CaptureInfo, read_capture
-from host.pipeline import DetectionParams, detect_cells, peak_offsets, points_from_cells
+from host.pipeline import DetectionParams, process_cube_nci
 from host.record_points import process_records
 from host.records import DetectionFrame, RecordDecoder, record_arrays
 from host.stream import (
     PacketDecoder,
     cube_frame_words,
     geometry_from_packet,
+    payload_words_to_cube,
 )
 from host.udp import UDP_MAX_PAYLOAD, max_packet_words
 from model.axis_packetizer import packets_per_frame, words_to_bytes
@@ -82,22 +83,9 @@ class PayloadFrame:
         return bool(self.valid.all()) and not self.problems
 
     def cube(self) -> np.ndarray:
-        """complex64 (n_virtual, n_range, n_doppler), LSB (:func:`words_to_cube`)."""
-        return words_to_cube(self.words, self.cfg)
-
-
-def words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
-    """``host.stream.payload_words_to_cube`` (same result, tested equal), about 2x faster
-    on a ``full`` frame: the 32-bit {Q, I} words are transposed to channel order while
-    still words (one strided copy), then widened contiguously. words: uint32 (frame_words,
-    num_rx) in DMA order -> complex64 (n_virtual, n_range, n_doppler)."""
-    w = np.ascontiguousarray(words, dtype="<u4").reshape(
-        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
-    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
-    t[...] = w.transpose(0, 3, 1, 2)
-    iq = np.empty(t.shape + (2,), np.float32)
-    iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
-    return iq.view(np.complex64).reshape(cfg.cube_shape)
+        """complex64 (n_virtual, n_range, n_doppler), LSB
+        (:func:`host.stream.payload_words_to_cube`)."""
+        return payload_words_to_cube(self.words, self.cfg)
 
 
 class CubePayloadDecoder(PacketDecoder[PayloadFrame]):
@@ -206,14 +194,7 @@ class Processor:
     def _process(self, frame_id: int, cube: np.ndarray, skipped: int,
                  cfg: RadarConfig | None = None) -> None:
         cfg = cfg or self.cfg
-        cfg.check_cube(cube)
-        # host.pipeline.process_cube's steps, keeping the integrated map it computes for
-        # the display (computing it again would cost a pass over the whole cube)
-        cells, noise, nci = detect_cells(cube, cfg, self.params)
-        offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
-        r, d = cells[:, 0], cells[:, 1]
-        cloud = points_from_cells(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg,
-                                  self.params, frame_id)
+        cloud, nci = process_cube_nci(cube, cfg, self.params, frame_id)
         objects = self._objects(cloud)
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=frame_id, cfg=cfg,
                           cloud=cloud, cube=cube, nci=nci, objects=objects,
