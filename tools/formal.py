@@ -104,12 +104,14 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             word, secs = run_task(sby, task, args.timeout)
             results.append(Result(sby.stem, props, task, depths[task], word, secs))
-            print(f"  {sby.stem:16s} {task:6s} {word:8s} {secs:7.1f} s", flush=True)
+            print(f"  {sby.stem:20s} {task:12s} {word:8s} {secs:7.1f} s", flush=True)
     print()
-    print(f"{'module':16s} {'mode':6s} {'depth':>5s} {'result':8s} {'time s':>7s}  property set")
+    print(f"{'module':20s} {'task':12s} {'depth':>5s} {'result':8s} {'time s':>7s}  property set")
     for r in results:
-        print(f"{r.module:16s} {r.mode:6s} {r.depth:5d} {r.result:8s} {r.seconds:7.1f}  "
+        print(f"{r.module:20s} {r.mode:12s} {r.depth:5d} {r.result:8s} {r.seconds:7.1f}  "
               f"{r.props}")
+    total = sum(r.seconds for r in results)
+    print(f"{len(results)} tasks, {total:.0f} s in all")
     ok = all(r.result in ("PROVEN", "PASS") for r in results)
     return 0 if ok else 1
 
