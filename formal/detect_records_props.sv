@@ -5,7 +5,8 @@
 // what cfar_2d sends (tuser {r, d}, rows starting at d = 1); the snapshot writer writes only
 // with snap_room. Both ports under the shared f_axis_port set, and:
 //   - fixed frame length: TLAST exactly on every FRAME_WORDS-th output word;
-//   - frame_count == record frames completed on m_axis; no record frame before its 16 cells
+//   - frame_count == record frames out on m_axis, or one more while the closing words are
+//     still in the output FIFO; no record frame before its 16 cells
 //     (frames out <= cells in / 16).
 `default_nettype none
 
@@ -59,7 +60,10 @@ module detect_records_props (
   end
   always_comb if (past && !rst) begin
     if (m_axis_tvalid) assert (m_axis_tlast == (pos_q == 3'(FW - 1)));
-    assert (frame_count[7:0] == n_frames);
+    // frame_count: frames whose last word was issued into the 4-word output FIFO, so at
+    // most one closed frame has not yet left m_axis
+    assert (n_frames <= frame_count[7:0] && frame_count[7:0] <= n_frames + 8'd1);
+    if (frame_count[7:0] != n_frames) assert (m_axis_tvalid);
     assert ({n_frames, 4'd0} <= 12'(n_in) + (m_axis_tvalid ? 12'd0 : 12'd0));
   end
   always_comb if (past && !rst) begin

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-// Formal harness of frame_store_axi (formal/frame_store_axi.sby): 1 TX x 1 RX x 8 range bins
-// x 2 chirps, DATA_W 16, TILE_R 8 (two-beat write bursts, one four-beat read burst per
-// frame), 128-bit AXI, 2 bursts outstanding, WFIFO_DEPTH 4. Written against the block's
+// Formal harness of frame_store_axi (formal/frame_store_axi.sby): 1 TX x 1 RX x 4 range bins
+// x 2 chirps, DATA_W 32 (64-bit words, 8 a frame), TILE_R 4 (two-beat write bursts, one
+// four-beat read burst per frame), 128-bit AXI, 2 bursts outstanding, WFIFO_DEPTH 4. Written against the block's
 // ports and parameters as they are; the memory side is free within the AXI4 rules.
 //   - s_axis, m_axis: the shared f_axis_port set (assumed / asserted);
 //   - the AXI4 master port: the shared f_axi4_master set (every channel's handshake, WLAST
 //     on the burst's last beat, outstanding bursts <= MAX_OUTSTANDING, 4 KiB, W not ahead);
-//   - no word created or lost on the way: words in >= 4 x W beats (4 words per 128-bit beat)
-//     >= words in - 24 (FIFO, gearbox, burst being collected); words out <= 4 x R beats;
+//   - no word created or lost on the way: words in >= 2 x W beats (2 words per 128-bit beat)
+//     >= words in - 12 (FIFO of 4 beats, both gearboxes); words out <= 2 x R beats;
 //   - output framing: TLAST on every N_DOPPLER-th word, TUSER[0] on the first word of each
 //     frame; frames_out <= frames_in;
 //   - status_mem_error is exactly "some B or R beat had an error response".
@@ -16,7 +16,7 @@
 module frame_store_axi_props (
   input wire logic         clk,
   input wire logic         rst,
-  input wire logic [31:0]  s_axis_tdata,
+  input wire logic [63:0]  s_axis_tdata,
   input wire logic         s_axis_tvalid,
   input wire logic         s_axis_tlast,
   input wire logic         m_axis_tready,
@@ -32,11 +32,11 @@ module frame_store_axi_props (
   input wire logic         rlast,
   input wire logic         rvalid
 );
-  localparam int N_RANGE = 8, N_DOPPLER = 2, WPB = 4;   // words per AXI beat
+  localparam int N_RANGE = 4, N_DOPPLER = 2, WPB = 2;   // words per AXI beat
   localparam int FRAME_WORDS = N_RANGE * N_DOPPLER;
 
   logic         s_axis_tready, m_axis_tvalid, m_axis_tlast;
-  logic [31:0]  m_axis_tdata;
+  logic [63:0]  m_axis_tdata;
   logic [0:0]   m_axis_tuser;
   logic         awid, arid, awlock, arlock, awvalid, wvalid, wlast, bready, arvalid, rready;
   logic [31:0]  awaddr, araddr;
@@ -50,8 +50,8 @@ module frame_store_axi_props (
   logic [31:0]  framing_cnt, mem_err_cnt, frames_in, frames_out;
 
   frame_store_axi #(
-    .NUM_TX(1), .NUM_RX(1), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .DATA_W(16),
-    .TILE_R(8), .AXI_DATA_W(128), .AXI_ADDR_W(32), .AXI_ID_W(1), .MEM_BASE(0),
+    .NUM_TX(1), .NUM_RX(1), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .DATA_W(32),
+    .TILE_R(4), .AXI_DATA_W(128), .AXI_ADDR_W(32), .AXI_ID_W(1), .MEM_BASE(0),
     .MAX_OUTSTANDING(2), .WFIFO_DEPTH(4)
   ) dut (
     .clk, .rst,
@@ -77,10 +77,10 @@ module frame_store_axi_props (
   initial assume (rst);
 
   logic [7:0] n_in, n_out, w_beats, r_beats;
-  f_axis_port #(.PAYLOAD_W(33), .ASSUME(1'b1)) u_s (
+  f_axis_port #(.PAYLOAD_W(65), .ASSUME(1'b1)) u_s (
     .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
     .payload({s_axis_tlast, s_axis_tdata}), .beats(n_in));
-  f_axis_port #(.PAYLOAD_W(34)) u_m (
+  f_axis_port #(.PAYLOAD_W(66)) u_m (
     .clk, .rst, .tvalid(m_axis_tvalid), .tready(m_axis_tready),
     .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}), .beats(n_out));
   f_axi4_master #(.ADDR_W(32), .DATA_W(128), .ID_W(1), .MAX_OUT(2)) u_axi (
@@ -106,12 +106,12 @@ module frame_store_axi_props (
   wire [9:0] r_words = 10'(r_beats) * 10'(WPB);
   always_comb if (past && !rst) begin
     assert (w_words <= 10'(n_in));
-    assert (10'(n_in) <= w_words + 10'd24);
+    assert (10'(n_in) <= w_words + 10'd12);
     assert (10'(n_out) <= r_words);
     if (m_axis_tvalid) begin
       assert (n_out != 8'(r_words));
       assert (m_axis_tlast == (n_out[0] == 1'b1));                    // N_DOPPLER = 2
-      assert (m_axis_tuser[0] == (n_out[3:0] == 4'd0));               // 16 words a frame
+      assert (m_axis_tuser[0] == (n_out[2:0] == 3'd0));               // 8 words a frame
     end
     assert (frames_out <= frames_in);
     assert (mem_err == f_err);
