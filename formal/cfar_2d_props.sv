@@ -5,7 +5,9 @@
 //   - every cell leaves exactly once, in order: output beat k carries tuser = {r, d} with
 //     r = (k / 4) mod 4 and d = (k + PD) mod 4 (each row starts at d = PD, wraps to 0..PD-1),
 //     TLAST on the last cell of every row; no cell before its input (out <= in);
-//   - frame_count counts completed frames (<= input frames).
+//   - frame_count counts completed frames (<= input frames);
+//   - status_framing_error is exactly "some input TLAST not on Doppler bin 3" (positions
+//     counted here from the input beats: a beat taken without being used shows here).
 `default_nettype none
 
 module cfar_2d_props (
@@ -43,11 +45,17 @@ module cfar_2d_props (
 
   logic       past = 1'b0;
   logic [7:0] n_det;
+  logic       f_err;
   wire        det_flag = m_axis_tdata[POW_W + SUM_W + CNT_W];
   always_ff @(posedge clk) begin
     past <= 1'b1;
-    if (rst) n_det <= '0;
-    else if (m_axis_tvalid && m_axis_tready && det_flag) n_det <= n_det + 8'd1;
+    if (rst) begin
+      n_det <= '0;
+      f_err <= 1'b0;
+    end else begin
+      if (m_axis_tvalid && m_axis_tready && det_flag) n_det <= n_det + 8'd1;
+      if (s_axis_tvalid && s_axis_tready && s_axis_tlast != (n_in[1:0] == 2'd3)) f_err <= 1'b1;
+    end
   end
 
   wire [1:0] exp_r = n_out[3:2];
@@ -60,10 +68,12 @@ module cfar_2d_props (
       assert (m_axis_tlast == (n_out[1:0] == 2'd3));
     end
     assert (frame_count[7:0] <= {4'd0, n_in[7:4]});
+    assert (framing == f_err);
   end
   always_comb if (past && !rst) begin
     cover (m_axis_tvalid && m_axis_tready && det_flag);
     cover (m_axis_tvalid && m_axis_tready && m_axis_tlast && exp_r == 2'd1);
+    cover (framing);
   end
   wire unused = ^{framing, detection_count, n_det};
 endmodule

@@ -9,6 +9,9 @@
 //   - the framing events: event_tlast_unexpected / _missing one cycle after an input beat
 //     with TLAST set before position N-1 / clear at position N-1 (positions counted here from
 //     the input beats), and never otherwise.
+// The sby script cuts the stage data (butterfly sums, twiddle products, output rounding and
+// their overflow flags) to free values: every property here is about control, and holds for
+// any data, so the cut only removes the multipliers from the solver's work.
 `default_nettype none
 
 module fft_axis_props (
