@@ -52,7 +52,7 @@ module radar_pipeline_props (
   f_axis_port #(.PAYLOAD_W(34), .ASSUME(1'b1)) u_s (
     .clk, .rst, .tvalid(s_axis_adc_tvalid), .tready(s_axis_adc_tready),
     .payload({s_axis_adc_tuser, s_axis_adc_tlast, s_axis_adc_tdata}), .beats(n_in));
-  f_axis_port #(.PAYLOAD_W(33)) u_m (
+  f_axis_port #(.PAYLOAD_W(33), .COVER(1'b0)) u_m (
     .clk, .rst, .tvalid(m_axis_dma_tvalid), .tready(m_axis_dma_tready),
     .payload({m_axis_dma_tlast, m_axis_dma_tdata}), .beats(n_out));
 
