@@ -38,7 +38,6 @@ module frame_store_axi_props (
   input wire logic         rvalid
 );
   localparam int N_RANGE = 4, N_DOPPLER = 2, WPB = 2;   // words per AXI beat
-  localparam int FRAME_WORDS = N_RANGE * N_DOPPLER;
 
   logic         s_axis_tready, m_axis_tvalid, m_axis_tlast;
   logic [63:0]  m_axis_tdata;
@@ -124,7 +123,6 @@ module frame_store_axi_props (
   end
   always_comb if (past && !rst) begin
     cover (m_axis_tvalid && m_axis_tready && m_axis_tuser[0]);
-    cover (m_axis_tvalid && m_axis_tready && n_out == 8'(FRAME_WORDS - 1));
     cover (mem_err);
   end
   wire unused = ^{framing, framing_cnt, awlock, arlock, awcache, arcache, awprot, arprot};
