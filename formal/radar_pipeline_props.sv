@@ -62,10 +62,10 @@ module radar_pipeline_props (
     assert (!awvalid && !wvalid && !arvalid);
     assert (n_out == 8'd0);
   end
-  // cover (depth 12): eight ADC beats taken, i.e. the assumptions leave the input free; the
+  // cover (depth 5): three ADC beats taken, i.e. the assumptions leave the input free; the
   // blocks' own covers need frames through the chain and are removed from this task
   // (chformal): each is reached in its block's own cover task
-  always_comb if (past && !rst) cover (s_axis_adc_tvalid && s_axis_adc_tready && n_in == 8'd7);
+  always_comb if (past && !rst) cover (s_axis_adc_tvalid && s_axis_adc_tready && n_in == 8'd2);
   wire unused = ^{bready, rready};
 endmodule
 
