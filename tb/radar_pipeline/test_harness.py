@@ -148,3 +148,26 @@ def test_harness_full_frame_store() -> None:
     st = run.status
     assert st["mem_protocol_errors"] == 0 and st["frames_out"] == 1, st
     print(f"full frame: {run.cycles} clocks in {run.wall_s:.1f} s", file=sys.stderr)
+
+
+def test_harness_mode1_frame_store_small4() -> None:
+    """OUTPUT_MODE = 1 with FRAME_STORE = 1 on the 4-TX set (frame_store_axi READ_ORDER = 1:
+    the store reads (r, t, d), so the detector sees all TX of a cell together): record
+    packets bit-exact against the model through AXI4 memory latency and 30 % stalls, DMA
+    stalls, and a reset after two frames (segments)."""
+    from dataclasses import replace
+
+    from test_radar_pipeline_detect import SETS
+
+    cfg, chain = SETS["small4"]
+    chain = replace(chain, frame_store=True)
+    frames = adc_frames("small4", cfg, 3, seed=4)
+    run = run_harness(frames, cfg, chain, seed=6, frame_store=True, mem_latency=40,
+                      mem_stall=0.3, dma_stall=0.2, chirp_gap=cfg.n_range, segment_frames=2)
+    want = [p for k in range(0, 3, 2) for p in dma_packets(frames[k:k + 2], cfg, chain)]
+    assert_packets_equal(run.packets, want, "mode 1, frame store")
+    assert [s["record_frames"] for s in run.segments] == [2, 1], run.segments
+    for st in run.segments:
+        assert st["mem_protocol_errors"] == 0 and st["status_mem_error"] == 0, st
+        assert st["detections"] > 0 and st["status_adc_overflow"] == 0, st
+        assert st["mem_writes"] > 0 and st["mem_writes"] == st["mem_reads"], st
