@@ -375,7 +375,7 @@ PARAMS = [
          MAX_OUTSTANDING=2, WFIFO_DEPTH=16, MEM_BASE=0x3000),
     # READ_ORDER 1 (r, t, d), on-chip detection: 4 TX, a group (4 strips) of 8 KiB read in
     # two 4 KiB bursts, 4-beat write rows
-    dict(NUM_TX=4, NUM_RX=4, N_RANGE=16, N_DOPPLER=32, TILE_R=4, AXI_DATA_W=128,
+    dict(NUM_TX=4, NUM_RX=4, N_RANGE=8, N_DOPPLER=32, TILE_R=4, AXI_DATA_W=128,
          MAX_OUTSTANDING=4, WFIFO_DEPTH=16, MEM_BASE=0x2000, READ_ORDER=1),
     # READ_ORDER 1 with 4 words per beat (one 32-bit lane) and 2 TX: 256-byte groups
     dict(NUM_TX=2, NUM_RX=1, N_RANGE=8, N_DOPPLER=8, TILE_R=4, AXI_DATA_W=128,
