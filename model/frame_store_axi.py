@@ -9,12 +9,18 @@ real read bursts. Words are uint32 lane arrays ``(n_words, num_rx)``.
 Layout (docs/frame_store.md): two frame areas of :attr:`StoreGeometry.frame_bytes` from
 ``mem_base``; frame k lives in area ``k % 2``. Inside an area, strip ``(t, s)`` (TX t, range
 bins ``s*tile_r .. s*tile_r+tile_r-1``) is a contiguous block of ``n_doppler`` rows of
-``tile_r`` words; row d holds chirp d of TX t. Byte offset of word (t, d, r)::
+``tile_r`` words; row d holds chirp d of TX t. The strips follow each other in the order the
+output needs them (:meth:`StoreGeometry.strip_index`, the one place for it): ``read_order`` 0
+((t, r, d), the cube order) puts strip ``t * strips + s``; ``read_order`` 1 ((r, t, d), all TX
+of a range bin together for on-chip detection) puts strip ``s * num_tx + t``. Byte offset of
+word (t, d, r)::
 
-    ((t * strips + r // tile_r) * n_doppler + d) * row_bytes + (r % tile_r) * word_bytes
+    (strip_index(t, r // tile_r) * n_doppler + d) * row_bytes + (r % tile_r) * word_bytes
 
-Write bursts: one row per (chirp, strip) in input order. Read bursts: the area linearly, in
-bursts of ``min(4096, strip_bytes)`` bytes.
+A *group* is what the on-chip buffer holds at a time: one strip (order 0) or the ``num_tx``
+strips of one s (order 1), contiguous either way. Write bursts: one row per (chirp, strip)
+in input order. Read bursts: the area linearly, in bursts of ``min(4096, group_bytes)`` bytes;
+each group leaves as its Doppler vectors, (r, t, d) inside the group.
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ class StoreGeometry:
     axi_data_w: int = 128
     axi_addr_w: int = 32
     mem_base: int = 0
+    read_order: int = 0
 
     def __post_init__(self) -> None:
         checks = [
@@ -67,6 +74,7 @@ class StoreGeometry:
             (_pow2(self.tile_r) and self.tile_r <= self.n_range, "tile_r",
              "a power of two in 1..n_range"),
             (self.mem_base % AXI_BOUNDARY == 0, "mem_base", "4 KiB aligned"),
+            (self.read_order in (0, 1), "read_order", "0 (t, r, d) or 1 (r, t, d)"),
         ]
         for ok, name, what in checks:
             if not ok:
@@ -104,8 +112,24 @@ class StoreGeometry:
         return self.row_bytes * self.n_doppler
 
     @property
+    def group_strips(self) -> int:
+        """Strips per group (the on-chip buffer's unit): 1 (order 0) or num_tx (order 1)."""
+        return self.num_tx if self.read_order == 1 else 1
+
+    @property
+    def group_bytes(self) -> int:
+        return self.strip_bytes * self.group_strips
+
+    @property
     def read_burst_bytes(self) -> int:
-        return min(AXI_BOUNDARY, self.strip_bytes)
+        return min(AXI_BOUNDARY, self.group_bytes)
+
+    def strip_index(self, t: np.ndarray | int, s: np.ndarray | int) -> np.ndarray | int:
+        """Position of strip (TX t, range strip s) inside a frame area: ``t*strips + s``
+        (read_order 0) or ``s*num_tx + t`` (read_order 1). Broadcasts over arrays."""
+        if self.read_order == 1:
+            return s * self.num_tx + t
+        return t * self.strips + s
 
     @property
     def frame_words(self) -> int:
@@ -127,8 +151,8 @@ class StoreGeometry:
 
     @property
     def strip_buffer_bits(self) -> int:
-        """On-chip read buffer: two strips."""
-        return 2 * self.strip_bytes * 8
+        """On-chip read buffer: two groups (two strips in order 0, 2*num_tx in order 1)."""
+        return 2 * self.group_bytes * 8
 
     def area_base(self, k: int) -> int:
         """Byte address of frame k's area."""
@@ -139,7 +163,7 @@ class StoreGeometry:
         (input order: chirp c = d*num_tx + t, range bin r)."""
         d, t, r = np.meshgrid(np.arange(self.n_doppler), np.arange(self.num_tx),
                               np.arange(self.n_range), indexing="ij")
-        row = (t * self.strips + r // self.tile_r) * self.n_doppler + d
+        row = self.strip_index(t, r // self.tile_r) * self.n_doppler + d
         return (row * self.row_bytes + (r % self.tile_r) * self.word_bytes).reshape(-1)
 
 
@@ -148,7 +172,7 @@ def write_bursts(g: StoreGeometry, k: int) -> np.ndarray:
     """int64 ``(n, 2)``: (byte address, beats) of frame k's write bursts in issue order."""
     d, t, s = np.meshgrid(np.arange(g.n_doppler), np.arange(g.num_tx), np.arange(g.strips),
                           indexing="ij")
-    addr = g.area_base(k) + ((t * g.strips + s) * g.n_doppler + d).reshape(-1) * g.row_bytes
+    addr = g.area_base(k) + (g.strip_index(t, s) * g.n_doppler + d).reshape(-1) * g.row_bytes
     return np.stack([addr, np.full_like(addr, g.row_bytes // g.axi_bytes)], axis=1)
 
 
@@ -234,11 +258,12 @@ class DramPageModel:
 # ---- payload -------------------------------------------------------------------------------------
 def store_frames(frames: list[np.ndarray], g: StoreGeometry) -> list[np.ndarray]:
     """Run frames through the external store: write each through its write bursts into a
-    byte memory, read it back through its read bursts and the two-strip buffer.
+    byte memory, read it back through its read bursts and the two-group buffer.
 
     frames: list of ``(frame_words, num_rx)`` uint32 words in input (chirp) order.
-    Returns the output frames ``(frame_words, num_rx)`` in Doppler-vector order, which equal
-    :func:`model.corner_turn.corner_turn` of each input.
+    Returns the output frames ``(frame_words, num_rx)`` in Doppler-vector order ((t, r, d)
+    for read_order 0, (r, t, d) for 1), which equal :func:`model.corner_turn.corner_turn`
+    of each input with the same read_order.
     """
     if g.data_w != 16:
         raise ValueError("store_frames models 32-bit lanes (data_w=16)")
@@ -254,13 +279,15 @@ def store_frames(frames: list[np.ndarray], g: StoreGeometry) -> list[np.ndarray]
         for (addr, beats), row in zip(write_bursts(g, k), data, strict=True):
             mem[addr:addr + beats * g.axi_bytes] = row
         stream = np.concatenate([mem[a:a + b * g.axi_bytes] for a, b in read_bursts(g, k)])
-        words = stream.view("<u4").reshape(g.num_tx * g.strips, g.n_doppler, row_words,
-                                           g.num_rx)
-        # each strip leaves as tile_r Doppler vectors: (strip, r, d)
-        out.append(np.ascontiguousarray(words.transpose(0, 2, 1, 3)).reshape(-1, g.num_rx))
+        gs = g.group_strips
+        words = stream.view("<u4").reshape(g.num_tx * g.strips // gs, gs, g.n_doppler,
+                                           row_words, g.num_rx)
+        # each group leaves as its Doppler vectors: (group, r, t in group, d)
+        out.append(np.ascontiguousarray(words.transpose(0, 3, 1, 2, 4)).reshape(-1, g.num_rx))
     return out
 
 
 def reference(frames: list[np.ndarray], g: StoreGeometry) -> list[np.ndarray]:
     """The on-chip corner turn of each frame (what the store must reproduce)."""
-    return [corner_turn(f, g.num_tx, g.n_range, g.n_doppler) for f in frames]
+    return [corner_turn(f, g.num_tx, g.n_range, g.n_doppler, read_order=g.read_order)
+            for f in frames]

@@ -45,6 +45,10 @@ RANGE_SCALE_SCH = 0xFFF
 DOPPLER_SCALE_SCH = 0x555
 """Doppler FFT scaling schedule: every other stage halves (1/sqrt(N) for even log2 N)."""
 
+FS_TILE_WORDS = 16
+"""Range bins per strip of the external frame store in mode 0 (FS_TILE_R); mode 1 divides it
+by num_tx so the on-chip read buffer stays the same size (:meth:`PipelineParams.store_tile_r`)."""
+
 
 @dataclass(frozen=True)
 class PipelineParams:
@@ -53,7 +57,8 @@ class PipelineParams:
     ``packet_words``: PACKET_WORDS; ``window``: WINDOW (periodic Hann before both FFTs);
     ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER;
     ``frame_store``: FRAME_STORE (corner turn in external memory over AXI4, same payload),
-    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R; ``output_mode``:
+    ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R (None:
+    :meth:`store_tile_r` picks it); ``output_mode``:
     OUTPUT_MODE (0: radar cube, 1: detection records); ``detect``: the detector settings in
     mode 1 (None: :meth:`detect_config` derives them from the RadarConfig).
     """
@@ -65,7 +70,7 @@ class PipelineParams:
     header: bool = True
     frame_store: bool = False
     axi_data_w: int = 128
-    fs_tile_r: int = 16
+    fs_tile_r: int | None = None
     output_mode: int = 0
     detect: DetectConfig | None = None
 
@@ -85,11 +90,23 @@ class PipelineParams:
                              f"match the radar configuration's {want}")
         return d
 
+    def store_tile_r(self, cfg: RadarConfig) -> int:
+        """FS_TILE_R: ``fs_tile_r`` if given, else the largest tile whose on-chip read buffer
+        is at most the mode-0 store's with 16-bin strips (2 x 16 x n_doppler words): 16 in
+        mode 0, 16 // num_tx in mode 1 (whose buffer holds the num_tx strips of one range
+        strip, docs/frame_store.md), and at least one AXI beat per row."""
+        if self.fs_tile_r is not None:
+            return self.fs_tile_r
+        group = cfg.num_tx if self.output_mode == 1 else 1
+        beat_words = max(1, self.axi_data_w // (cfg.num_rx * 32))
+        return min(cfg.n_range, max(FS_TILE_WORDS // group, beat_words, 1))
+
     def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
-        """The external frame store's geometry (FRAME_STORE = 1)."""
+        """The external frame store's geometry (FRAME_STORE = 1); its read order is the
+        corner turn's, ``output_mode`` ((t, r, d) for the cube, (r, t, d) for detection)."""
         return StoreGeometry(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
-                             n_doppler=cfg.n_doppler, tile_r=self.fs_tile_r,
-                             axi_data_w=self.axi_data_w)
+                             n_doppler=cfg.n_doppler, tile_r=self.store_tile_r(cfg),
+                             axi_data_w=self.axi_data_w, read_order=self.output_mode)
 
     def frame_words(self, cfg: RadarConfig) -> int:
         """Payload words per frame: num_tx * n_range * n_doppler (mode 0), the record
@@ -103,8 +120,8 @@ class PipelineParams:
         (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
         schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``;
         OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1)."""
-        store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w, "FS_TILE_R": self.fs_tile_r}
-                 if self.frame_store else {})
+        store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w,
+                  "FS_TILE_R": self.store_tile_r(cfg)} if self.frame_store else {})
         if self.output_mode == 1:
             d = self.detect_config(cfg).hdl_parameters()
             store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
@@ -133,9 +150,6 @@ class PipelineParams:
         """ValueError for an OUTPUT_MODE / detector setting the RTL refuses."""
         if self.output_mode not in (0, 1):
             raise ValueError(f"output_mode={self.output_mode} not 0 or 1")
-        if self.output_mode == 1 and self.frame_store and cfg.num_tx > 1:
-            raise ValueError("output_mode=1 with frame_store needs num_tx=1: the external "
-                             "frame store reads only the (t, r, d) order")
         if self.output_mode == 1:
             self.detect_config(cfg)
 
@@ -228,8 +242,8 @@ def _turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.nda
     """Range-FFT words complex (num_tx * n_doppler * n_range, num_rx), chirp-major input
     order -> Doppler-vector order ((t, r, d) in mode 0, (r, t, d) in mode 1), through the
     on-chip corner turn or, with ``params.frame_store``, through the external store's bursts
-    and strip buffer (the same payload: tests/test_frame_store_chain.py; mode 1 only with
-    num_tx = 1, where both orders are equal)."""
+    and group buffer in the same read order (the same payload:
+    tests/test_frame_store_chain.py)."""
     if params.frame_store:
         return unpack_iq(store_frames([pack_iq(words)], params.store_geometry(cfg))[0])
     return corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler,

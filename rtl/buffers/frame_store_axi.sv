@@ -1,18 +1,21 @@
 // SPDX-License-Identifier: Apache-2.0
 // External frame store: the corner turn (frame transpose between the range FFT and the Doppler
 // FFT) in DDR4 over an AXI4 master port, a drop-in for corner_turn (same AXI4-Stream ports,
-// same output order) when the frame does not fit on chip.
+// same output order for the same READ_ORDER) when the frame does not fit on chip.
 //
 // Layout (docs/frame_store.md): two frame areas of FRAME_BYTES from MEM_BASE, frame k in area
 // k mod 2. Inside an area the range axis is cut into strips of TILE_R range bins; strip
 // (t, s) of TX t is a contiguous block of N_DOPPLER rows, row d holding range bins
-// s*TILE_R .. s*TILE_R+TILE_R-1 of chirp d of TX t:
-//   byte offset of word (t, d, r) = ((t*S + r/TILE_R)*N_DOPPLER + d)*TILE_R*WORD_B
-//                                   + (r mod TILE_R)*WORD_B,            S = N_RANGE/TILE_R.
+// s*TILE_R .. s*TILE_R+TILE_R-1 of chirp d of TX t. The strips follow each other in the
+// order the output needs them, S = N_RANGE/TILE_R:
+//   READ_ORDER 0 (t, r, d): strip index t*S + s     (a group = one strip)
+//   READ_ORDER 1 (r, t, d): strip index s*NUM_TX + t (a group = the NUM_TX strips of s)
+//   byte offset of word (t, d, r) = (strip index * N_DOPPLER + d)*TILE_R*WORD_B
+//                                   + (r mod TILE_R)*WORD_B.
 // Write side: each chirp is written as S INCR bursts of one row (TILE_R words, aligned, so
 // never across 4 KiB) straight from a small FIFO. Read side: the frame area is read linearly
-// (INCR bursts of min(4 KiB, strip) bytes) into a two-strip on-chip buffer, and each strip
-// leaves as TILE_R Doppler vectors. Frame k+1 is written while frame k is read; the writer
+// (INCR bursts of min(4 KiB, group) bytes) into a two-group on-chip buffer, and each group
+// leaves as TILE_R (order 0) or TILE_R*NUM_TX (order 1) Doppler vectors. Frame k+1 is written while frame k is read; the writer
 // starts frame k+2 only once frame k has been read back, the reader starts frame k only once
 // every write of frame k has its BRESP. Memory slower than the input fills the FIFO and
 // drops s_axis_tready: the back-pressure reaches the chirp ping-pong, which drops whole
@@ -28,6 +31,11 @@ module frame_store_axi #(
   parameter int N_RANGE = 64,
   // Chirps per TX per frame (output Doppler vector length), power of two, 2..4096.
   parameter int N_DOPPLER = 256,
+  // Output order of the Doppler vectors (corner_turn's READ_ORDER): 0 = (t, r, d), the DMA
+  // cube order; 1 = (r, t, d), all TX of a range bin together (on-chip detection). The
+  // on-chip read buffer holds two groups: 2*TILE_R*N_DOPPLER words (order 0) or NUM_TX
+  // times that (order 1).
+  parameter int READ_ORDER = 0,
   // Bits of I and of Q per lane: 8, 16 or 32.
   parameter int DATA_W = 16,
   // Range bins per strip (one write burst = TILE_R words), power of two, 1..N_RANGE, with
@@ -57,8 +65,9 @@ module frame_store_axi #(
   input  wire logic                          s_axis_tvalid,
   output logic                               s_axis_tready,
   input  wire logic                          s_axis_tlast,
-  // Doppler vectors: for TX t, for range bin r, N_DOPPLER words (chirps of TX t in order),
-  // TLAST on the last word of every vector, TUSER[0] on the first word of every frame
+  // Doppler vectors: for TX t, for range bin r (READ_ORDER 0; order 1: for r, for t),
+  // N_DOPPLER words (chirps of TX t in order), TLAST on the last word of every vector,
+  // TUSER[0] on the first word of every frame
   output logic      [NUM_RX*2*DATA_W-1:0]    m_axis_tdata,
   output logic                               m_axis_tvalid,
   input  wire logic                          m_axis_tready,
@@ -120,17 +129,19 @@ module frame_store_axi #(
   localparam int S       = N_RANGE / TILE_R;      // strips per TX
   localparam longint WB_BYTES    = TILE_R * WORD_B;                 // one write burst (row)
   localparam int     WB_BEATS    = int'(WB_BYTES / AXI_B);
+  localparam int     G           = (READ_ORDER == 1) ? NUM_TX : 1;  // strips per group
   localparam longint STRIP_BYTES = WB_BYTES * N_DOPPLER;
-  localparam longint RB_BYTES    = (STRIP_BYTES < 4096) ? STRIP_BYTES : 4096; // one read burst
+  localparam longint GROUP_BYTES = STRIP_BYTES * G;
+  localparam longint RB_BYTES    = (GROUP_BYTES < 4096) ? GROUP_BYTES : 4096; // one read burst
   localparam int     RB_BEATS    = int'(RB_BYTES / AXI_B);
   localparam int     RB_UNITS    = RB_BEATS / BPU;
-  localparam int     STRIP_UNITS = int'(STRIP_BYTES * 8 / longint'(UNIT_W));
+  localparam int     GROUP_UNITS = int'(GROUP_BYTES * 8 / longint'(UNIT_W));
   localparam int     WB_UNITS    = int'(WB_BYTES * 8 / longint'(UNIT_W));
-  localparam int     STRIP_WORDS = TILE_R * N_DOPPLER;
+  localparam int     GROUP_WORDS = TILE_R * N_DOPPLER * G;
   localparam longint FRAME_BYTES = STRIP_BYTES * S * NUM_TX;
   localparam int     WBURSTS     = NUM_TX * N_DOPPLER * S;          // write bursts per frame
   localparam int     RBURSTS     = int'(FRAME_BYTES / RB_BYTES);    // read bursts per frame
-  localparam int     NSTRIPS     = NUM_TX * S;                      // strips per frame
+  localparam int     NGROUPS     = NUM_TX * S / G;                  // groups per frame
 
   localparam int BS  = $clog2(S);
   localparam int BT  = $clog2(NUM_TX);
@@ -138,15 +149,16 @@ module frame_store_axi #(
   localparam int BRG = $clog2(N_RANGE);
   localparam int BTR = $clog2(TILE_R);
   localparam int BWPU = $clog2(WPU);
+  localparam int BG  = $clog2(G);
   // counter widths (at least 1 bit)
   localparam int WBW  = (WBURSTS > 1) ? $clog2(WBURSTS) : 1;
   localparam int RBW  = (RBURSTS > 1) ? $clog2(RBURSTS) : 1;
   localparam int WBTW = (WB_BEATS > 1) ? $clog2(WB_BEATS) : 1;
   localparam int RBTW = (RB_BEATS > 1) ? $clog2(RB_BEATS) : 1;
   localparam int BPW_ = (BPU > 1) ? $clog2(BPU) : 1;
-  localparam int SIW  = (NSTRIPS > 1) ? $clog2(NSTRIPS) : 1;
-  localparam int OIW  = $clog2(STRIP_WORDS);                        // >= 1 (N_DOPPLER >= 2)
-  localparam int BUF_DEPTH = 2 * STRIP_UNITS;
+  localparam int SIW  = (NGROUPS > 1) ? $clog2(NGROUPS) : 1;
+  localparam int OIW  = $clog2(GROUP_WORDS);                        // >= 1 (N_DOPPLER >= 2)
+  localparam int BUF_DEPTH = 2 * GROUP_UNITS;
   localparam int BUF_AW    = $clog2(BUF_DEPTH);
   localparam int CRW       = BUF_AW + 1;
   localparam int OUTW      = $clog2(MAX_OUTSTANDING + 1);
@@ -165,6 +177,10 @@ module frame_store_axi #(
   if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
     $fatal(1, "frame_store_axi (%m): N_DOPPLER=%0d must be a power of two in 2..4096",
            N_DOPPLER);
+  end
+  if (READ_ORDER != 0 && READ_ORDER != 1) begin : g_bad_read_order
+    $fatal(1, "frame_store_axi (%m): READ_ORDER=%0d must be 0 (t, r, d) or 1 (r, t, d)",
+           READ_ORDER);
   end
   if (DATA_W != 8 && DATA_W != 16 && DATA_W != 32) begin : g_bad_data_w
     $fatal(1, "frame_store_axi (%m): DATA_W=%0d must be 8, 16 or 32", DATA_W);
@@ -243,7 +259,8 @@ module frame_store_axi #(
     .m_axis_tdata(wb_tdata), .m_axis_tvalid(wb_tvalid), .m_axis_tready(wb_tready)
   );
 
-  // AW: one burst per (chirp, strip) in input order: index = (d*NUM_TX + t)*S + s
+  // AW: one burst per (chirp, strip) in input order: index = (d*NUM_TX + t)*S + s; the row
+  // goes to strip t*S + s (READ_ORDER 0) or s*NUM_TX + t (READ_ORDER 1)
   logic [WBW-1:0]  aw_idx_q;
   logic [OUTW-1:0] aw_out_q;     // AW issued, BRESP not yet in
   logic signed [WBW+1:0] w_open_q; // AWs accepted minus W bursts completed (-1..WBURSTS)
@@ -263,7 +280,8 @@ module frame_store_axi #(
     s_  = idx & 64'(S - 1);
     t_  = (idx >> BS) & 64'(NUM_TX - 1);
     d_  = idx >> (BS + BT);
-    aw_off = (((t_ << BS) + s_) * 64'(N_DOPPLER) + d_) * 64'(WB_BYTES)
+    aw_off = ((READ_ORDER == 1 ? ((s_ << BT) + t_) : ((t_ << BS) + s_)) * 64'(N_DOPPLER) + d_)
+             * 64'(WB_BYTES)
            + (aw_f_q[0] ? 64'(FRAME_BYTES) : 64'd0);
   end
 
@@ -300,7 +318,7 @@ module frame_store_axi #(
   assign b_hs = m_axi_mem_bvalid && m_axi_mem_bready;
 
   // =========================================================================================
-  // Read side: AR linear over the frame area -> R beats -> units -> two-strip buffer
+  // Read side: AR linear over the frame area -> R beats -> units -> two-group buffer
   // =========================================================================================
   logic [RBW-1:0]  ar_idx_q;
   logic [OUTW-1:0] ar_out_q;     // AR issued, last R beat not yet in
@@ -348,7 +366,7 @@ module frame_store_axi #(
     always_ff @(posedge clk) r_acc_q <= '0;
   end
 
-  // ---- strip buffer ----------------------------------------------------------------------
+  // ---- group buffer ----------------------------------------------------------------------
   logic              ram_rd_en;
   logic [BUF_AW-1:0] ram_rd_addr;
   logic [UNIT_W-1:0] ram_rd_data;
@@ -364,22 +382,24 @@ module frame_store_axi #(
   );
 
   // =========================================================================================
-  // Output: strip by strip, for r in the strip, for d: word d*TILE_R + r of the strip
+  // Output: group by group, for r in the group, for t in the group (order 1), for d:
+  // word (t*N_DOPPLER + d)*TILE_R + r of the group (order 0: t = 0)
   // =========================================================================================
-  logic [OIW-1:0] o_idx_q;       // r*N_DOPPLER + d within the strip
-  logic [SIW-1:0] o_strip_q;     // strip within the frame
-  logic [1:0]     out_sc_q;      // strips completely read out (mod 4)
+  logic [OIW-1:0] o_idx_q;       // (r*G + t)*N_DOPPLER + d within the group
+  logic [SIW-1:0] o_strip_q;     // group within the frame
+  logic [1:0]     out_sc_q;      // groups completely read out (mod 4)
   logic           can_issue, o_issue, o_strip_end;
-  logic [OIW-1:0] o_word;        // word index inside the strip (memory order)
+  logic [OIW-1:0] o_word;        // word index inside the group (memory order)
   logic           p_last_q, p_sof_q;
   logic [(BWPU > 0 ? BWPU : 1)-1:0] p_sel_q;
 
   always_comb begin
-    logic [31:0] idx, d_, r_;
+    logic [31:0] idx, d_, t_, r_;
     idx = 32'(o_idx_q);
     d_  = idx & 32'(N_DOPPLER - 1);
-    r_  = idx >> BD;
-    o_word = OIW'(d_ * 32'(TILE_R) + r_);
+    t_  = (idx >> BD) & 32'(G - 1);
+    r_  = idx >> (BD + BG);
+    o_word = OIW'(((t_ << BD) + d_) * 32'(TILE_R) + r_);
   end
 
   assign o_issue     = (out_sc_q != recv_sc_q) && can_issue;
@@ -496,7 +516,7 @@ module frame_store_axi #(
       end
       ar_out_q <= ar_out_q + OUTW'(ar_hs) - OUTW'(r_end);
       credit_q <= credit_q - (ar_hs ? CRW'(RB_UNITS) : '0)
-                           + ((o_issue && o_strip_end) ? CRW'(STRIP_UNITS) : '0);
+                           + ((o_issue && o_strip_end) ? CRW'(GROUP_UNITS) : '0);
       if (r_hs) begin
         r_beat_q <= r_last_exp ? '0 : r_beat_q + 1'b1;
         if (BPU > 1) r_part_q <= r_part_q + 1'b1;
@@ -515,8 +535,8 @@ module frame_store_axi #(
         o_idx_q <= o_idx_q + 1'b1;
         if (o_strip_end) begin
           out_sc_q  <= out_sc_q + 1'b1;
-          o_strip_q <= (o_strip_q == SIW'(NSTRIPS - 1)) ? '0 : o_strip_q + 1'b1;
-          if (o_strip_q == SIW'(NSTRIPS - 1)) frames_out_q <= frames_out_q + 1'b1;
+          o_strip_q <= (o_strip_q == SIW'(NGROUPS - 1)) ? '0 : o_strip_q + 1'b1;
+          if (o_strip_q == SIW'(NGROUPS - 1)) frames_out_q <= frames_out_q + 1'b1;
         end
       end
 
@@ -566,7 +586,7 @@ module frame_store_axi #(
     .payload({m_axi_mem_rid, m_axi_mem_rresp, m_axi_mem_rlast, m_axi_mem_rdata}));
 
 `ifndef SYNTHESIS
-  // block invariants: AXI4 4 KiB rule, strip buffer never over-reserved
+  // block invariants: AXI4 4 KiB rule, group buffer never over-reserved
   always_ff @(posedge clk) begin
     if (!rst) begin
       if (m_axi_mem_awvalid)
@@ -576,7 +596,7 @@ module frame_store_axi #(
         assert ({1'b0, m_axi_mem_araddr[11:0]} + 13'(RB_BYTES) <= 13'h1000)
           else $error("frame_store_axi: read burst crosses 4 KiB");
       if (r_unit) assert (credit_q <= CRW'(BUF_DEPTH))
-        else $error("frame_store_axi: strip buffer over-reserved");
+        else $error("frame_store_axi: group buffer over-reserved");
     end
   end
 `endif

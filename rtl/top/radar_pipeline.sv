@@ -15,8 +15,9 @@
 // OUTPUT_MODE = 1 (on-chip detection, DESIGN 3.4, docs/detect.md): the corner turn reads
 // (r, t, d), the Doppler FFT output goes through detect_chain (NCI, 2-D CFAR, records) and
 // the fixed-length record stream through the same packetizer (header, sequence numbers,
-// DAMAGED/OVERFLOW flags). With FRAME_STORE = 1 only for NUM_TX = 1 (the external store
-// reads the (t, r, d) order, which then equals (r, t, d)).
+// DAMAGED/OVERFLOW flags). With FRAME_STORE = 1 the external store reads (r, t, d) too
+// (frame_store_axi READ_ORDER = 1: its on-chip buffer holds 2 x NUM_TX strips of FS_TILE_R
+// range bins, docs/frame_store.md).
 `default_nettype none
 
 module radar_pipeline #(
@@ -188,10 +189,6 @@ module radar_pipeline #(
   if (OUTPUT_MODE < 0 || OUTPUT_MODE > 1) begin : g_bad_output_mode
     $fatal(1, "%m: OUTPUT_MODE=%0d not 0 (cube) or 1 (detection records)", OUTPUT_MODE);
   end
-  if (OUTPUT_MODE == 1 && FRAME_STORE && NUM_TX > 1) begin : g_bad_frame_store
-    $fatal(1, "%m: FRAME_STORE=1 with OUTPUT_MODE=1 needs NUM_TX=1 (got %0d): the external frame store reads only the (t, r, d) order",
-           NUM_TX);
-  end
   if (OUTPUT_MODE == 1 && (MAX_DETECTIONS < 1 || MAX_DETECTIONS > 65535))
   begin : g_bad_max_detections
     $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535", MAX_DETECTIONS);
@@ -317,7 +314,8 @@ module radar_pipeline #(
   end else begin : g_ct_external
     frame_store_axi #(
       .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
-      .DATA_W(DATA_W), .TILE_R(FS_TILE_R), .AXI_DATA_W(AXI_DATA_W), .AXI_ADDR_W(AXI_ADDR_W),
+      .READ_ORDER(OUTPUT_MODE), .DATA_W(DATA_W), .TILE_R(FS_TILE_R), .AXI_DATA_W(AXI_DATA_W),
+      .AXI_ADDR_W(AXI_ADDR_W),
       .AXI_ID_W(AXI_ID_W), .MEM_BASE(MEM_BASE)
     ) u_frame_store (
       .clk, .rst,

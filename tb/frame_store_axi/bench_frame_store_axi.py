@@ -34,18 +34,24 @@ DRAM_PEAK = 64 / 8 * 2400e6
 directions; MIG's AXI port is 512 bits at 300 MHz)."""
 
 PRESET_STORES = {
-    # name: (preset, tile_r, axi_data_w)
-    "paper-fpga": ("paper-fpga", 16, 128),
-    "paper-fpga/32": ("paper-fpga", 32, 128),
-    "full": ("full", 16, 512),
-    "full/32": ("full", 32, 512),
+    # name: (preset, tile_r, axi_data_w, read_order); "m1": READ_ORDER 1 (on-chip detection,
+    # (r, t, d)), whose buffer holds NUM_TX strips per group
+    "paper-fpga": ("paper-fpga", 16, 128, 0),
+    "paper-fpga/32": ("paper-fpga", 32, 128, 0),
+    "full": ("full", 16, 512, 0),
+    "full/32": ("full", 32, 512, 0),
+    "full-m1/4": ("full", 4, 512, 1),
+    "full-m1/8": ("full", 8, 512, 1),
+    "full-m1/16": ("full", 16, 512, 1),
 }
 
 
-def geometry(preset: str, tile_r: int, axi_data_w: int) -> fs.StoreGeometry:
+def geometry(preset: str, tile_r: int, axi_data_w: int, read_order: int = 0
+             ) -> fs.StoreGeometry:
     c = get_preset(preset)
     return fs.StoreGeometry(num_tx=c.num_tx, num_rx=c.num_rx, n_range=c.n_range,
-                            n_doppler=c.n_doppler, tile_r=tile_r, axi_data_w=axi_data_w)
+                            n_doppler=c.n_doppler, tile_r=tile_r, axi_data_w=axi_data_w,
+                            read_order=read_order)
 
 
 def hist_text(trace: list[tuple[int, int, str]]) -> str:
@@ -60,8 +66,8 @@ def model_table() -> None:
     print(f"{'preset':<13} {'AXI':>4} {'TILE_R':>6} {'frame MiB':>9} {'mem MiB':>7} "
           f"{'AXI MB/frame':>12} {'buffer Mib':>10} {'need GB/s':>9} {'port GB/s':>9} "
           f"{'of port':>7} {'of DDR4':>7} {'row hits':>8}  bursts per frame (dir x beats)")
-    for name, (preset, tile_r, axi_w) in PRESET_STORES.items():
-        g = geometry(preset, tile_r, axi_w)
+    for name, (preset, tile_r, axi_w, order) in PRESET_STORES.items():
+        g = geometry(preset, tile_r, axi_w, order)
         fps = 1.0 / get_preset(preset).frame_time_s
         trace = fs.interleaved_trace(g, 4)
         hits, total = pm.row_hits(trace, g.axi_bytes)

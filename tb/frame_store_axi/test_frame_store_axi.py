@@ -1,7 +1,8 @@
 """cocotb testbench of ``rtl/buffers/frame_store_axi.sv`` against ``model/frame_store_axi.py``:
 cocotbext-axi ``AxiRam`` on ``m_axi_mem`` with pause generators on all five AXI channels, the
 AR/AW address trace checked burst by burst against the model, payload word by word against
-the on-chip corner turn, SLVERR answers counted, mid-stream reset."""
+the on-chip corner turn in the same read order (READ_ORDER 0: (t, r, d), the cube; 1:
+(r, t, d), on-chip detection), SLVERR answers counted, mid-stream reset."""
 
 from __future__ import annotations
 
@@ -76,7 +77,7 @@ class TB(AxisTB):
             num_tx=param("NUM_TX"), num_rx=param("NUM_RX"), n_range=param("N_RANGE"),
             n_doppler=param("N_DOPPLER"), data_w=param("DATA_W"), tile_r=param("TILE_R"),
             axi_data_w=param("AXI_DATA_W"), axi_addr_w=param("AXI_ADDR_W"),
-            mem_base=param("MEM_BASE"))
+            mem_base=param("MEM_BASE"), read_order=param("READ_ORDER", 0))
         self.ram = FaultAxiRam(AxiBus.from_prefix(dut, "m_axi_mem"), dut.clk, dut.rst,
                                size=self.g.mem_base + self.g.memory_bytes)
         self.aw: list[tuple[int, int]] = []
@@ -372,6 +373,13 @@ PARAMS = [
     # not a multiple of the frame size
     dict(NUM_TX=2, NUM_RX=16, N_RANGE=16, N_DOPPLER=16, TILE_R=8, AXI_DATA_W=512,
          MAX_OUTSTANDING=2, WFIFO_DEPTH=16, MEM_BASE=0x3000),
+    # READ_ORDER 1 (r, t, d), on-chip detection: 4 TX, a group (4 strips) of 8 KiB read in
+    # two 4 KiB bursts, 4-beat write rows
+    dict(NUM_TX=4, NUM_RX=4, N_RANGE=8, N_DOPPLER=32, TILE_R=4, AXI_DATA_W=128,
+         MAX_OUTSTANDING=4, WFIFO_DEPTH=16, MEM_BASE=0x2000, READ_ORDER=1),
+    # READ_ORDER 1 with 4 words per beat (one 32-bit lane) and 2 TX: 256-byte groups
+    dict(NUM_TX=2, NUM_RX=1, N_RANGE=8, N_DOPPLER=8, TILE_R=4, AXI_DATA_W=128,
+         MAX_OUTSTANDING=2, WFIFO_DEPTH=4, MEM_BASE=0x0, READ_ORDER=1),
 ]
 
 
@@ -390,6 +398,10 @@ MODEL_GEOMETRIES = [
     dict(num_tx=1, num_rx=4, n_range=64, n_doppler=256, tile_r=16),            # paper-fpga
     dict(num_tx=4, num_rx=16, n_range=256, n_doppler=256, tile_r=16,           # full
          axi_data_w=512, mem_base=0x8000_0000),
+    dict(num_tx=4, num_rx=4, n_range=16, n_doppler=32, tile_r=4, read_order=1),
+    dict(num_tx=2, num_rx=1, n_range=8, n_doppler=8, tile_r=4, read_order=1),
+    dict(num_tx=4, num_rx=16, n_range=256, n_doppler=256, tile_r=4,            # full, mode 1
+         axi_data_w=512, read_order=1),
 ]
 
 
@@ -417,6 +429,8 @@ def test_model_rejects_bad_geometry() -> None:
         fs.StoreGeometry(num_tx=1, num_rx=4, n_range=64, n_doppler=256, mem_base=0x800)
     with pytest.raises(ValueError, match="tile_r"):
         fs.StoreGeometry(num_tx=1, num_rx=1, n_range=64, n_doppler=256, tile_r=2)
+    with pytest.raises(ValueError, match="read_order"):
+        fs.StoreGeometry(num_tx=4, num_rx=4, n_range=64, n_doppler=64, read_order=2)
     with pytest.raises(ValueError, match="axi_addr_w"):
         fs.StoreGeometry(num_tx=4, num_rx=16, n_range=256, n_doppler=256,
                          mem_base=0xFF00_0000)
