@@ -11,7 +11,7 @@ JOBS   ?= auto
 OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
-        gnn-eval clean help view view-records bench-view test-detect-long test-full \
+        gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
         formal coverage mutate mutate-ci
 all: test
 
@@ -26,6 +26,7 @@ help:
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
 	@echo "make test-full       one full-size frame, FRAME_STORE=1 top + AXI4 memory, bit-exact"
+	@echo "make test-full-detect  Table I full frame, OUTPUT_MODE=1 + FRAME_STORE=1, records bit-exact"
 	@echo "make test-detect-long  detector blocks and the mode-1 top at every parameter set"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
@@ -165,3 +166,7 @@ test-detect-long: $(STAMP)
 .PHONY: test-full
 test-full: $(STAMP)
 	FULL_FRAME=1 $(RUN) pytest -q -n 0 -s tb/radar_pipeline/test_harness.py -k full_frame_store
+
+.PHONY: test-full-detect
+test-full-detect: $(STAMP)
+	FULL_DETECT=1 $(RUN) pytest -q -n 0 -s tb/radar_pipeline/test_harness.py -k full_frame_store_detect
