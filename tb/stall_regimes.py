@@ -85,6 +85,15 @@ async def run_cross(tb, scale: int, run: Callable[[tuple[str, str], int], Awaita
                 "full" if full_cross() else "CI subset", len(done), ", ".join(done))
 
 
+async def _flush_source(tb) -> None:
+    """After the reset under test: the source's frame in flight (clear() drops only the
+    queued ones) is let finish into the block, then a second reset removes that testbench
+    artefact (a register the reset misses is still missed: both resets are the same)."""
+    if not tb.source.idle():
+        await tb.source.wait()
+        await tb.reset()
+
+
 async def reset_while_stalled(tb, start: Callable[[], Awaitable[None]], min_stall: int = 8
                               ) -> None:
     """Reset during backpressure: hold TREADY low, ``start()`` traffic, wait until the
@@ -103,8 +112,9 @@ async def reset_while_stalled(tb, start: Callable[[], Awaitable[None]], min_stal
     assert stalled >= min_stall, "output never valid under backpressure"
     tb.source.clear()
     await tb.reset()
-    tb.sink.clear()
     tb.set_backpressure_generator(itertools.repeat(False))
+    await _flush_source(tb)
+    tb.sink.clear()
 
 
 async def reset_while_sending(tb, start: Callable[[], Awaitable[None]], beats: int) -> None:
@@ -122,4 +132,5 @@ async def reset_while_sending(tb, start: Callable[[], Awaitable[None]], beats: i
     assert seen >= beats, f"only {seen} output beats before the reset"
     tb.source.clear()
     await tb.reset()
+    await _flush_source(tb)
     tb.sink.clear()
