@@ -578,6 +578,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="kill mutants with the module's SymbiYosys proof instead of its tests")
     ap.add_argument("--resume", action="store_true",
                     help="keep the verdicts already in --json, run only the rest")
+    ap.add_argument("--reverse", action="store_true",
+                    help="run the sample from its end (a second worker on another --json "
+                         "meets the first one in the middle)")
     ap.add_argument("--timeout", type=float, default=300.0,
                     help="seconds per mutant (a hang counts as killed)")
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
@@ -624,6 +627,8 @@ def main(argv: list[str] | None = None) -> int:
         results = [(m, done[m.ident]["verdict"], done[m.ident]["seconds"]) for m in chosen
                    if m.ident in done]
         chosen = [m for m in chosen if m.ident not in done]
+    if args.reverse:
+        chosen = chosen[::-1]
     for m in chosen:
         verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
                          else run_mutant(m, args.timeout, quick=args.quick or args.ci))
