@@ -586,6 +586,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
     ap.add_argument("--report", action="store_true",
                     help="only print the report of the verdicts already in --json")
+    ap.add_argument("--merge", type=Path, action="append", default=[],
+                    help="with --report: also these results files (other workers' --json); "
+                         "the merged verdicts are written to --json")
     args = ap.parse_args(argv)
     modules = args.modules or list(TESTS)
     if args.formal and not args.modules:
@@ -604,6 +607,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: no results file {args.json}", file=sys.stderr)
             return 2
         done = json.loads(args.json.read_text())
+        if args.merge:
+            by_id = {r["ident"]: r for f in args.merge for r in json.loads(f.read_text())}
+            by_id.update({r["ident"]: r for r in done})
+            done = list(by_id.values())
+            args.json.write_text(json.dumps(done, indent=1))
         fields = set(Mutant.__dataclass_fields__)
         print(report([(Mutant(**{k: v for k, v in r.items() if k in fields}), r["verdict"],
                        r["seconds"]) for r in done]))
