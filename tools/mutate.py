@@ -505,6 +505,12 @@ EQUIVALENT: dict[str, str] = {
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
+    "nci:const:2": (
+        "s1_valid_q set (not cleared) by reset: it only enables the accumulator RAM write, so "
+        "reset writes a stale partial sum at a stale address; every accumulator word that TX "
+        "t >= 1 reads was written by TX t-1 of the same Doppler bin after the reset (a row "
+        "of N_DOPPLER beats later), so the stray word is always overwritten before it is "
+        "read (and with NUM_TX = 1 the register drives nothing)"),
     "mark_fifo:const:8": (
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
