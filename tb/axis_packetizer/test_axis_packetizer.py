@@ -208,6 +208,32 @@ async def test_framing_error(dut):
 
 
 @cocotb.test()
+async def test_framing_error_on_packet_closing_word(dut):
+    """The TLAST error falls on the word that closes packet 0 (an early TLAST there, or a
+    missing one when that word is a TLAST position): packet 0's own header already carries
+    the framing flag (kills the mutant that stamps only the registered flag)."""
+    tb = TB(dut)
+    if not tb.tlast_period or not tb.header:
+        tb.log.info("framing test needs TLAST_PERIOD>0 and HEADER=1: skipped")
+        return
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.2, 27))
+    tb.set_backpressure_generator(random_pause(0.2, 28) if tb.backpressure else no_pause())
+    frame = tb.random_frame()
+    t, cut = tb.tlast_period, tb.packet_words          # error on word cut - 1
+    bounds = set(range(t, len(frame), t)) ^ {cut}      # add an early TLAST or drop one
+    edges = [0, *sorted(b for b in bounds if 0 < b < len(frame)), len(frame)]
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        await tb.send_words(frame[a:b])
+    got = await tb.drain()
+    st = tb.status()
+    assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
+    hdrs = [pk.parse_header(p[0]) for p in got]
+    assert np.array_equal(np.vstack([p[1:] for p in got]), frame)
+    assert all(h.framing for h in hdrs), [h.framing for h in hdrs]
+
+
+@cocotb.test()
 async def test_reset_recovery(dut):
     """Reset in mid-frame under stalls, then clean frames from frame id 0."""
     tb = TB(dut)
