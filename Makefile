@@ -112,6 +112,13 @@ mutate: $(STAMP)
 mutate-ci: $(STAMP)
 	MUTATE_CI=1 $(RUN) pytest -q -n 0 tests/test_verif_tools.py
 
+# Every (input gap, output backpressure) stall-regime pair of tb/stall_regimes.py (16 per
+# parameter set) instead of the 4-pair CI subset that `make test` runs
+STALL_TBS ?= tb/frame_align tb/corner_turn tb/axis_packetizer tb/chirp_pingpong
+.PHONY: test-stall
+test-stall: $(STAMP)
+	STALL_CROSS=full $(RUN) pytest -n $(JOBS) $(STALL_TBS)
+
 GNN_CACHE ?= $(HOME)/.cache/radar-gnn
 
 gnn-dataset: $(STAMP)

@@ -505,6 +505,15 @@ EQUIVALENT: dict[str, str] = {
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
+    "cfar_2d:rel:10": (
+        "lo = (q < PR) ? PR - q : 0 with <= instead of <: the two differ only at q == PR, "
+        "where the taken arm gives PR - q = 0, the same as the other arm"),
+    "nci:const:2": (
+        "s1_valid_q set (not cleared) by reset: it only enables the accumulator RAM write, so "
+        "reset writes a stale partial sum at a stale address; every accumulator word that TX "
+        "t >= 1 reads was written by TX t-1 of the same Doppler bin after the reset (a row "
+        "of N_DOPPLER beats later), so the stray word is always overwritten before it is "
+        "read (and with NUM_TX = 1 the register drives nothing)"),
     "mark_fifo:const:8": (
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
@@ -578,11 +587,17 @@ def main(argv: list[str] | None = None) -> int:
                     help="kill mutants with the module's SymbiYosys proof instead of its tests")
     ap.add_argument("--resume", action="store_true",
                     help="keep the verdicts already in --json, run only the rest")
+    ap.add_argument("--reverse", action="store_true",
+                    help="run the sample from its end (a second worker on another --json "
+                         "meets the first one in the middle)")
     ap.add_argument("--timeout", type=float, default=300.0,
                     help="seconds per mutant (a hang counts as killed)")
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
     ap.add_argument("--report", action="store_true",
                     help="only print the report of the verdicts already in --json")
+    ap.add_argument("--merge", type=Path, action="append", default=[],
+                    help="with --report: also these results files (other workers' --json); "
+                         "the merged verdicts are written to --json")
     args = ap.parse_args(argv)
     modules = args.modules or list(TESTS)
     if args.formal and not args.modules:
@@ -601,6 +616,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: no results file {args.json}", file=sys.stderr)
             return 2
         done = json.loads(args.json.read_text())
+        if args.merge:
+            by_id = {r["ident"]: r for f in args.merge for r in json.loads(f.read_text())}
+            by_id.update({r["ident"]: r for r in done})
+            done = list(by_id.values())
+            args.json.write_text(json.dumps(done, indent=1))
         fields = set(Mutant.__dataclass_fields__)
         print(report([(Mutant(**{k: v for k, v in r.items() if k in fields}), r["verdict"],
                        r["seconds"]) for r in done]))
@@ -624,6 +644,8 @@ def main(argv: list[str] | None = None) -> int:
         results = [(m, done[m.ident]["verdict"], done[m.ident]["seconds"]) for m in chosen
                    if m.ident in done]
         chosen = [m for m in chosen if m.ident not in done]
+    if args.reverse:
+        chosen = chosen[::-1]
     for m in chosen:
         verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
                          else run_mutant(m, args.timeout, quick=args.quick or args.ci))

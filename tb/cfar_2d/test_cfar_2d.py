@@ -180,11 +180,12 @@ PARAMS = [
     # GO with top range bins blanked, asymmetric window, rows 0, 1, 11, 12 never report
     dict(N_RANGE=16, N_DOPPLER=32, POW_W=34, GUARD_R=1, GUARD_D=2, TRAIN_R=2, TRAIN_D=3, KIND=1,
          BLANK_TOP=3, REPORT_LO=2, REPORT_HI=11),
-]
-LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
-    # smallest: 4 x 4 map, no guard, one training cell per side, CA
+    # smallest: 4 x 4 map, no guard, one training cell per side, CA (the KIND 0 arm in the
+    # default regression: seconds to build and run)
     dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
          BLANK_TOP=1),
+]
+LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
     # SO, Doppler window nearly the whole row (wrap on both sides)
     dict(N_RANGE=16, N_DOPPLER=8, POW_W=38, GUARD_R=0, GUARD_D=1, TRAIN_R=3, TRAIN_D=2, KIND=2,
          BLANK_TOP=0),

@@ -11,6 +11,7 @@ import pytest
 from model import corner_turn as ct
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import stall_regimes
 
 
 class TB(AxisTB):
@@ -153,6 +154,58 @@ async def test_reset_recovery(dut):
     got = await rx
     tb.check(got, frames)
     assert tb.status()["frames_out"] == 2
+
+
+@cocotb.test()
+async def test_stall_cross(dut):
+    """Stall regimes crossed (tb/stall_regimes.py: CI subset, or all 16 pairs with
+    STALL_CROSS=full): per (input, output) pair, frames through the block bit-exact."""
+    tb = TB(dut)
+    await tb.reset()
+    nfr = 1 if tb.frame_words > 4096 else 2
+    sent = []
+
+    async def run(pair, k):
+        frames = [tb.random_frame() for _ in range(nfr)]
+        rx = cocotb.start_soon(tb.recv_frames(nfr))
+        for f in frames:
+            await tb.send_frame(f)
+        tb.check(await rx, frames)
+        sent.extend(frames)
+
+    await stall_regimes.run_cross(tb, tb.n_range, run)
+    st = tb.status()
+    assert st["framing_error_count"] == 0 and st["frames_out"] == len(sent), st
+
+
+@cocotb.test()
+async def test_reset_during_backpressure_and_output(dut):
+    """Reset while the output is valid and stalled, then reset while words flow out
+    (mid-frame): counters cleared, the next frames bit-exact."""
+    tb = TB(dut)
+    await tb.reset()
+
+    async def start():  # queues the frames (the source sends them in the background)
+        for _ in range(2 if tb.frame_words <= 4096 else 1):
+            await tb.send_frame(tb.random_frame())
+
+    for case in ("backpressure", "output"):
+        if case == "backpressure":
+            await stall_regimes.reset_while_stalled(tb, start)
+        else:
+            await stall_regimes.reset_while_sending(tb, start, beats=tb.frame_words // 2)
+        st = tb.status()
+        assert all(v == 0 for v in st.values()), (case, st)
+        tb.set_idle_generator(random_pause(0.2, 11))
+        tb.set_backpressure_generator(random_pause(0.2, 12))
+        frames = [tb.random_frame() for _ in range(2)]
+        rx = cocotb.start_soon(tb.recv_frames(2))
+        for f in frames:
+            await tb.send_frame(f)
+        tb.check(await rx, frames)
+        assert tb.status()["frames_out"] == 2, case
+        tb.set_idle_generator(no_pause())
+        await tb.reset()
 
 
 # ------------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@ from cocotb.triggers import RisingEdge
 from model.frame_align import frame_align
 from rtlsim.axis import AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import stall_regimes
 
 
 class TB(AxisTB):
@@ -161,6 +162,50 @@ async def reset_mid_stream(dut) -> None:
     await tb.wait_quiet(4 * tb.n_range)
     assert tb.done == want.frames_damaged == [False, False]
     assert tb.counters()[:2] == base[:2] == (0, 0)
+
+@cocotb.test()
+async def stall_cross_with_losses(dut) -> None:
+    """Stall regimes crossed (tb/stall_regimes.py: CI subset, all 16 pairs with
+    STALL_CROSS=full), each pair from reset with random chirp losses: output chirps, frame
+    marks and counters equal the model."""
+    tb = TB(dut)
+
+    async def run(pair, k) -> None:
+        tb.rng = np.random.default_rng(300 + k)
+        await tb.reset()
+        tb.done.clear()
+        seq = tb.sequence(3, faults=True)
+        await tb.send(*seq)
+        await tb.check(*seq, "stall pair " + "/".join(pair))
+
+    await stall_regimes.run_cross(tb, tb.n_range, run)
+
+
+@cocotb.test()
+async def reset_during_backpressure(dut) -> None:
+    """Reset while the output is valid and held by TREADY low: counters cleared, nothing of
+    the old stream leaks, the next frames pass unchanged and undamaged."""
+    tb = TB(dut)
+    await tb.reset()
+
+    async def start() -> None:
+        await tb.send(*tb.sequence(2, faults=False))
+
+    await stall_regimes.reset_while_stalled(tb, start)
+    assert tb.counters() == (0, 0, 0), tb.counters()
+    await tb.wait_quiet(2 * tb.n_range)  # the flushed source finishes its chirp
+    tb.sink.clear()
+    tb.done.clear()
+    base = tb.counters()
+    seq = tb.sequence(2, faults=False)
+    await tb.send(*seq)
+    want = frame_align(*seq, tb.frame_chirps)
+    got = await tb.collect(len(want.chirps))
+    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
+    await tb.wait_quiet(4 * tb.n_range)
+    assert tb.done == want.frames_damaged == [False, False]
+    assert tb.counters()[:2] == base[:2] == (0, 0)
+
 
 
 PARAMS = [dict(NUM_RX=2, DATA_W=16, N_RANGE=4, FRAME_CHIRPS=6),
