@@ -46,6 +46,9 @@ HARNESS_SRC = Path(__file__).resolve().parent
 TOPLEVEL = "radar_pipeline"
 EXE = f"V{TOPLEVEL}"
 BUILD_JOBS = 2
+CXX_OPT = "-O2"
+"""C++ optimisation of the harness and the Verilated model (Verilator's own -O3 and the
+rest of :data:`rtlsim.toolchain.BUILD_ARGS`, assertions on, apply as in every build)."""
 
 
 @dataclass(frozen=True)
@@ -55,8 +58,9 @@ class HarnessRun:
     ``packets``: DMA packets in arrival order, each uint32 (words, num_rx) (header word
     first); ``segments``: per reset segment, the status ports (:data:`HARNESS_STATUS`) after
     it drained plus ``frames`` (and, FRAME_STORE = 1, the memory model's ``mem_writes``,
-    ``mem_reads`` beats and ``mem_protocol_errors`` during the segment); ``cycles``: clocks simulated (resets included); ``wall_s``: the C++ loop's
-    wall time (build and file I/O excluded).
+    ``mem_reads`` beats and ``mem_protocol_errors`` during the segment); ``cycles``: clocks
+    simulated (resets included); ``wall_s``: the C++ loop's wall time (build and file I/O
+    excluded).
     """
 
     packets: list[np.ndarray]
@@ -113,7 +117,7 @@ def build_harness(cfg: RadarConfig, chain: PipelineParams | None = None,
         ensure_verilator_env()
         cmd = ["verilator", "--cc", "--exe", "--build", "-j", str(BUILD_JOBS), *BUILD_ARGS,
                "--top-module", TOPLEVEL, "--Mdir", str(build_dir), "-o", EXE,
-               "-CFLAGS", f"-O2 -I{HARNESS_SRC} -I{build_dir}",
+               "-CFLAGS", f"{CXX_OPT} -I{HARNESS_SRC} -I{build_dir}",
                *[f"-G{k}={v}" for k, v in params.items()],
                *[str(s) for s in sources], str(HARNESS_SRC / "main.cpp")]
         proc = subprocess.run(cmd, cwd=build_dir, capture_output=True, text=True)

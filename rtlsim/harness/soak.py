@@ -10,11 +10,12 @@ Frames are the Table I scene's consecutive frames (independent noise). They go i
 one harness run each. With ``--store both`` (default) the chunks alternate between the top
 with the on-chip corner turn (FRAME_STORE = 0) and the top with the external frame store
 (FRAME_STORE = 1, the harness's AXI4 memory: per chunk a random latency and random stalls on
-all five channels). Each chunk draws a timing profile (ADC rate, chirp gaps, DMA and memory
-stall rates; the DMA and the memory always faster on average than the ADC, so no frame may
-be lost) and resets the top every ``--reset-every`` frames (frame ids restart at 0). While
-the harness runs a chunk, the model computes the next chunk's expected packets and FFT
-overflow beats (``model.radar_pipeline.dma_frames``).
+all five channels). Each chunk takes the next timing profile of its variant in turn (ADC
+rate, chirp gaps, DMA and memory stall rates; the DMA and the memory always faster on
+average than the ADC, so no frame may be lost) with a random seed (and memory latency), and
+resets the top every ``--reset-every`` frames (frame ids restart at 0). While the harness
+runs a chunk, the model computes the next chunk's expected packets and FFT overflow beats
+(``model.radar_pipeline.dma_frames``).
 
 Checks per frame: its DMA packets equal the model's. Checks per reset segment: every status
 counter the harness reads equals :func:`expected_status` (the FFT overflow flag and count
@@ -55,7 +56,7 @@ STORE_PROFILES = (
     {"adc_gap": 0.0, "chirp_gap": 192, "dma_stall": 0.3, "mem_stall": 0.3},
     {"adc_gap": 0.5, "chirp_gap": 0, "dma_stall": 0.3, "mem_stall": 0.2},
     {"adc_gap": 0.7, "chirp_gap": 0, "dma_stall": 0.5, "mem_stall": 0.5},
-    {"adc_gap": 0.4, "chirp_gap": 0, "dma_stall": 0.0, "mem_stall": 0.0},
+    {"adc_gap": 0.4, "chirp_gap": 0, "dma_stall": 0.0, "mem_stall": 0.1},
 )
 """Timing profiles of the external frame store: the memory's ready rate (each burst also
 waits ``mem_latency``, drawn per chunk from :data:`MEM_LATENCY`) above the ADC valid rate."""
@@ -187,12 +188,13 @@ def main(argv: list[str] | None = None) -> int:
     def chunk_at(start: int) -> Chunk | None:
         if start >= args.frames:
             return None
-        store = stores[(start // chunk) % len(stores)]
-        if store:
-            opts = dict(STORE_PROFILES[int(rng.integers(len(STORE_PROFILES)))])
+        k, n_var = start // chunk, len(stores)
+        store = stores[k % n_var]
+        if store:       # profiles in turn (each one runs), seeds and latency drawn
+            opts = dict(STORE_PROFILES[k // n_var % len(STORE_PROFILES)])
             opts["mem_latency"] = int(rng.integers(MEM_LATENCY[0], MEM_LATENCY[1] + 1))
         else:
-            opts = dict(PROFILES[int(rng.integers(len(PROFILES)))])
+            opts = dict(PROFILES[k // n_var % len(PROFILES)])
         opts["seed"] = int(rng.integers(1 << 31))
         frames = [simulate_scene(scene, k).samples
                   for k in range(start, min(start + chunk, args.frames))]
