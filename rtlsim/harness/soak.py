@@ -138,14 +138,15 @@ class Tally:
     payload_bad: int = 0
     status_bad: int = 0
     wall_s: float = 0.0
+    cpu_s: float = 0.0
 
-    def add(self, frames: int, cycles: int, payload_bad: int, status_bad: int,
-            wall_s: float) -> None:
-        self.frames += frames
-        self.cycles += cycles
-        self.payload_bad += payload_bad
-        self.status_bad += status_bad
-        self.wall_s += wall_s
+    def add(self, t: Tally) -> None:
+        self.frames += t.frames
+        self.cycles += t.cycles
+        self.payload_bad += t.payload_bad
+        self.status_bad += t.status_bad
+        self.wall_s += t.wall_s
+        self.cpu_s += t.cpu_s
 
 
 @dataclass(frozen=True)
@@ -180,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     t_build = time.perf_counter()
     for store in stores:
         build_harness(cfg, chains[store])
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time() + cpu_children()
     print(f"soak: {args.frames} paper-fpga frames, chunks of {chunk}, reset every "
           f"{args.reset_every} frames, FRAME_STORE {'/'.join(str(int(s)) for s in stores)} "
           f"(harnesses built/checked in {t0 - t_build:.1f} s)")
@@ -220,7 +221,8 @@ def main(argv: list[str] | None = None) -> int:
                                                                       chains[cur.store]))]
             if len(run.segments) != len(want):
                 st_bad.append(f"{len(run.segments)} segments, expected {len(want)}")
-            tallies[cur.store].add(len(cur.frames), run.cycles, bad, len(st_bad), run.wall_s)
+            tallies[cur.store].add(Tally(len(cur.frames), run.cycles, bad, len(st_bad),
+                                         run.wall_s, run.cpu_s))
             ovf = sum(s["fft_overflow_count"] for s in run.segments)
             print(f"  frames {cur.start:>4}..{cur.start + len(cur.frames) - 1:<4} "
                   f"FRAME_STORE {int(cur.store)} {cur.options}: {run.cycles} cycles, "
@@ -229,24 +231,35 @@ def main(argv: list[str] | None = None) -> int:
                   + (f": {'; '.join(st_bad[:6])}" if st_bad else ""), flush=True)
             cur = nxt
     wall = time.perf_counter() - t0
-    return report(tallies, wall)
+    return report(tallies, wall, time.process_time() + cpu_children() - cpu0)
 
 
-def report(tallies: dict[bool, Tally], wall: float) -> int:
-    """Print the table; 1 if any frame or status mismatched, else 0."""
+def cpu_children() -> float:
+    """CPU seconds of the finished harness processes."""
+    import resource
+
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def report(tallies: dict[bool, Tally], wall: float, cpu: float) -> int:
+    """Print the table (``wall`` / ``cpu``: seconds of the whole soak, builds excluded);
+    1 if any frame or status mismatched, else 0."""
     total = Tally()
-    print(f"{'top':<22} {'frames':>6} {'cycles':>12} {'payload':>8} {'status':>7} "
-          f"{'RTL s':>7} {'cycles/s':>10}")
-    print(f"{'':<22} {'':>6} {'':>12} {'mismatch':>8} {'mismatch':>7}")
+    print(f"{'top':<20} {'frames':>6} {'cycles':>11} {'payload':>8} {'status':>8} "
+          f"{'RTL wall':>8} {'RTL CPU':>8} {'cyc/CPU-s':>9}")
+    print(f"{'':<20} {'':>6} {'':>11} {'mismatch':>8} {'mismatch':>8} {'s':>8} {'s':>8}")
+
+    def row(name: str, t: Tally) -> None:
+        print(f"{name:<20} {t.frames:>6} {t.cycles:>11,} {t.payload_bad:>8} {t.status_bad:>8} "
+              f"{t.wall_s:>8.1f} {t.cpu_s:>8.1f} {t.cycles / max(t.cpu_s, 1e-9):>9,.0f}")
+
     for store, t in tallies.items():
-        total.add(t.frames, t.cycles, t.payload_bad, t.status_bad, t.wall_s)
-        name = "FRAME_STORE 1 (AXI4)" if store else "FRAME_STORE 0"
-        print(f"{name:<22} {t.frames:>6} {t.cycles:>12,} {t.payload_bad:>8} {t.status_bad:>7} "
-              f"{t.wall_s:>7.1f} {t.cycles / max(t.wall_s, 1e-9):>10,.0f}")
-    print(f"{'total':<22} {total.frames:>6} {total.cycles:>12,} {total.payload_bad:>8} "
-          f"{total.status_bad:>7} {total.wall_s:>7.1f} "
-          f"{total.cycles / max(total.wall_s, 1e-9):>10,.0f}")
-    print(f"wall time {wall:.1f} s (harness runs, model and scene simulation overlapped)")
+        total.add(t)
+        row("FRAME_STORE 1 (AXI4)" if store else "FRAME_STORE 0", t)
+    row("total", total)
+    print(f"wall time {wall:.1f} s, CPU {cpu:.1f} s (harness runs overlapped with the model "
+          f"and the scene simulation; on a loaded machine the CPU time is the stable figure)")
     return 1 if total.payload_bad or total.status_bad else 0
 
 
