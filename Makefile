@@ -87,7 +87,8 @@ bench-rtl: $(STAMP)
 	$(RUN) python tb/radar_pipeline/bench_harness.py
 	$(RUN) python tb/frame_store_axi/bench_frame_store_axi.py
 
-# not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness (~10 min)
+# not part of `make test`: SOAK_FRAMES paper-fpga frames through the C++ harness, chunks
+# alternating FRAME_STORE = 0 / 1 (AXI4 memory stalls), payload and status vs the model
 SOAK_FRAMES ?= 1000
 soak: $(STAMP)
 	$(RUN) python -m rtlsim.harness.soak --frames $(SOAK_FRAMES)

@@ -279,14 +279,46 @@ def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,
     """DMA packets of consecutive frames exactly as ``radar_pipeline`` sends them: uint32
     arrays (words, num_rx), one per TLAST-closed packet, header word first. Mode 0: the
     cube; mode 1: the record streams (:func:`record_frames`), same framing."""
+    return [p for f in dma_frames(adc_frames, cfg, params, first_frame_id) for p in f.packets]
+
+
+@dataclass(frozen=True)
+class FrameDma:
+    """One frame as ``radar_pipeline`` sends it, and the FFT saturation behind it.
+
+    ``packets``: uint32 arrays (words, num_rx), header word first (as :func:`dma_packets`);
+    ``range_overflow`` / ``doppler_overflow``: output beats of the range / Doppler FFT whose
+    computation saturated (the RTL's per-FFT ``event_overflow`` pulses, as
+    :class:`ChainOutput`).
+    """
+
+    packets: list[np.ndarray]
+    range_overflow: int
+    doppler_overflow: int
+
+
+def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
+               params: PipelineParams | None = None, first_frame_id: int = 0
+               ) -> list[FrameDma]:
+    """:func:`dma_packets` per frame, with each frame's FFT overflow beats (one model run
+    gives both: what a soak compares the RTL's packets and status counters with)."""
     params = params or PipelineParams()
     params.check(cfg)
+    overflow: list[tuple[int, int]] = []
     if params.output_mode == 1:
-        payloads = record_frames(adc_frames, cfg, params, first_frame_id)
+        def words():                    # one frame's Doppler output at a time
+            for adc in adc_frames:
+                dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params, False)
+                overflow.append((rng_ov, dop_ov))
+                yield pack_iq(dop)
+        payloads = detect_stream(words(), params.detect_config(cfg),
+                                 first_frame_id=first_frame_id)
     else:
-        payloads = [cube_to_payload(run_chain(adc, cfg, params).payload) for adc in adc_frames]
-    out: list[np.ndarray] = []
-    for k, payload in enumerate(payloads):
-        out.extend(packetize(payload, params.packet_words, first_frame_id + k,
-                             header=params.header))
-    return out
+        payloads = []
+        for adc in adc_frames:
+            out = run_chain(adc, cfg, params)
+            overflow.append((out.range_overflow, out.doppler_overflow))
+            payloads.append(cube_to_payload(out.payload))
+    return [FrameDma(packetize(payload, params.packet_words, first_frame_id + k,
+                               header=params.header), *ov)
+            for k, (payload, ov) in enumerate(zip(payloads, overflow, strict=True))]

@@ -5,8 +5,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import time
+from concurrent.futures import Future, ProcessPoolExecutor
 from pathlib import Path
+from typing import Any
 
 from host.cfar import paper_threshold
 from host.evaluate import alias_note, match_targets, table3
@@ -19,7 +22,40 @@ from radar.objects import gnn_objects, object_boxes
 from radar.sources import SOURCES, get_source
 
 
+def _import_gnn() -> None:
+    """Worker warm-up: import the GNN (torch, torch_geometric: most of the demo's start-up)."""
+    import gnn.infer  # noqa: F401
+
+
+class GnnWorker:
+    """:func:`radar.objects.gnn_objects` in a worker process (spawned, so nothing of this
+    process is forked) that imports torch while this process simulates the scene, runs the
+    chain and draws; :meth:`objects` then only waits for the inference. Same function, same
+    checkpoint: the same objects as calling it here."""
+
+    def __init__(self) -> None:
+        self._pool = ProcessPoolExecutor(max_workers=1,
+                                         mp_context=multiprocessing.get_context("spawn"))
+        self._warm: Future[None] = self._pool.submit(_import_gnn)
+
+    def objects(self, cloud: Any, ego_speed_mps: float) -> list[dict[str, Any]]:
+        """Objects of ``cloud`` (a :class:`host.pointcloud.PointCloud`), as ``gnn_objects``."""
+        return self._pool.submit(gnn_objects, cloud, ego_speed_mps).result()
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
+    gnn = None if args.no_gnn else GnnWorker()
+    try:
+        return _demo(args, gnn)
+    finally:
+        if gnn is not None:
+            gnn.close()
+
+
+def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     from host.angle import range_azimuth_power
     from host.plots import (
         plot_detection_mask,
@@ -68,8 +104,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
         az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom,
         note=alias_note(scene.targets, cfg)))
     ego = default_ego_speed_mps(scene)  # the same default as radar detect / radar gnn detect
-    objects = gnn_objects(cloud, ego) if not args.no_gnn else []
-    if not args.no_gnn:
+    objects = gnn.objects(cloud, ego) if gnn is not None else []
+    if gnn is not None:
         print(f"GNN (synthetic-trained checkpoint; ego {ego * 3.6:.0f} km/h is beyond its "
               f"training range): " + (", ".join(
                   f"{o['class']} {o['score']:.2f} at ({o['x_m']:.1f}, {o['y_m']:.1f}) m"

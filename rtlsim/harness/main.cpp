@@ -9,8 +9,9 @@
 // Input (--adc): little-endian uint32 records, one per ADC beat: flags (bit 0 TLAST, bit 1
 // TUSER[0] = frame start), then NUM_RX words {Q, I}. The beats of --frames frames, in order.
 // Output (--dma): per TLAST-closed DMA packet a uint32 word count, then its words x NUM_RX
-// uint32 lanes. Output (--status): JSON with cycles, wall time and, per segment, the status
-// ports read after the segment drained.
+// uint32 lanes. Output (--status): JSON with cycles, wall and CPU time (wall_s, cpu_s) and,
+// per segment, the status ports read after the segment drained (FRAME_STORE = 1: also the
+// memory model's beats written / read and protocol errors during the segment).
 //
 // Run: --segment-frames K streams K frames, waits for their --packets-per-frame packets
 // each, reads the status, then pulses rst (8 cycles) before the next segment (0: one
@@ -25,6 +26,7 @@
 
 #include <chrono>
 #include <cinttypes>
+#include <ctime>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -143,6 +145,7 @@ class Harness {
 
   int run() {
     auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t cpu0 = std::clock();
     std::FILE* dma = std::fopen(a_.dma.c_str(), "wb");
     if (!dma) fail(2, "cannot write " + a_.dma);
     dma_ = dma;
@@ -157,10 +160,12 @@ class Harness {
     std::fclose(dma);
     top_->final();
     double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     std::FILE* st = std::fopen(a_.status.c_str(), "w");
     if (!st) fail(2, "cannot write " + a_.status);
-    std::fprintf(st, "{\"cycles\": %" PRIu64 ", \"wall_s\": %.6f, \"packets\": %" PRIu64
-                 ", \"segments\": [%s]}\n", cycles_, wall, packets_, segs.c_str());
+    std::fprintf(st, "{\"cycles\": %" PRIu64 ", \"wall_s\": %.6f, \"cpu_s\": %.6f, "
+                 "\"packets\": %" PRIu64 ", \"segments\": [%s]}\n", cycles_, wall, cpu,
+                 packets_, segs.c_str());
     std::fclose(st);
     return 0;
   }
@@ -225,6 +230,9 @@ class Harness {
     packet_.clear();  // a packet cut by the reset is not a packet
 #ifdef HARNESS_FRAME_STORE
     mem_->reset_channels();
+    mem_at_reset_[0] = mem_->beats_written();
+    mem_at_reset_[1] = mem_->beats_read();
+    mem_at_reset_[2] = mem_->protocol_errors();
 #endif
   }
 
@@ -276,9 +284,11 @@ class Harness {
     HARNESS_STATUS(HARNESS_STATUS_FIELD)
 #undef HARNESS_STATUS_FIELD
 #ifdef HARNESS_FRAME_STORE
-    s += ", \"mem_writes\": " + std::to_string(mem_->beats_written()) +
-         ", \"mem_reads\": " + std::to_string(mem_->beats_read()) +
-         ", \"mem_protocol_errors\": " + std::to_string(mem_->protocol_errors());
+    // the memory model's counters since the segment's reset, like the top's counters
+    s += ", \"mem_writes\": " + std::to_string(mem_->beats_written() - mem_at_reset_[0]) +
+         ", \"mem_reads\": " + std::to_string(mem_->beats_read() - mem_at_reset_[1]) +
+         ", \"mem_protocol_errors\": " +
+         std::to_string(mem_->protocol_errors() - mem_at_reset_[2]);
 #endif
     return s + "}";
   }
@@ -288,6 +298,7 @@ class Harness {
   std::unique_ptr<Top> top_;
 #ifdef HARNESS_FRAME_STORE
   std::unique_ptr<harness::Axi4Mem> mem_;
+  uint64_t mem_at_reset_[3] = {0, 0, 0};  // beats written, read, protocol errors
 #endif
   std::mt19937_64 rng_adc_, rng_dma_;
   std::vector<uint32_t> adc_;

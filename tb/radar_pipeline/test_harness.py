@@ -14,13 +14,15 @@ from __future__ import annotations
 
 import os
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from test_radar_pipeline import CONFIGS, adc_frames, assert_packets_equal
 
-from model.radar_pipeline import dma_packets
+from model.radar_pipeline import dma_frames, dma_packets
 from rtlsim.harness import run_harness, run_pipeline
+from rtlsim.harness.soak import expected_status, payload_mismatches, status_mismatches
 from rtlsim.pipeline_rtl import run_pipeline_rtl
 from rtlsim.toolchain import RTL
 
@@ -85,6 +87,47 @@ def test_harness_reports_dma_overload() -> None:
 def test_harness_bad_input() -> None:
     with pytest.raises(ValueError, match="expected shape"):
         run_harness([np.zeros((3, 4, 64), complex)], CFG, CHAIN)
+
+
+def saturating_frame() -> np.ndarray:
+    """Full-scale DC on every lane (32767 + 32767j): the Doppler FFT saturates (4 beats on
+    small4, model.radar_pipeline.dma_frames), the range FFT does not."""
+    return np.full((CFG.n_chirps, CFG.num_rx, CFG.n_range), 32767 + 32767j)
+
+
+@pytest.mark.parametrize("frame_store", [False, True])
+def test_harness_status_as_model_predicts(frame_store: bool) -> None:
+    """The soak's check (rtlsim.harness.soak): per reset segment every status counter as
+    the model predicts, including the FFT overflow flag and count of frames that saturate
+    (segments [scene, DC], [scene, scene], [DC]) and, FRAME_STORE = 1, the memory beats; a
+    prediction without the overflow (or with a frame too few) is caught."""
+    if frame_store and "FRAME_STORE" not in (RTL / "top" / "radar_pipeline.sv").read_text():
+        pytest.skip("radar_pipeline has no FRAME_STORE parameter in this tree")
+    scene = adc_frames(NAME, CFG, 3, seed=17)
+    frames = [scene[0], saturating_frame(), scene[1], scene[2], saturating_frame()]
+    kw = {"mem_latency": 30, "mem_stall": 0.3} if frame_store else {}
+    run = run_harness(frames, CFG, CHAIN, seed=6, adc_gap=0.5, dma_stall=0.3,
+                      segment_frames=2, frame_store=frame_store, **kw)
+    model_chain = replace(CHAIN, frame_store=frame_store)   # the store's geometry: defaults
+    want = [dma_frames(frames[k:k + 2], CFG, model_chain) for k in range(0, 5, 2)]
+    assert payload_mismatches(run, [f for seg in want for f in seg]) == 0
+    assert [s["fft_overflow_count"] for s in run.segments] == [4, 0, 4], run.segments
+    for seg, w in zip(run.segments, want, strict=True):
+        assert status_mismatches(seg, expected_status(w, CFG, model_chain)) == [], seg
+    clean = dma_frames(scene[:2], CFG, model_chain)         # no overflow predicted
+    assert any("fft_overflow_count" in m for m in
+               status_mismatches(run.segments[0], expected_status(clean, CFG, model_chain)))
+    assert status_mismatches(run.segments[1], expected_status(want[1][:1], CFG, model_chain))
+
+
+def test_dma_frames_is_dma_packets() -> None:
+    """``dma_frames`` (packets and overflow per frame) gives ``dma_packets``' packets."""
+    frames = [*adc_frames(NAME, CFG, 2, seed=8), saturating_frame()]
+    per_frame = dma_frames(frames, CFG, CHAIN, first_frame_id=3)
+    flat = [p for f in per_frame for p in f.packets]
+    assert_packets_equal(flat, dma_packets(frames, CFG, CHAIN, first_frame_id=3), "dma_frames")
+    assert [(f.range_overflow, f.doppler_overflow) for f in per_frame] == [(0, 0), (0, 0),
+                                                                           (0, 4)]
 
 
 @pytest.mark.parametrize(("mem_latency", "mem_stall"), [(20, 0.0), (40, 0.3)])
