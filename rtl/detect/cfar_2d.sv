@@ -173,9 +173,12 @@ module cfar_2d #(
     .rd_data (cw_rd)
   );
 
+  // Slot selects are ROWS-way decodes with constant part-selects (a variable part-select
+  // of the CW_W-bit word would be a full-width shifter per use)
   always_comb begin
     cw_wr = cw_rd;
-    cw_wr[st_slot_q * POW_W +: POW_W] = st_x_q;
+    for (int s = 0; s < ROWS; s++)
+      if (st_slot_q == SLOT_W'(s)) cw_wr[s * POW_W +: POW_W] = st_x_q;
   end
 
   // ---------------------------------------------------------------------------------------
@@ -228,23 +231,26 @@ module cfar_2d #(
 
   // ---------------------------------------------------------------------------------------
   // Vertical sums of the arriving column over the tested row's window
+  logic [POW_W-1:0] win [NE];     // win[k]: cell of window row q-PR+k (slot (p+1+k) mod ROWS)
+  always_comb begin
+    for (int k = 0; k < NE; k++) win[k] = '0;
+    for (int s = 0; s < ROWS; s++)
+      if (st_slot_q == SLOT_W'(s))
+        for (int k = 0; k < NE; k++) win[k] = cw_rd[((s + 1 + k) % ROWS) * POW_W +: POW_W];
+  end
+
   logic [SUM_W-1:0] vo, vi;
   logic [POW_W-1:0] vcut;
   always_comb begin
-    int sl;
     vo   = '0;
     vi   = '0;
     vcut = '0;
     for (int k = 0; k < NE; k++) begin
-      // slot of row q-PR+k = (p + 1 + k) mod ROWS
-      sl = int'(st_slot_q) + 1 + k;
-      if (sl >= ROWS) sl = sl - ROWS;
-      if (sl >= ROWS) sl = sl - ROWS;
       if (rowv1_q[k]) begin
-        vo = vo + SUM_W'(cw_rd[sl * POW_W +: POW_W]);
-        if (k >= PR - GUARD_R && k <= PR + GUARD_R) vi = vi + SUM_W'(cw_rd[sl * POW_W +: POW_W]);
+        vo = vo + SUM_W'(win[k]);
+        if (k >= PR - GUARD_R && k <= PR + GUARD_R) vi = vi + SUM_W'(win[k]);
       end
-      if (k == PR) vcut = cw_rd[sl * POW_W +: POW_W];
+      if (k == PR) vcut = win[k];
     end
   end
 
