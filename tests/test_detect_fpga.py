@@ -44,15 +44,6 @@ def test_bad_input_one_line(tmp_path, capsys):
     assert not (tmp_path / "x.json").exists()
 
 
-def test_rtl_backend_fails_in_one_line_or_runs(tmp_path, capsys):
-    """--backend rtl --detect fpga on full: the RTL top cannot run mode 1 with the external
-    frame store and 4 TX (or has no OUTPUT_MODE yet): a one-line reason, no build."""
-    rc = main(["detect", "--scene", "table1", "--json", str(tmp_path / "x.json"), "--detect",
-               "fpga", "--backend", "rtl"])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and len(err) == 1 and "--backend rtl" in err[0], err
-
-
 @pytest.mark.skipif(not os.environ.get("DETECT_LONG"),
                     reason="builds the mode-1 top (minutes): make test-detect-long")
 def test_rtl_backend_same_points_as_model_paper_fpga(tmp_path):
