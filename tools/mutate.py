@@ -505,9 +505,12 @@ EQUIVALENT: dict[str, str] = {
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
-    "cfar_2d:rel:10": (
+    "cfar_2d:rel:12": (
         "lo = (q < PR) ? PR - q : 0 with <= instead of <: the two differ only at q == PR, "
         "where the taken arm gives PR - q = 0, the same as the other arm"),
+    "cfar_2d:rel:14": (
+        "if (hi > PR) hi = PR with >= instead of >: the two differ only at hi == PR, where "
+        "the assignment writes the value hi already has"),
     "nci:const:2": (
         "s1_valid_q set (not cleared) by reset: it only enables the accumulator RAM write, so "
         "reset writes a stale partial sum at a stale address; every accumulator word that TX "
