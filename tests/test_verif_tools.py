@@ -110,6 +110,34 @@ def test_coverage_table_and_parse(tmp_path: Path) -> None:
     assert "| `m` | 1/2 (50.0%) | - | - |" in text
 
 
+def test_coverage_waivers(tmp_path: Path) -> None:
+    """The project's waiver file loads; a waiver leaves its points out of hit and total alike
+    (toggle: by signal name, line: by source text); a malformed entry names itself."""
+    assert coverage.load_waivers(), "tools/coverage_waivers.toml holds no waiver"
+    w = coverage.Waiver(name="ctr", kind="toggle", module="*", signal=r"\w+_count",
+                        reason="counters")
+    tog = "\x01page\x02v_toggle/m\x01o\x02{}"
+    dat = tmp_path / "a.dat"
+    dat.write_text("# SystemC::Coverage-3\n" + "".join(
+        f"C '{tog.format(o)}' {n}\n" for o, n in [("x_count[31]:0->1", 0),
+                                                    ("x_count[0]:0->1", 3),
+                                                    ("data[3]:0->1", 0), ("data[0]:0->1", 1)]))
+    points = coverage.parse_points([dat])
+    assert coverage.summary(points)["m"]["toggle"] == [2, 4]
+    assert coverage.summary(points, [w])["m"]["toggle"] == [1, 2]
+    text = coverage.table_text(coverage.summary(points), markdown=True,
+                               waived=coverage.summary(points, [w]))
+    assert "| `m` | - | - | 2/4 (50.0%) | - | 50.0% |" in text
+    bad = tmp_path / "w.toml"
+    bad.write_text('[[waiver]]\nname = "nope"\nkind = "toggle"\nmodule = "*"\nsignal = "x"\n')
+    with pytest.raises(ValueError, match="waiver nope: no reason"):
+        coverage.load_waivers(bad)
+    bad.write_text('[[waiver]]\nname = "l"\nkind = "line"\nmodule = "m"\nsignal = "x"\n'
+                   'reason = "r"\n')
+    with pytest.raises(ValueError, match="names source text"):
+        coverage.load_waivers(bad)
+
+
 @pytest.mark.skipif(os.environ.get("MUTATE_CI", "0") in ("", "0"),
                     reason="MUTATE_CI=1 (make mutate-ci): one Verilator build per mutant")
 @pytest.mark.parametrize("mutant", mutate.ci_mutants(), ids=lambda m: m.ident)
