@@ -13,14 +13,14 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import RisingEdge
+from cocotb.triggers import RisingEdge, with_timeout
 from cocotbext.axi import AxiBus, AxiStreamFrame
 from cocotbext.axi.axi_ram import AxiRamRead, AxiRamWrite
 from cocotbext.axi.memory import Memory
 
 from model import frame_store_axi as fs
 from model.axis_packetizer import words_to_bytes
-from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
+from rtlsim.axis import CLK_PERIOD_NS, AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
 
@@ -148,10 +148,18 @@ class TB(AxisTB):
         return frames
 
     async def run_frames(self, frames: list[np.ndarray]) -> list[np.ndarray]:
-        rx = cocotb.start_soon(self.recv_frames(len(frames)))
-        for f in frames:
-            await self.send_frame(f)
-        return await rx
+        """Send the frames and receive as many, within a generous budget (200 clocks per
+        word, 40x the slowest stall pattern here): a stream that stops fails at once
+        instead of hanging the test."""
+
+        async def both() -> list[np.ndarray]:
+            rx = cocotb.start_soon(self.recv_frames(len(frames)))
+            for f in frames:
+                await self.send_frame(f)
+            return await rx
+
+        budget = (10_000 + 200 * sum(len(f) for f in frames)) * CLK_PERIOD_NS
+        return await with_timeout(both(), budget, "ns")
 
     def status(self) -> dict[str, int]:
         d = self.dut
