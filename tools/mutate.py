@@ -511,6 +511,12 @@ EQUIVALENT: dict[str, str] = {
     "cfar_2d:rel:14": (
         "if (hi > PR) hi = PR with >= instead of >: the two differ only at hi == PR, where "
         "the assignment writes the value hi already has"),
+    "corner_turn:drop:4": (
+        "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
+        "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
+    "frame_align:const:8": (
+        "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
+        "from PASS through the arm that writes discard_q, so the reset value is never read"),
     "nci:const:2": (
         "s1_valid_q set (not cleared) by reset: it only enables the accumulator RAM write, so "
         "reset writes a stale partial sum at a stale address; every accumulator word that TX "
