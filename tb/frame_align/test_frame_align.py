@@ -136,6 +136,24 @@ async def start_lost_early_start_and_midframe_entry(dut) -> None:
     await tb.check(chirps, sof, gap, "edge cases")
 
 
+async def clean_frames_after_reset(tb: TB) -> None:
+    """After a reset: let the flushed source finish its chirp, then 2 fault-free frames must
+    pass exactly as the model says, undamaged, with frames_damaged and chirps_filled still 0
+    (chirps_discarded may count the interrupted chirp's tail, which has no frame start)."""
+    await tb.wait_quiet(2 * tb.n_range)  # the flushed source finishes its chirp
+    tb.sink.clear()
+    tb.done.clear()
+    base = tb.counters()
+    seq = tb.sequence(2, faults=False)
+    await tb.send(*seq)
+    want = frame_align(*seq, tb.frame_chirps)
+    got = await tb.collect(len(want.chirps))
+    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
+    await tb.wait_quiet(4 * tb.n_range)
+    assert tb.done == want.frames_damaged == [False, False]
+    assert tb.counters()[:2] == base[:2] == (0, 0)
+
+
 @cocotb.test()
 async def reset_mid_stream(dut) -> None:
     """A reset in the middle of a frame, then clean frames: nothing of the old stream leaks."""
@@ -149,19 +167,9 @@ async def reset_mid_stream(dut) -> None:
     tb.source.clear()
     tb.sink.clear()
     tb.done.clear()
-    await tb.wait_quiet(2 * tb.n_range)  # the flushed source finishes its chirp
-    tb.sink.clear()
-    tb.done.clear()
     # the interrupted chirp's tail has no frame start: it is discarded (counted)
-    base = tb.counters()
-    seq = tb.sequence(2, faults=False)
-    await tb.send(*seq)
-    want = frame_align(*seq, tb.frame_chirps)
-    got = await tb.collect(len(want.chirps))
-    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
-    await tb.wait_quiet(4 * tb.n_range)
-    assert tb.done == want.frames_damaged == [False, False]
-    assert tb.counters()[:2] == base[:2] == (0, 0)
+    await clean_frames_after_reset(tb)
+
 
 @cocotb.test()
 async def stall_cross_with_losses(dut) -> None:
@@ -193,18 +201,7 @@ async def reset_during_backpressure(dut) -> None:
 
     await stall_regimes.reset_while_stalled(tb, start)
     assert tb.counters() == (0, 0, 0), tb.counters()
-    await tb.wait_quiet(2 * tb.n_range)  # the flushed source finishes its chirp
-    tb.sink.clear()
-    tb.done.clear()
-    base = tb.counters()
-    seq = tb.sequence(2, faults=False)
-    await tb.send(*seq)
-    want = frame_align(*seq, tb.frame_chirps)
-    got = await tb.collect(len(want.chirps))
-    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
-    await tb.wait_quiet(4 * tb.n_range)
-    assert tb.done == want.frames_damaged == [False, False]
-    assert tb.counters()[:2] == base[:2] == (0, 0)
+    await clean_frames_after_reset(tb)
 
 
 
