@@ -89,7 +89,7 @@ def test_capture_replay_receive_with_defaults(tmp_path, faults):
     assert sum(p["frame"] == 0 for p in doc["points"]) >= 3
 
 
-def test_receive_ctrl_c_writes_json_no_traceback(tmp_path, capsys):
+def test_receive_ctrl_c_writes_json_no_traceback(tmp_path, capsys, sigint_raises):
     import os
     import signal
 

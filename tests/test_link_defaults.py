@@ -80,7 +80,7 @@ def test_nothing_arrives_returns_no_frames_within_the_total_timeout():
     assert frames == [] and rx.datagrams == 0 and 0.5 < time.monotonic() - t0 < 3.0
 
 
-def test_ctrl_c_keeps_what_was_received():
+def test_ctrl_c_keeps_what_was_received(sigint_raises):
     cfg = get_preset("paper-fpga")
     pw = max_packet_words(cfg.num_rx)
     pk = frame_packets(_cube(cfg), cfg, pw, 0)
