@@ -31,12 +31,11 @@ from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.detect_records import (
     HDR_LANES,
-    TAG_RECORD,
-    TAG_TRAILER,
     Record,
     Trailer,
     decode_frame,
-    hdr_words,
+    frame_end,
+    record_scan,
     record_words,
 )
 
@@ -137,30 +136,15 @@ class RecordList(Sequence[Record]):
         return f"RecordList({len(self)} records)"
 
 
-def _trailer(lanes: np.ndarray) -> Trailer:
-    """The trailer of its header lanes (uint32 (>= 5,)), as ``model.detect_records``."""
-    return Trailer(records=int(lanes[1]), detections=int(lanes[2]),
-                   truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
-                   frame_id=int(lanes[3]), max_detections=int(lanes[4]))
-
-
 def decode_record_fields(words: np.ndarray, num_tx: int
                          ) -> tuple[RecordFields, Trailer | None, list[str]]:
     """``model.detect_records.decode_frame`` into arrays: (records, trailer or None,
     errors), the same records, trailer and error messages (tests), without building a
     ``Record`` per detection. words: uint32 (n_words, num_rx), padding allowed; never
     raises on bad data."""
-    w = np.asarray(words, dtype=np.uint32)
+    w, pos, n, hw = record_scan(words, num_tx)
     num_rx = w.shape[1]
-    hw = hdr_words(num_rx)
     rw = hw + num_tx
-    n_words = len(w)
-    n_pos = (n_words - hw) // rw + 1 if n_words >= hw else 0
-    pos = np.arange(n_pos) * rw
-    tags = w[pos, 0] >> 24 if n_pos else np.zeros(0, np.uint32)
-    stop = (tags != TAG_RECORD) | (pos + rw > n_words)
-    first = int(np.argmax(stop)) if stop.any() else n_pos
-    n = first
     if n:
         # all records are one (n, rw, num_rx) block: header lanes, then num_tx snapshot words
         block = w[:n * rw].reshape(n, rw, num_rx)
@@ -174,21 +158,8 @@ def decode_record_fields(words: np.ndarray, num_tx: int
             snapshot=block[:, hw:])
     else:
         fields = empty_fields(num_tx, num_rx)
-    errors: list[str] = []
-    if first < n_pos:
-        p = int(pos[first])
-        tag = int(tags[first])
-        if tag == TAG_TRAILER:
-            tr = _trailer(w[p:p + hw].reshape(-1))
-            if tr.records != n:
-                errors.append(f"trailer counts {tr.records} records, found {n}")
-            return fields, tr, errors
-        if tag != TAG_RECORD:
-            errors.append(f"word {p}: bad record tag 0x{tag:02x}")
-        else:
-            errors.append(f"word {p}: record cut short")
-    errors.append("no trailer")
-    return fields, None, errors
+    tr, errors = frame_end(w, pos, n, hw)
+    return fields, tr, errors
 
 
 @dataclass

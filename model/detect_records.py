@@ -147,16 +147,14 @@ def encode_frame(records: Sequence[Record], detections: int, num_tx: int, num_rx
     return out
 
 
-def decode_frame(words: np.ndarray, num_tx: int) -> RecordFrame:
-    """Records of one frame's record stream (uint32 ``(n, num_rx)``, padding allowed).
-
-    Never raises on bad data: a bad tag, a missing trailer or a count mismatch is reported
-    in ``errors``. Vectorised: the headers sit at a fixed stride, so all of them are read
-    at once up to the first word that is not a record header (same output as
-    :func:`decode_frame_reference`)."""
+def record_scan(words: np.ndarray, num_tx: int) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Where a frame's records are: (w uint32 (n_words, num_rx), the candidate header word
+    positions int (n_pos,) at the record stride, the number n of complete records before the
+    first position that is not one, header words per record hw). Records are read at
+    ``pos[:n]``; ``pos[n]`` (when n < n_pos) is where the frame's end is looked for
+    (:func:`frame_end`)."""
     w = np.asarray(words, dtype=np.uint32)
-    num_rx = w.shape[1]
-    hw = hdr_words(num_rx)
+    hw = hdr_words(w.shape[1])
     rw = hw + num_tx
     n_words = len(w)
     # candidate header positions: pos + hw <= n_words
@@ -165,26 +163,48 @@ def decode_frame(words: np.ndarray, num_tx: int) -> RecordFrame:
     tags = w[pos, 0] >> 24 if n_pos else np.zeros(0, np.uint32)
     # a record is complete when its snapshot fits too
     stop = (tags != TAG_RECORD) | (pos + rw > n_words)
-    first = int(np.argmax(stop)) if stop.any() else n_pos
-    recs = _records_at(w, pos[:first], hw, num_tx)
+    n = int(np.argmax(stop)) if stop.any() else n_pos
+    return w, pos, n, hw
+
+
+def trailer_of(lanes: np.ndarray) -> Trailer:
+    """The trailer of its header lanes (uint32 (>= 5,))."""
+    return Trailer(records=int(lanes[1]), detections=int(lanes[2]),
+                   truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
+                   frame_id=int(lanes[3]), max_detections=int(lanes[4]))
+
+
+def frame_end(w: np.ndarray, pos: np.ndarray, n: int, hw: int
+              ) -> tuple[Trailer | None, list[str]]:
+    """The frame's trailer after its n records (:func:`record_scan`), or None, and the
+    errors: a trailer whose count is not n, a bad tag, a record cut short, no trailer."""
     errors: list[str] = []
-    if first < n_pos:
-        p = int(pos[first])
-        tag = int(tags[first])
+    if n < len(pos):
+        p = int(pos[n])
+        tag = int(w[p, 0] >> 24)
         if tag == TAG_TRAILER:
-            lanes = w[p:p + hw].reshape(-1)
-            tr = Trailer(records=int(lanes[1]), detections=int(lanes[2]),
-                         truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
-                         frame_id=int(lanes[3]), max_detections=int(lanes[4]))
-            if tr.records != len(recs):
-                errors.append(f"trailer counts {tr.records} records, found {len(recs)}")
-            return RecordFrame(recs, tr, errors)
+            tr = trailer_of(w[p:p + hw].reshape(-1))
+            if tr.records != n:
+                errors.append(f"trailer counts {tr.records} records, found {n}")
+            return tr, errors
         if tag != TAG_RECORD:
             errors.append(f"word {p}: bad record tag 0x{tag:02x}")
         else:
             errors.append(f"word {p}: record cut short")
     errors.append("no trailer")
-    return RecordFrame(recs, None, errors)
+    return None, errors
+
+
+def decode_frame(words: np.ndarray, num_tx: int) -> RecordFrame:
+    """Records of one frame's record stream (uint32 ``(n, num_rx)``, padding allowed).
+
+    Never raises on bad data: a bad tag, a missing trailer or a count mismatch is reported
+    in ``errors``. Vectorised: the headers sit at a fixed stride, so all of them are read
+    at once up to the first word that is not a record header (same output as
+    :func:`decode_frame_reference`)."""
+    w, pos, n, hw = record_scan(words, num_tx)
+    tr, errors = frame_end(w, pos, n, hw)
+    return RecordFrame(_records_at(w, pos[:n], hw, num_tx), tr, errors)
 
 
 def _records_at(w: np.ndarray, pos: np.ndarray, hw: int, num_tx: int) -> list[Record]:
