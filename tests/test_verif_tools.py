@@ -124,9 +124,10 @@ def test_coverage_waivers(tmp_path: Path) -> None:
                                                     ("data[3]:0->1", 0), ("data[0]:0->1", 1)]))
     points = coverage.parse_points([dat])
     assert coverage.summary(points)["m"]["toggle"] == [2, 4]
-    assert coverage.summary(points, [w])["m"]["toggle"] == [1, 2]
+    waived = coverage.assign_waivers(points, [w])
+    assert coverage.summary(points, waived)["m"]["toggle"] == [1, 2]
     text = coverage.table_text(coverage.summary(points), markdown=True,
-                               waived=coverage.summary(points, [w]))
+                               waived=coverage.summary(points, waived))
     assert "| `m` | - | - | 2/4 (50.0%) | - | 50.0% |" in text
     bad = tmp_path / "w.toml"
     bad.write_text('[[waiver]]\nname = "nope"\nkind = "toggle"\nmodule = "*"\nsignal = "x"\n')

@@ -126,6 +126,17 @@ def waiver_of(fields: dict[str, str], waivers: list[Waiver]) -> Waiver | None:
     return next((w for w in waivers if w.matches(*km, fields)), None)
 
 
+def assign_waivers(points: dict[tuple, int], waivers: list[Waiver]) -> dict[tuple, Waiver]:
+    """Point key -> the waiver covering it, for every waived point (matched once, then used
+    by the table, the uncovered list and the unused-waiver check)."""
+    out = {}
+    for key in points:
+        w = waiver_of(dict(key), waivers)
+        if w is not None:
+            out[key] = w
+    return out
+
+
 def parse_points(files: list[Path]) -> dict[tuple, int]:
     """Coverage points of all files keyed without the instance hierarchy (so a point is hit
     when any instance of the module hit it): key -> max count."""
@@ -143,17 +154,15 @@ def parse_points(files: list[Path]) -> dict[tuple, int]:
     return points
 
 
-def summary(points: dict[tuple, int], waivers: list[Waiver] | None = None
+def summary(points: dict[tuple, int], waived: dict[tuple, Waiver] | None = None
             ) -> dict[str, dict[str, list[int]]]:
-    """module -> kind (line/branch/toggle) -> [hit, total]; with ``waivers``, the points they
-    cover are left out (of hit and total alike)."""
+    """module -> kind (line/branch/toggle) -> [hit, total]; the ``waived`` points
+    (:func:`assign_waivers`) are left out (of hit and total alike)."""
     table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0]))
     for key, count in points.items():
         fields = dict(key)
         km = _kind_module(fields)
-        if km is None:
-            continue
-        if waivers and waiver_of(fields, waivers):
+        if km is None or (waived and key in waived):
             continue
         kind, module = km
         cell = table[module][kind]
@@ -171,7 +180,7 @@ def write_merged(points: dict[tuple, int], path: Path) -> None:
 
 
 def write_uncovered(points: dict[tuple, int], path: Path,
-                    waivers: list[Waiver] | None = None) -> None:
+                    waived: dict[tuple, Waiver] | None = None) -> None:
     """Text report: every point never hit, as ``file:line kind module detail``, followed by
     ``[waived: name]`` when a waiver covers it."""
     rows = []
@@ -180,16 +189,16 @@ def write_uncovered(points: dict[tuple, int], path: Path,
             continue
         f = dict(key)
         rel = f.get("f", "?").split("/rtl/", 1)[-1]
-        w = waiver_of(f, waivers or [])
+        w = (waived or {}).get(key)
         rows.append((rel, int(f.get("l", 0)), f.get("page", "?"), f.get("o", ""),
                      f" [waived: {w.name}]" if w else ""))
     path.write_text("".join(f"rtl/{r}:{ln} {page} {o}{w}\n"
                             for r, ln, page, o, w in sorted(rows)))
 
 
-def unused_waivers(points: dict[tuple, int], waivers: list[Waiver]) -> list[Waiver]:
+def unused_waivers(waived: dict[tuple, Waiver], waivers: list[Waiver]) -> list[Waiver]:
     """Waivers that cover no point of this run (stale, or their testbench did not run)."""
-    used = {waiver_of(dict(k), waivers) for k in points}
+    used = set(waived.values())
     return [w for w in waivers if w not in used]
 
 
@@ -226,21 +235,21 @@ def table_text(table: dict[str, dict[str, list[int]]], markdown: bool = False,
         hit, total = (waived or {}).get(module, {}).get(kind, [0, 0])
         return "-" if not total else f"{100 * hit / total:.1f}%"
 
-    extra = ("line waived", "toggle waived") if waived is not None else ()
+    extra = ("line", "toggle") if waived is not None else ()   # kinds shown after waivers
     if markdown:
-        lines = ["| module | line | branch | toggle |" + "".join(f" {e} |" for e in extra),
+        lines = ["| module | line | branch | toggle |" + "".join(f" {k} waived |" for k in extra),
                  "|---|---:|---:|---:|" + "---:|" * len(extra)]
         for module in sorted(table):
             lines.append(f"| `{module}` | " + " | ".join(
                 cell(*table[module].get(k, [0, 0])) for k in kinds) + " |" + "".join(
-                f" {pct(module, e.split()[0])} |" for e in extra))
+                f" {pct(module, k)} |" for k in extra))
         return "\n".join(lines)
     lines = [f"{'module':20s}" + "".join(f"{k:>22s}" for k in kinds)
-             + "".join(f"{e:>15s}" for e in extra)]
+             + "".join(f"{k + ' waived':>15s}" for k in extra)]
     for module in sorted(table):
         lines.append(f"{module:20s}" + "".join(
             f"{cell(*table[module].get(k, [0, 0])):>22s}" for k in kinds) + "".join(
-            f"{pct(module, e.split()[0]):>15s}" for e in extra))
+            f"{pct(module, k):>15s}" for k in extra))
     return "\n".join(lines)
 
 
@@ -275,12 +284,13 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     points = parse_points(files)
     write_merged(points, OUT / "merged.dat")
-    write_uncovered(points, OUT / "uncovered.txt", waivers)
+    waived = assign_waivers(points, waivers)
+    write_uncovered(points, OUT / "uncovered.txt", waived)
     table = summary(points)
-    text = table_text(table, markdown=args.markdown, waived=summary(points, waivers))
+    text = table_text(table, markdown=args.markdown, waived=summary(points, waived))
     (OUT / "summary.txt").write_text(text + "\n")
     print(text)
-    for w in unused_waivers(points, waivers):
+    for w in unused_waivers(waived, waivers):
         print(f"note: waiver {w.name} ({w.kind}, {w.module}) covers no point of this run")
     print(f"\nmerged: {OUT / 'merged.dat'}; uncovered points: {OUT / 'uncovered.txt'} "
           f"(waivers: {WAIVERS.name}, {len(waivers)})")

@@ -148,9 +148,9 @@ class TB(AxisTB):
         return frames
 
     async def run_frames(self, frames: list[np.ndarray]) -> list[np.ndarray]:
-        """Send the frames and receive as many, within a generous budget (200 clocks per
-        word, 40x the slowest stall pattern here): a stream that stops fails at once
-        instead of hanging the test."""
+        """Send the frames and receive as many, within a generous budget (10,000 clocks +
+        200 per word, far above what the stall patterns here cost): a stream that stops
+        fails the test instead of hanging it."""
 
         async def both() -> list[np.ndarray]:
             rx = cocotb.start_soon(self.recv_frames(len(frames)))
