@@ -150,7 +150,7 @@ view: $(STAMP) $(VIEW_CAPTURE)
 	$(RUN) radar view --replay $(VIEW_CAPTURE) --gnn --ego-speed 27.78
 
 # the same scene as the on-chip detector's record stream (OUTPUT_MODE = 1)
-VIEW_RECORDS ?= $(OUT)/table1_paper-fpga_records.dmacap
+VIEW_RECORDS ?= $(OUT)/table1_paper-fpga_records2.dmacap
 
 $(VIEW_RECORDS): | $(STAMP)
 	mkdir -p $(dir $@)

@@ -19,7 +19,7 @@ module cfar_2d_props (
   input wire logic       m_axis_tready
 );
   localparam int NR = 4, ND = 4, PD = 1;
-  localparam int POW_W = 8, CNT_W = 4, SUM_W = 12, OUT_W = 32;
+  localparam int POW_W = 8, CNT_W = 4, SUM_W = 12, OUT_W = 64;
   (* anyconst *) logic [3*4-1:0] cfg_scale;
 
   logic             s_axis_tready, m_axis_tvalid, m_axis_tlast, framing;

@@ -21,7 +21,7 @@ module detect_chain_props (
   input wire logic        s_axis_tlast,
   input wire logic        m_axis_tready
 );
-  localparam int FW = 9;   // MAX_DETECTIONS * (HDR 4 + TX 1) + HDR 4
+  localparam int FW = 17;  // MAX_DETECTIONS * (HDR 8 + TX 1) + HDR 8
   (* anyconst *) logic [11:0] cfg_scale;
   logic        s_axis_tready, m_axis_tvalid, m_axis_tlast, framing, trunc;
   logic [63:0] m_axis_tdata;
@@ -46,7 +46,7 @@ module detect_chain_props (
     .payload({m_axis_tlast, m_axis_tdata}), .beats(n_out));
 
   logic       past = 1'b0;
-  logic [3:0] pos_q;
+  logic [4:0] pos_q;
   logic [7:0] n_frames;
   logic       f_err;
   always_ff @(posedge clk) begin
@@ -57,14 +57,14 @@ module detect_chain_props (
       f_err    <= 1'b0;
     end else begin
       if (m_axis_tvalid && m_axis_tready) begin
-        pos_q <= (pos_q == 4'(FW - 1)) ? '0 : pos_q + 4'd1;
+        pos_q <= (pos_q == 5'(FW - 1)) ? '0 : pos_q + 5'd1;
         if (m_axis_tlast) n_frames <= n_frames + 8'd1;
       end
       if (s_axis_tvalid && s_axis_tready && s_axis_tlast != (n_in[1:0] == 2'd3)) f_err <= 1'b1;
     end
   end
   always_comb if (past && !rst) begin
-    if (m_axis_tvalid) assert (m_axis_tlast == (pos_q == 4'(FW - 1)));
+    if (m_axis_tvalid) assert (m_axis_tlast == (pos_q == 5'(FW - 1)));
     // frame_count: frames whose last word was issued into the 4-word output FIFO, so at
     // most one closed frame has not yet left m_axis
     assert (n_frames <= frame_count[7:0] && frame_count[7:0] <= n_frames + 8'd1);

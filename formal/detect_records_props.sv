@@ -15,11 +15,11 @@ module detect_records_props (
   input wire logic         rst,
   input wire logic         snap_wr,
   input wire logic [127:0] snap_data,
-  input wire logic [31:0]  s_axis_tdata,
+  input wire logic [63:0]  s_axis_tdata,
   input wire logic         s_axis_tvalid,
   input wire logic         m_axis_tready
 );
-  localparam int FW = 5;   // FRAME_WORDS = MAX_DETECTIONS * (HDR 2 + TX 1) + HDR 2
+  localparam int FW = 9;   // FRAME_WORDS = MAX_DETECTIONS * (HDR 4 + TX 1) + HDR 4
   logic         snap_room, s_axis_tready, m_axis_tvalid, m_axis_tlast, trunc;
   logic [127:0] m_axis_tdata;
   logic [31:0]  frame_count;
@@ -34,7 +34,7 @@ module detect_records_props (
   initial assume (rst);
 
   logic [7:0] n_in, n_out;
-  f_axis_port #(.PAYLOAD_W(36), .ASSUME(1'b1)) u_s (
+  f_axis_port #(.PAYLOAD_W(68), .ASSUME(1'b1)) u_s (
     .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
     .payload({s_axis_tuser, s_axis_tdata}), .beats(n_in));
   f_axis_port #(.PAYLOAD_W(129)) u_m (
@@ -46,7 +46,7 @@ module detect_records_props (
   always_comb if (!rst && snap_wr) assume (snap_room);
 
   logic       past = 1'b0;
-  logic [2:0] pos_q;       // word within the record frame
+  logic [3:0] pos_q;       // word within the record frame
   logic [7:0] n_frames;
   always_ff @(posedge clk) begin
     past <= 1'b1;
@@ -54,12 +54,12 @@ module detect_records_props (
       pos_q    <= '0;
       n_frames <= '0;
     end else if (m_axis_tvalid && m_axis_tready) begin
-      pos_q <= (pos_q == 3'(FW - 1)) ? '0 : pos_q + 3'd1;
+      pos_q <= (pos_q == 4'(FW - 1)) ? '0 : pos_q + 4'd1;
       if (m_axis_tlast) n_frames <= n_frames + 8'd1;
     end
   end
   always_comb if (past && !rst) begin
-    if (m_axis_tvalid) assert (m_axis_tlast == (pos_q == 3'(FW - 1)));
+    if (m_axis_tvalid) assert (m_axis_tlast == (pos_q == 4'(FW - 1)));
     // frame_count: frames whose last word was issued into the 4-word output FIFO, so at
     // most one closed frame has not yet left m_axis
     assert (n_frames <= frame_count[7:0] && frame_count[7:0] <= n_frames + 8'd1);

@@ -5,6 +5,8 @@ cost on the link and on the host. Prints four tables:
 1. detection: true targets found through ``--detect fpga`` and ``--detect host`` on the
    Table I scene (``full``) and on random point-target scenes (both presets), and their
    agreement (targets the host path finds that the FPGA path finds too; goal >= 99 %);
+   then Table I over ``--table1-seeds`` noise seeds: per vehicle, how often each path finds
+   it and its mean |range|, |azimuth|, |velocity| errors (goal: fpga no worse than host);
 2. false alarms on noise-only frames (thermal noise through the fixed-point chain) against
    the configured Pfa: CFAR detections per reportable cell (records) and points per cell
    for both paths (goal: within 2x);
@@ -146,6 +148,34 @@ def detection_rows(scenes: list[Scene]) -> dict[str, float]:
             "agree": 100.0 * both / max(host_found, 1), "fpga_only": fpga_only,
             "rerr_host": float(np.mean(err_host)) if err_host else float("nan"),
             "rerr_fpga": float(np.mean(err_fpga)) if err_fpga else float("nan")}
+
+
+def table1_seed_rows(seeds: int) -> tuple[list[tuple[int, str, int, float, float, float]],
+                                          int]:
+    """Table I (``full``) over ``seeds`` noise realisations through both paths: rows
+    (vehicle, path, frames found, mean |range err| m, mean |azimuth err| deg, mean
+    |velocity err| m/s) and the number of seeds whose two clouds are the same."""
+    acc: dict[tuple[int, str], list[tuple[float, float, float]]] = {}
+    same = 0
+    for seed in range(seeds):
+        sc = table1_scene("full", seed=seed)
+        cfg = sc.config
+        params = DetectionParams()
+        host, fpga, _ = _both_paths(simulate_scene(sc).samples, cfg, params,  # type: ignore[misc]
+                                    fpga_detect_config(cfg, params.cfar))
+        same += _same_cloud(host, fpga)
+        for path, cloud in (("host", host), ("fpga", fpga)):
+            for i, m in enumerate(match_targets(cloud, sc.targets, cfg)[0]):
+                if m.index >= 0:
+                    acc.setdefault((i, path), []).append(
+                        (abs(m.range_err_m), abs(m.azimuth_err_deg), abs(m.velocity_err_mps)))
+    rows = []
+    for i in range(len(table1_scene("full").targets)):
+        for path in ("host", "fpga"):
+            e = np.array(acc.get((i, path), []), dtype=float).reshape(-1, 3)
+            mean = e.mean(axis=0) if len(e) else np.full(3, np.nan)
+            rows.append((i, path, len(e), *map(float, mean)))
+    return rows, same
 
 
 def false_alarm_rows(preset: str, frames: int, pfas: tuple[float, ...]
@@ -293,6 +323,8 @@ def main() -> None:
     ap.add_argument("--full-scenes", type=int, default=20,
                     help="random full scenes (about 6 s each on this machine)")
     ap.add_argument("--noise-frames", type=int, default=40, help="noise-only paper-fpga frames")
+    ap.add_argument("--table1-seeds", type=int, default=30,
+                    help="noise seeds of the Table I error table (about 2 s each)")
     ap.add_argument("--repeat", type=int, default=5, help="timing runs; best is reported")
     ap.add_argument("--host-only", action="store_true",
                     help="only table 4 (host time per frame), a minute instead of ~15")
@@ -327,6 +359,19 @@ def other_tables(args: argparse.Namespace) -> None:
               f"{r['fpga_only']} | {r['rerr_host']:.2f} / {r['rerr_fpga']:.2f} | "
               f"{r['az_host']:.3f} / {r['az_fpga']:.3f} | {r['az_host_ref']:.3f} / "
               f"{r['az_fpga_ref']:.3f} | {r['same_clouds']} of {r['scenes']} |")
+
+    t1 = table1_scene("full")
+    rows, same = table1_seed_rows(args.table1_seeds)
+    print(f"\n## Table I, full, {args.table1_seeds} noise seeds: errors of the point nearest "
+          f"each vehicle ({same} of {args.table1_seeds} seeds give the same cloud on both "
+          f"paths)")
+    print("| vehicle (range, az, v) | path | found | mean abs range err (m) | "
+          "mean abs az err (deg) | mean abs v err (m/s) |")
+    print("|---|---|---|---|---|---|")
+    for i, path, found, dr, daz, dv in rows:
+        t = t1.targets[i]
+        print(f"| {t.range_m:g} m, {t.azimuth_deg:+g} deg, {t.radial_velocity_mps:+.1f} m/s | "
+              f"{path} | {found}/{args.table1_seeds} | {dr:.4f} | {daz:.4f} | {dv:.4f} |")
 
     print(f"\n## False alarms, {args.noise_frames} noise-only paper-fpga frames (fixed-point "
           f"chain; per reportable cell)")

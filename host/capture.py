@@ -9,8 +9,9 @@ File layout (little-endian)::
     then per packet: u32 length in bytes, the packet's bytes (header word + payload)
 
 A capture of the detection-record stream (``OUTPUT_MODE = 1``, ``host.records``) starts with
-b"RDMAREC1" instead and has one more u32 after n_doppler: MAX_DETECTIONS (which fixes the
-record frame's length); the packets follow as above.
+b"RDMAREC2" instead and has one more u32 after n_doppler: MAX_DETECTIONS (which fixes the
+record frame's length); the packets follow as above. (b"RDMAREC1" captures hold the record
+format before the neighbour powers, 8 header lanes instead of 16: refused with a message.)
 
 ``radar replay`` sends a capture over UDP one packet per datagram; ``radar receive`` decodes
 datagrams with :class:`host.stream.StreamDecoder`.
@@ -30,7 +31,9 @@ from model.config import RadarConfig
 from model.reference import cube_to_dma_order
 
 MAGIC = b"RDMACAP1"
-MAGIC_RECORDS = b"RDMAREC1"
+MAGIC_RECORDS = b"RDMAREC2"
+MAGIC_RECORDS_V1 = b"RDMAREC1"
+"""Record captures of the 8-lane header format (no neighbour powers), no longer read."""
 _HEAD = struct.Struct("<8s5I")
 _MAX_DET = struct.Struct("<I")
 
@@ -97,6 +100,11 @@ def read_capture(path: Path) -> tuple[CaptureInfo, Iterator[bytes]]:
     raising ValueError."""
     f = open(path, "rb")  # noqa: SIM115 - closed by the generator
     head = f.read(_HEAD.size)
+    if head[:8] == MAGIC_RECORDS_V1:
+        f.close()
+        raise ValueError(f"{path}: record capture of the old format ({MAGIC_RECORDS_V1!r}: "
+                         f"8-lane record headers without the neighbour powers); capture it "
+                         f"again")
     if len(head) < _HEAD.size or head[:8] not in (MAGIC, MAGIC_RECORDS):
         f.close()
         raise ValueError(f"{path}: not a DMA capture (missing {MAGIC!r} or {MAGIC_RECORDS!r} "

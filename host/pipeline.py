@@ -243,18 +243,27 @@ def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.n
         return 10 * np.log10(np.maximum(sigma, 1e-30))
 
 
-def peak_offsets(logp: np.ndarray, cells: np.ndarray) -> np.ndarray:
+def neighbour_offsets(logc: np.ndarray, lognb: np.ndarray, inner: np.ndarray) -> np.ndarray:
     """Fractional (range, Doppler) offsets of peaks from their cell centres, float (n, 2)
-    in (-0.5, 0.5), by Gaussian interpolation over the 3 log-power samples along each axis
-    (Doppler circular; 0 at the range ends). logp: float (n_range, n_doppler) log power;
-    cells: int (n, 2) of (range_bin, doppler_bin)."""
+    in (-0.5, 0.5), by Gaussian interpolation over the 3 log-power samples along each axis;
+    the range offset is 0 where ``inner`` is False (a range end). logc: float (n,) the
+    cells' log powers; lognb: float (n, 4) their neighbours' at range - 1, range + 1,
+    Doppler - 1, Doppler + 1 (``model.cfar_2d.NEIGHBOURS``); inner: bool (n,)."""
+    dr = np.where(inner, gaussian_offset(lognb[:, 0], logc, lognb[:, 1]), 0.0)
+    dd = gaussian_offset(lognb[:, 2], logc, lognb[:, 3])
+    return np.stack([dr, dd], axis=1).reshape(len(logc), 2)
+
+
+def peak_offsets(logp: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """:func:`neighbour_offsets` of cells on a map (Doppler circular; 0 at the range ends).
+    logp: float (n_range, n_doppler) log power; cells: int (n, 2) of (range_bin,
+    doppler_bin). Returns float (n, 2) bins."""
     nr, nd = logp.shape
     r, d = cells[:, 0], cells[:, 1]
-    inner = (r > 0) & (r < nr - 1)
     rm, rp = np.clip(r - 1, 0, nr - 1), np.clip(r + 1, 0, nr - 1)
-    dr = np.where(inner, gaussian_offset(logp[rm, d], logp[r, d], logp[rp, d]), 0.0)
-    dd = gaussian_offset(logp[r, (d - 1) % nd], logp[r, d], logp[r, (d + 1) % nd])
-    return np.stack([dr, dd], axis=1).reshape(len(cells), 2)
+    lognb = np.stack([logp[rm, d], logp[rp, d], logp[r, (d - 1) % nd],
+                      logp[r, (d + 1) % nd]], axis=1).reshape(len(cells), 4)
+    return neighbour_offsets(logp[r, d], lognb, (r > 0) & (r < nr - 1))
 
 
 def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,

@@ -13,10 +13,10 @@ own CFAR (``host.pipeline`` module docstring), on the records alone:
 3. sidelobe masking against stronger *detected* cells in the same row and column
    (``host.cfar.sidelobe_masked``; a cell strong enough to throw sidelobes above the
    threshold is always detected itself);
-4. peak offsets: Gaussian interpolation over the 3 log powers as on the cube when both
-   neighbours along an axis were detected; with one detected neighbour the window's
-   two-bin amplitude ratio (Hann: delta = (2a - 1) / (a + 1), rectangular:
-   a / (1 + a), a = |X_neighbour| / |X_peak|); with none, 0 (the cell centre);
+4. peak offsets: Gaussian interpolation over the 3 log powers along each axis, from the
+   four neighbour powers every record carries (``host.pipeline.neighbour_offsets``, the
+   cube path's interpolation on the same values: detected or not, the neighbours' powers
+   come from the FPGA's map);
 5. TDM compensation, velocity unfolding, angle estimation and the point cloud: the same
    points as :func:`host.pipeline.points_from_cells` (the cube path's code), computed by
    :func:`points_from_snapshots` with less work: the TDM test runs only the alias classes
@@ -41,7 +41,7 @@ from host.pipeline import (
     _cloud,
     _tdm_compensate,
     choose_folds,
-    gaussian_offset,
+    neighbour_offsets,
     points_from_cells,
 )
 from host.pointcloud import PointCloud
@@ -50,44 +50,16 @@ from model.config import RadarConfig
 from model.reference import signed_bins
 
 
-def _two_bin_offset(ratio: np.ndarray, windowed: bool) -> np.ndarray:
-    """Offset (bins, towards the neighbour) of a tone from its peak bin, float (n,), from the
-    amplitude ratio neighbour / peak (float (n,) in [0, 1])."""
-    a = np.clip(ratio, 0.0, 1.0)
-    d = (2 * a - 1) / (a + 1) if windowed else a / (1 + a)
-    return np.clip(d, 0.0, 0.5)
-
-
-def record_offsets(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool]
-                   ) -> np.ndarray:
-    """Fractional (range, Doppler) peak offsets, float (n, 2), from the detected powers
-    around each cell (step 4 of the module docstring). pmap: float (n_range, n_doppler),
-    detected cells' NCI power, 0 elsewhere; cells: int (n, 2) (range_bin, doppler_bin)."""
-    nr, nd = pmap.shape
-    out = np.zeros((len(cells), 2))
-    if not len(cells):
-        return out
-    r, d = cells[:, 0], cells[:, 1]
-    c = pmap[r, d]
-    ok_r = (r > 0) & (r < nr - 1)
-    neighbours = (
-        (np.where(ok_r, pmap[np.clip(r - 1, 0, nr - 1), d], 0.0),
-         np.where(ok_r, pmap[np.clip(r + 1, 0, nr - 1), d], 0.0)),
-        (pmap[r, (d - 1) % nd], pmap[r, (d + 1) % nd]),
-    )
-    for axis, (lm, lp) in enumerate(neighbours):
-        both = (lm > 0) & (lp > 0)
-        if both.any():
-            out[both, axis] = gaussian_offset(np.log(lm[both]), np.log(c[both]),
-                                              np.log(lp[both]))
-        only_p = (lp > 0) & ~both
-        only_m = (lm > 0) & ~both
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out[only_p, axis] = _two_bin_offset(np.sqrt(lp[only_p] / c[only_p]),
-                                                windowed[axis])
-            out[only_m, axis] = -_two_bin_offset(np.sqrt(lm[only_m] / c[only_m]),
-                                                 windowed[axis])
-    return out
+def record_offsets(power: np.ndarray, neighbours: np.ndarray, range_bin: np.ndarray,
+                   n_range: int) -> np.ndarray:
+    """Fractional (range, Doppler) peak offsets, float (n, 2) bins, of records (step 4 of
+    the module docstring): power float (n,), neighbours float (n, 4)
+    (``host.records.RecordArrays``), range_bin int (n,); the cube path's interpolation
+    (``host.pipeline.peak_offsets``) on the same powers."""
+    logc = np.log(np.maximum(power, 1e-30))
+    lognb = np.log(np.maximum(neighbours, 1e-30))
+    r = np.asarray(range_bin)
+    return neighbour_offsets(logc, lognb, (r > 0) & (r < n_range - 1))
 
 
 def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
@@ -250,6 +222,14 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
                   ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
 
 
+def _neighbours(arr: RecordArrays) -> np.ndarray:
+    """The records' neighbour powers, float (n, 4); ValueError when they are not known."""
+    if arr.neighbours is None:
+        raise ValueError("records without neighbour powers: the peak offsets need them "
+                         "(host.records.record_arrays gives them)")
+    return arr.neighbours
+
+
 def _check_channels(arr: RecordArrays, cfg: RadarConfig) -> None:
     if arr.snapshot.shape[1:] != (cfg.n_virtual,):
         raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
@@ -267,9 +247,9 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     _check_channels(arr, cfg)
     if reference:
         return process_records_reference(arr, cfg, params, frame)
-    idx, pmap = select_records(arr, cfg, params)
+    idx, _ = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-    offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
     return points_from_snapshots(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                                  offsets, cfg, params, frame)
 
@@ -283,8 +263,8 @@ def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
     ``select_records_reference`` and ``host.pipeline.points_from_cells_reference``."""
     params = params or DetectionParams()
     _check_channels(arr, cfg)
-    idx, pmap = select_records(arr, cfg, params)
+    idx, _ = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-    offsets = record_offsets(pmap, cells, (params.range_window, params.doppler_window))
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
     return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                              offsets, cfg, params, frame)

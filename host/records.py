@@ -35,6 +35,7 @@ from model.detect_records import (
     Trailer,
     decode_frame,
     frame_end,
+    neighbour_powers,
     record_scan,
     record_words,
 )
@@ -64,7 +65,8 @@ class RecordFields:
     """The fields of n records as arrays (``model.detect_records.Record``'s, record k in
     row k): ``range_bin``, ``doppler_bin``, ``cells``, ``index``, ``frame_id``: int64 (n,);
     ``power``, ``noise_sum``: uint64 (n,) (the 64-bit header fields); ``snapshot``: uint32
-    (n, num_tx, num_rx) packed {Q, I}."""
+    (n, num_tx, num_rx) packed {Q, I}; ``neighbours``: uint64 (n, 4) the neighbour powers
+    (range - 1, range + 1, Doppler - 1, Doppler + 1)."""
 
     range_bin: np.ndarray
     doppler_bin: np.ndarray
@@ -74,6 +76,7 @@ class RecordFields:
     index: np.ndarray
     frame_id: np.ndarray
     snapshot: np.ndarray
+    neighbours: np.ndarray
 
     def __len__(self) -> int:
         return int(len(self.range_bin))
@@ -97,7 +100,8 @@ def empty_fields(num_tx: int, num_rx: int) -> RecordFields:
     """:class:`RecordFields` of no record."""
     z = np.zeros(0, np.int64)
     u = np.zeros(0, np.uint64)
-    return RecordFields(z, z, u, u, z, z, z, np.zeros((0, num_tx, num_rx), np.uint32))
+    return RecordFields(z, z, u, u, z, z, z, np.zeros((0, num_tx, num_rx), np.uint32),
+                        np.zeros((0, 4), np.uint64))
 
 
 class RecordList(Sequence[Record]):
@@ -124,7 +128,8 @@ class RecordList(Sequence[Record]):
         return Record(range_bin=int(f.range_bin[i]), doppler_bin=int(f.doppler_bin[i]),
                       power=int(f.power[i]), noise_sum=int(f.noise_sum[i]),
                       cells=int(f.cells[i]), snapshot=f.snapshot[i], index=int(f.index[i]),
-                      frame_id=int(f.frame_id[i]))
+                      frame_id=int(f.frame_id[i]),
+                      neighbours=tuple(int(v) for v in f.neighbours[i]))  # type: ignore[arg-type]
 
     def __iter__(self) -> Iterator[Record]:
         return (self[i] for i in range(len(self)))
@@ -155,7 +160,7 @@ def decode_record_fields(words: np.ndarray, num_tx: int
             power=u[:, 2] | (u[:, 3] << np.uint64(32)),
             noise_sum=u[:, 4] | (u[:, 5] << np.uint64(32)),
             cells=lane[:, 1] & 0xFFFF, index=lane[:, 1] >> 16, frame_id=lane[:, 6],
-            snapshot=block[:, hw:])
+            snapshot=block[:, hw:], neighbours=neighbour_powers(lane))
     else:
         fields = empty_fields(num_tx, num_rx)
     tr, errors = frame_end(w, pos, n, hw)
@@ -253,7 +258,9 @@ class RecordArrays:
     ``range_bin``, ``doppler_bin``: int (n,) (natural Doppler order); ``power``: float64 (n,)
     non-coherent power sum_v |x_v|^2; ``noise``: float64 (n,) the CFAR's mean training-cell
     power (same units); ``snapshot``: complex64 (n, num_tx * num_rx), virtual channel
-    v = tx * num_rx + rx (the cube's channel order).
+    v = tx * num_rx + rx (the cube's channel order); ``neighbours``: float64 (n, 4) the
+    non-coherent powers of the cells at range - 1, range + 1, Doppler - 1, Doppler + 1 (0
+    beyond the range ends; None: not known, e.g. records built by hand).
     """
 
     range_bin: np.ndarray
@@ -261,6 +268,7 @@ class RecordArrays:
     power: np.ndarray
     noise: np.ndarray
     snapshot: np.ndarray
+    neighbours: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(len(self.range_bin))
@@ -286,7 +294,8 @@ def fields_arrays(fields: RecordFields, n_virtual: int, gain: float = 1.0) -> Re
     g2 = gain * gain
     return RecordArrays(fields.range_bin, fields.doppler_bin,
                         fields.power.astype(np.float64) / g2, fields.noise() / g2,
-                        (snap / gain).astype(np.complex64))
+                        (snap / gain).astype(np.complex64),
+                        fields.neighbours.astype(np.float64) / g2)
 
 
 def record_arrays_reference(records: Sequence[Record], n_virtual: int, gain: float = 1.0
@@ -298,9 +307,11 @@ def record_arrays_reference(records: Sequence[Record], n_virtual: int, gain: flo
     db = np.fromiter((r.doppler_bin for r in records), dtype=np.int64, count=n)
     power = np.fromiter((r.power for r in records), dtype=np.float64, count=n)
     noise = np.fromiter((r.noise for r in records), dtype=np.float64, count=n)
+    nb = np.array([r.neighbours for r in records], dtype=np.float64).reshape(n, 4)
     if n:
         snap = unpack_iq(np.stack([r.snapshot for r in records])).reshape(n, n_virtual)
     else:
         snap = np.zeros((0, n_virtual), np.complex64)
     g2 = gain * gain
-    return RecordArrays(rb, db, power / g2, noise / g2, (snap / gain).astype(np.complex64))
+    return RecordArrays(rb, db, power / g2, noise / g2, (snap / gain).astype(np.complex64),
+                        nb / g2)

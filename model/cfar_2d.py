@@ -21,8 +21,12 @@ Doppler halves (column offsets < 0 and > 0; the CUT's own column is in neither h
 Decision (exact integers): ``power * 2^scale_frac > S * scale[e]``, S the kind's training sum.
 
 Output word of the RTL (one per cell, LSB first): power ``pow_w`` bits, training sum S
-``sum_w`` bits, training cell count ``cnt_w`` bits, detect 1 bit; tuser ``{r, d}``; order per
-row: d = PD..n_doppler-1, 0..PD-1 (:func:`output_order`).
+``sum_w`` bits, training cell count ``cnt_w`` bits, detect 1 bit, then the powers of the
+cell's four neighbours, ``pow_w`` bits each, in the order of :data:`NEIGHBOURS` (range - 1,
+range + 1, Doppler - 1, Doppler + 1; Doppler circular, 0 outside the map in range): what the
+host's Gaussian peak interpolation needs, so the records give the cube path's range and
+Doppler offsets; tuser ``{r, d}``; order per row: d = PD..n_doppler-1, 0..PD-1
+(:func:`output_order`).
 """
 
 from __future__ import annotations
@@ -34,6 +38,8 @@ import numpy as np
 from model.cfar_stats import ca_factor, effective_cells_mask, go_so_factor
 
 KINDS = ("ca", "go", "so")
+NEIGHBOURS = ((-1, 0), (1, 0), (0, -1), (0, 1))
+"""(range, Doppler) offsets of the four neighbour powers of an output cell, in field order."""
 
 
 @dataclass(frozen=True)
@@ -107,7 +113,8 @@ class Cfar2dConfig:
 
     @property
     def out_bytes(self) -> int:
-        return (self.pow_w + self.sum_w + self.cnt_w + 1 + 7) // 8
+        return (self.pow_w + self.sum_w + self.cnt_w + 1 + len(NEIGHBOURS) * self.pow_w
+                + 7) // 8
 
     def hdl_parameters(self) -> dict[str, int]:
         """HDL parameters of ``cfar_2d`` for this configuration."""
@@ -123,12 +130,14 @@ class Cfar2dConfig:
 @dataclass
 class CfarCells:
     """Per-cell results, each ``(n_range, n_doppler)``: ``power`` and ``train_sum`` int64,
-    ``count`` int64 training cells in the sum, ``detect`` bool."""
+    ``count`` int64 training cells in the sum, ``detect`` bool; ``neighbours`` int64
+    ``(n_range, n_doppler, 4)``: the powers of each cell's neighbours (:func:`neighbours`)."""
 
     power: np.ndarray
     train_sum: np.ndarray
     count: np.ndarray
     detect: np.ndarray
+    neighbours: np.ndarray
 
     def noise(self) -> np.ndarray:
         """Mean training power per cell, float64 ``(n_range, n_doppler)``."""
@@ -203,6 +212,20 @@ def pack_scale(scale: np.ndarray, cfg: Cfar2dConfig) -> int:
     return sum(int(v) << (e * cfg.scale_w) for e, v in enumerate(scale))
 
 
+def neighbours(power: np.ndarray) -> np.ndarray:
+    """Powers of the four neighbours (:data:`NEIGHBOURS`) of every cell of a map (int64
+    ``(n_range, n_doppler)``; any dtype), ``(n_range, n_doppler, 4)`` of its dtype:
+    Doppler circular; 0 beyond the first and last range rows (blanked rows are real map
+    rows here: their power is sent, as the host's map has it)."""
+    p = np.asarray(power)
+    out = np.zeros((*p.shape, len(NEIGHBOURS)), dtype=p.dtype)
+    out[1:, :, 0] = p[:-1]
+    out[:-1, :, 1] = p[1:]
+    out[:, :, 2] = np.roll(p, 1, axis=1)
+    out[:, :, 3] = np.roll(p, -1, axis=1)
+    return out
+
+
 def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCells:
     """Run the CFAR on one map. power: int ``(n_range, n_doppler)``; scale: int
     ``(2PR+1,)`` from :func:`scale_table`."""
@@ -238,7 +261,7 @@ def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCell
         if q < cfg.rows and lo <= q < hi:
             sc = int(scale[edge_index(q, cfg)])
             detect[q] = [int(c) * frac > int(t) * sc for c, t in zip(p[q], s, strict=True)]
-    return CfarCells(p, train_sum, count, detect)
+    return CfarCells(p, train_sum, count, detect, neighbours(p))
 
 
 def output_order(cfg: Cfar2dConfig) -> np.ndarray:
@@ -248,8 +271,23 @@ def output_order(cfg: Cfar2dConfig) -> np.ndarray:
     return np.stack([r, np.tile(d, cfg.n_range)], axis=1)
 
 
-def unpack_cell(value: int, cfg: Cfar2dConfig) -> tuple[int, int, int, bool]:
-    """RTL output word -> (power, train_sum, count, detect)."""
+def pack_cell(cells: CfarCells, r: int, d: int, cfg: Cfar2dConfig) -> int:
+    """The RTL's output word of cell (r, d) (module docstring), as an integer."""
     pw, sw, cw = cfg.pow_w, cfg.sum_w, cfg.cnt_w
-    return (value & ((1 << pw) - 1), (value >> pw) & ((1 << sw) - 1),
-            (value >> (pw + sw)) & ((1 << cw) - 1), bool((value >> (pw + sw + cw)) & 1))
+    v = (int(cells.power[r, d]) | (int(cells.train_sum[r, d]) << pw)
+         | (int(cells.count[r, d]) << (pw + sw)) | (int(cells.detect[r, d]) << (pw + sw + cw)))
+    base = pw + sw + cw + 1
+    for k, nb in enumerate(cells.neighbours[r, d]):
+        v |= int(nb) << (base + k * pw)
+    return v
+
+
+def unpack_cell(value: int, cfg: Cfar2dConfig
+                ) -> tuple[int, int, int, bool, tuple[int, ...]]:
+    """RTL output word -> (power, train_sum, count, detect, neighbour powers (4,))."""
+    pw, sw, cw = cfg.pow_w, cfg.sum_w, cfg.cnt_w
+    base = pw + sw + cw + 1
+    mask = (1 << pw) - 1
+    return (value & mask, (value >> pw) & ((1 << sw) - 1),
+            (value >> (pw + sw)) & ((1 << cw) - 1), bool((value >> (pw + sw + cw)) & 1),
+            tuple((value >> (base + k * pw)) & mask for k in range(len(NEIGHBOURS))))

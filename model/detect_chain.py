@@ -92,10 +92,7 @@ def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
     recs = []
     for r, d in cfar_2d.output_order(cfg.cfar):
         if cells.detect[r, d]:
-            recs.append(detect_records.Record(
-                range_bin=int(r), doppler_bin=int(d), power=int(cells.power[r, d]),
-                noise_sum=int(cells.train_sum[r, d]), cells=int(cells.count[r, d]),
-                snapshot=snap[r, :, d, :].copy()))
+            recs.append(detect_records.Record.of_cell(cells, r, d, snap[r, :, d, :].copy()))
     return recs, cells
 
 

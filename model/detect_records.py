@@ -8,8 +8,9 @@ bits), as in ``model/axis_packetizer.py``. One frame of the record stream is exa
 
     record 0 .. record n-1, trailer, zero words up to the fixed frame length
 
-A header (record header or trailer) is a vector of 8 lanes sent as ``hdr_words(num_rx) =
-ceil(8 / num_rx)`` words (lanes past 8 are zero). Record header lanes::
+A header (record header or trailer) is a vector of 16 lanes sent as ``hdr_words(num_rx) =
+ceil(16 / num_rx)`` words (lanes past 16 are zero; one word at ``num_rx`` = 16). Record
+header lanes::
 
     0: [31:24] TAG_RECORD 0xD1, [23:12] range bin, [11:0] Doppler bin (natural order)
     1: [31:16] record index within the frame, [15:0] training cells in the noise sum
@@ -17,6 +18,10 @@ ceil(8 / num_rx)`` words (lanes past 8 are zero). Record header lanes::
     4, 5: noise sum S (the CFAR's training sum), 64 bits; noise estimate = S / cells
     6: frame id (frames since reset)
     7: 0
+    8..15: the integrated powers of the cell's four neighbours, 64 bits each, low lane first,
+       in the order range - 1, range + 1, Doppler - 1, Doppler + 1 (``model.cfar_2d.
+       NEIGHBOURS``; Doppler circular, 0 beyond the first and last range rows): the host
+       interpolates the peak position from them as from the cube's map
 
 followed by ``num_tx`` words: the Doppler-FFT values of the cell for TX 0..num_tx-1, lanes
 = RX 0..num_rx-1, ``{Q[31:16], I[15:0]}`` (the snapshot). Trailer lanes::
@@ -24,7 +29,7 @@ followed by ``num_tx`` words: the Doppler-FFT values of the cell for TX 0..num_t
     0: [31:24] TAG_TRAILER 0xDE, [1] sticky truncated (any frame since reset), [0] truncated
        (this frame had more than max_detections detections)
     1: records in this frame; 2: detections found in this frame (saturates at 2^17-1)
-    3: frame id; 4: max_detections; 5..7: 0
+    3: frame id; 4: max_detections; 5..15: 0
 
 Records are in CFAR output order (``model.cfar_2d.output_order``): range row by row, within a
 row Doppler bins PD..n_doppler-1, 0..PD-1.
@@ -37,9 +42,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from model.cfar_2d import CfarCells
+
 TAG_RECORD = 0xD1
 TAG_TRAILER = 0xDE
-HDR_LANES = 8
+HDR_LANES = 16
+NEIGHBOUR_LANE = 8
+"""First header lane of the four 64-bit neighbour powers."""
 MAX_COUNT = (1 << 17) - 1
 
 
@@ -66,7 +75,9 @@ def snap_rows(guard_r: int, train_r: int) -> int:
 
 @dataclass(frozen=True)
 class Record:
-    """One detection. ``snapshot``: uint32 ``(num_tx, num_rx)`` packed {Q, I} lanes."""
+    """One detection. ``snapshot``: uint32 ``(num_tx, num_rx)`` packed {Q, I} lanes;
+    ``neighbours``: the integrated powers of the cells at range - 1, range + 1, Doppler - 1,
+    Doppler + 1 (``model.cfar_2d.NEIGHBOURS``)."""
 
     range_bin: int
     doppler_bin: int
@@ -76,6 +87,16 @@ class Record:
     snapshot: np.ndarray
     index: int = 0
     frame_id: int = 0
+    neighbours: tuple[int, int, int, int] = (0, 0, 0, 0)
+
+    @classmethod
+    def of_cell(cls, cells: CfarCells, r: int, d: int, snapshot: np.ndarray) -> Record:
+        """The record the RTL sends for CFAR output cell (r, d) with its snapshot (uint32
+        ``(num_tx, num_rx)``)."""
+        return cls(range_bin=int(r), doppler_bin=int(d), power=int(cells.power[r, d]),
+                   noise_sum=int(cells.train_sum[r, d]), cells=int(cells.count[r, d]),
+                   snapshot=snapshot,
+                   neighbours=tuple(int(v) for v in cells.neighbours[r, d]))  # type: ignore[arg-type]
 
     @property
     def noise(self) -> float:
@@ -132,6 +153,8 @@ def encode_frame(records: Sequence[Record], detections: int, num_tx: int, num_rx
         lanes[2], lanes[3] = _u64(rec.power)
         lanes[4], lanes[5] = _u64(rec.noise_sum)
         lanes[6] = frame_id & 0xFFFFFFFF
+        for j, nb in enumerate(rec.neighbours):
+            lanes[NEIGHBOUR_LANE + 2 * j], lanes[NEIGHBOUR_LANE + 2 * j + 1] = _u64(nb)
         words.append(_lanes_to_words(lanes, num_rx))
         words.append(np.asarray(rec.snapshot, dtype=np.uint32).reshape(num_tx, num_rx))
     lanes = np.zeros(HDR_LANES, dtype=np.uint32)
@@ -223,10 +246,20 @@ def _records_at(w: np.ndarray, pos: np.ndarray, hw: int, num_tx: int) -> list[Re
     cells = (hdr[:, 1] & 0xFFFF).tolist()
     index = (hdr[:, 1] >> 16).tolist()
     fid = hdr[:, 6].tolist()
+    nb = neighbour_powers(hdr).tolist()
     return [Record(range_bin=a, doppler_bin=b, power=c, noise_sum=d, cells=e,
-                   snapshot=snaps[i].reshape(num_tx, num_rx), index=f, frame_id=g)
-            for i, (a, b, c, d, e, f, g) in enumerate(zip(rb, db, power, noise, cells, index,
-                                                          fid, strict=True))]
+                   snapshot=snaps[i].reshape(num_tx, num_rx), index=f, frame_id=g,
+                   neighbours=tuple(h))
+            for i, (a, b, c, d, e, f, g, h) in enumerate(zip(rb, db, power, noise, cells, index,
+                                                             fid, nb, strict=True))]
+
+
+def neighbour_powers(hdr: np.ndarray) -> np.ndarray:
+    """The four neighbour powers of record headers, uint64 ``(n, 4)``, from their lanes
+    (int64 ``(n, >= HDR_LANES)``)."""
+    lo = hdr[:, NEIGHBOUR_LANE:NEIGHBOUR_LANE + 8:2]
+    hi = hdr[:, NEIGHBOUR_LANE + 1:NEIGHBOUR_LANE + 8:2]
+    return (lo.astype(np.uint64) | (hi.astype(np.uint64) << np.uint64(32)))
 
 
 def decode_frame_reference(words: np.ndarray, num_tx: int) -> RecordFrame:
@@ -262,7 +295,10 @@ def decode_frame_reference(words: np.ndarray, num_tx: int) -> RecordFrame:
             power=int(lanes[2]) | (int(lanes[3]) << 32),
             noise_sum=int(lanes[4]) | (int(lanes[5]) << 32), cells=int(lanes[1]) & 0xFFFF,
             snapshot=w[pos + hw:pos + hw + num_tx].copy(), index=int(lanes[1]) >> 16,
-            frame_id=int(lanes[6])))
+            frame_id=int(lanes[6]),
+            neighbours=tuple(int(lanes[NEIGHBOUR_LANE + 2 * j])  # type: ignore[arg-type]
+                             | (int(lanes[NEIGHBOUR_LANE + 2 * j + 1]) << 32)
+                             for j in range(4))))
         pos += hw + num_tx
     errors.append("no trailer")
     return RecordFrame(recs, None, errors)

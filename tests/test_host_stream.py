@@ -239,6 +239,9 @@ def test_capture_round_trip(tmp_path):
     (tmp_path / "bad.dmacap").write_bytes(b"hello")
     with pytest.raises(ValueError, match="not a DMA capture"):
         read_capture(tmp_path / "bad.dmacap")
+    (tmp_path / "old.dmacap").write_bytes(b"RDMAREC1" + bytes(24))
+    with pytest.raises(ValueError, match="old format.*neighbour powers"):
+        read_capture(tmp_path / "old.dmacap")
 
 
 @pytest.mark.parametrize("preset", ["paper-fpga", "full"])

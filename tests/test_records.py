@@ -5,9 +5,10 @@ raised), truncation flagged, and records -> point cloud equal to the cube path's
 import numpy as np
 import pytest
 
-from host.pipeline import DetectionParams, process_cube
+from host.pipeline import DetectionParams, peak_offsets, process_cube
 from host.record_points import process_records, record_offsets
 from host.records import RecordDecoder, fpga_detect_config, record_arrays
+from model import cfar_2d as cm
 from model.axis_packetizer import pack_iq, packetize_stream, words_to_bytes
 from model.config import get_preset
 from model.detect_chain import DetectConfig, detect_stream, detections
@@ -119,21 +120,22 @@ def test_wrong_max_detections_is_reported():
     assert got and not any(f.complete for f in got)
 
 
-def test_offsets_from_neighbour_records():
-    # a Hann-windowed tone 0.3 bins above bin 10: |W| at offsets 0.3, 0.7, 1.3
+def test_offsets_from_neighbour_powers():
+    """The records' neighbour powers give the cube path's interpolation
+    (``host.pipeline.peak_offsets`` on the map), detected or not; 0 in range at the ends."""
     def hann(x):
         return abs(np.sinc(x) / (1 - x * x))
-    pmap = np.zeros((32, 32))
-    pmap[10, 5], pmap[11, 5] = hann(0.3) ** 2, hann(0.7) ** 2
-    off = record_offsets(pmap, np.array([[10, 5]]), (True, True))
-    assert off[0, 0] == pytest.approx(0.3, abs=1e-6) and off[0, 1] == 0.0
-    below = np.zeros((32, 32))        # the same tone 0.3 bins below: neighbour under it
-    below[10, 5], below[9, 5] = pmap[10, 5], pmap[11, 5]
-    assert record_offsets(below, np.array([[10, 5]]), (True, True))[0, 0] == pytest.approx(
-        -0.3, abs=1e-6)
-    pmap[9, 5] = hann(1.3) ** 2     # both neighbours: the cube path's Gaussian fit
-    off = record_offsets(pmap, np.array([[10, 5]]), (True, True))
-    assert 0.2 < off[0, 0] < 0.4
+    pmap = np.full((32, 32), 1e-3)
+    # a Hann-windowed tone 0.3 bins above range bin 10, 0.2 below Doppler bin 5
+    for dr in (-1, 0, 1):
+        for dd in (-1, 0, 1):
+            pmap[10 + dr, 5 + dd] = (hann(dr - 0.3) * hann(dd + 0.2)) ** 2
+    cells = np.array([[10, 5], [0, 5], [31, 7]])
+    nb = cm.neighbours(pmap)[cells[:, 0], cells[:, 1]]
+    off = record_offsets(pmap[cells[:, 0], cells[:, 1]], nb, cells[:, 0], 32)
+    np.testing.assert_array_equal(off, peak_offsets(np.log(pmap), cells))
+    assert 0.2 < off[0, 0] < 0.4 and -0.3 < off[0, 1] < -0.1
+    assert off[1, 0] == 0.0 and off[2, 0] == 0.0
 
 
 def test_records_give_the_cube_points_paper_fpga():

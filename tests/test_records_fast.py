@@ -49,6 +49,7 @@ from host.records import (
     record_arrays,
     record_arrays_reference,
 )
+from model import cfar_2d as cm
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import get_preset
 from model.detect_records import (
@@ -327,7 +328,8 @@ def test_table1_full_cells_as_records() -> None:
     cube = radar_cube(simulate_scene(scene).samples, cfg)
     cells, noise, nci = detect_cells(cube, cfg, params)
     arr = RecordArrays(cells[:, 0], cells[:, 1], nci[cells[:, 0], cells[:, 1]], noise,
-                       cube[:, cells[:, 0], cells[:, 1]].T.astype(np.complex64))
+                       cube[:, cells[:, 0], cells[:, 1]].T.astype(np.complex64),
+                       cm.neighbours(nci)[cells[:, 0], cells[:, 1]])
     new = process_records(arr, cfg, params)
     assert len(new) >= 4
     _same_cloud(new, process_records_reference(arr, cfg, params))

@@ -3,7 +3,8 @@
 // smallest-of (SO), circular in Doppler, training window cut at the range ends with a
 // per-edge-row threshold scale, the top BLANK_TOP range bins blanked (never tested, never
 // used for training). Streams the map in (for r, for d) and sends every cell out with its
-// training sum, training cell count and the detection flag.
+// training sum, training cell count, the detection flag and the powers of its four
+// neighbours (range -1/+1, Doppler -1/+1: what the host's peak interpolation needs).
 //
 // Architecture (docs/detect.md): a column store of N_DOPPLER words, each holding the cells
 // of the last ROWS = 2*PR+2 range rows of that Doppler column. Pass p writes input row p
@@ -52,7 +53,7 @@ module cfar_2d #(
   parameter int IN_W = ((POW_W + 7) / 8) * 8,
   parameter int CNT_W = $clog2((2 * (GUARD_R + TRAIN_R) + 1) * (2 * (GUARD_D + TRAIN_D) + 1)),
   parameter int SUM_W = POW_W + CNT_W,
-  parameter int OUT_W = ((POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8
+  parameter int OUT_W = ((5 * POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8
 ) (
   input  wire logic                     clk,
   input  wire logic                     rst,
@@ -63,8 +64,9 @@ module cfar_2d #(
   input  wire logic                     s_axis_tvalid,
   output logic                          s_axis_tready,
   input  wire logic                     s_axis_tlast,
-  // Tested cells: tdata = {detect, count, sum, power} (zero-extended to OUT_W),
-  // tuser = {r, d}, TLAST on the last cell of every row
+  // Tested cells: tdata = {pow(r, d+1), pow(r, d-1), pow(r+1, d), pow(r-1, d), detect,
+  // count, sum, power} (zero-extended to OUT_W; Doppler circular, a range neighbour
+  // outside 0..N_RANGE-1 is 0), tuser = {r, d}, TLAST on the last cell of every row
   output logic      [OUT_W-1:0]         m_axis_tdata,
   output logic                          m_axis_tvalid,
   input  wire logic                     m_axis_tready,
@@ -130,7 +132,8 @@ module cfar_2d #(
   if (CW_W > 4096) begin : g_bad_column_word
     $fatal(1, "%m: (2*PR+2)*POW_W=%0d bits per column above 4096", CW_W);
   end
-  if (IN_W < POW_W || CNT_W < 1 || SUM_W != POW_W + CNT_W || OUT_W < POW_W + SUM_W + CNT_W + 1)
+  if (IN_W < POW_W || CNT_W < 1 || SUM_W != POW_W + CNT_W ||
+      OUT_W < 5 * POW_W + SUM_W + CNT_W + 1)
   begin : g_bad_derived
     $fatal(1, "%m: IN_W/CNT_W/SUM_W/OUT_W are derived, do not override");
   end
@@ -204,7 +207,7 @@ module cfar_2d #(
   end
 
   // Stage 1 registers (the step's read data arrives with them)
-  logic              v1_q, test1_q, out1_q, last1_q, cut_ok1_q;
+  logic              v1_q, test1_q, out1_q, last1_q, cut_ok1_q, rm_ok1_q, rp_ok1_q;
   logic [NE-1:0]     rowv1_q;
   logic [$clog2(NE+1)-1:0] n_out1_q, n_in1_q;
   logic [$clog2(NE)-1:0]   e1_q;
@@ -225,6 +228,8 @@ module cfar_2d #(
     n_in1_q   <= n_in;
     e1_q      <= e_idx;
     cut_ok1_q <= (q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI);
+    rm_ok1_q  <= (q >= 1);                 // row q-1 exists
+    rp_ok1_q  <= (q + 1 < N_RANGE);        // row q+1 exists
     r1_q      <= BR'(q);
     d1_q      <= BD'(s_q - S_W'(PD));   // centre column (mod N_DOPPLER)
   end
@@ -254,21 +259,42 @@ module cfar_2d #(
     end
   end
 
-  // Shift register of the previous 2*PD columns' sums (index 0 = newest)
+  // Shift register of the previous 2*PD columns' sums (index 0 = newest), of the previous
+  // PD+1 columns' CUT-row cells (the CUT at PD-1, its Doppler neighbours at PD and PD-2)
+  // and of the previous PD columns' cells in rows q-1 and q+1 (the CUT's column at PD-1)
   logic [SUM_W-1:0] sr_o [2*PD];
   logic [SUM_W-1:0] sr_i [2*PD];
-  logic [POW_W-1:0] sr_c [PD];
+  logic [POW_W-1:0] sr_c [PD+1];
+  logic [POW_W-1:0] sr_rm [PD];
+  logic [POW_W-1:0] sr_rp [PD];
   always_ff @(posedge clk) begin
     if (v1_q && test1_q) begin
-      sr_o[0] <= vo;
-      sr_i[0] <= vi;
-      sr_c[0] <= vcut;
+      sr_o[0]  <= vo;
+      sr_i[0]  <= vi;
+      sr_c[0]  <= vcut;
+      sr_rm[0] <= win[PR-1];
+      sr_rp[0] <= win[PR+1];
       for (int k = 1; k < 2 * PD; k++) begin
         sr_o[k] <= sr_o[k-1];
         sr_i[k] <= sr_i[k-1];
       end
-      for (int k = 1; k < PD; k++) sr_c[k] <= sr_c[k-1];
+      for (int k = 1; k <= PD; k++) sr_c[k] <= sr_c[k-1];
+      for (int k = 1; k < PD; k++) begin
+        sr_rm[k] <= sr_rm[k-1];
+        sr_rp[k] <= sr_rp[k-1];
+      end
     end
+  end
+
+  // Neighbour powers of the centre cell (Doppler +1 is the arriving column when PD = 1)
+  logic [POW_W-1:0] nb_rm, nb_rp, nb_dm, nb_dp;
+  assign nb_rm = rm_ok1_q ? sr_rm[PD-1] : '0;
+  assign nb_rp = rp_ok1_q ? sr_rp[PD-1] : '0;
+  assign nb_dm = sr_c[PD];
+  if (PD > 1) begin : g_dp_sr
+    assign nb_dp = sr_c[PD-2];
+  end else begin : g_dp_arriving
+    assign nb_dp = vcut;
   end
 
   // Window around the centre column (offset j = -PD..PD; j = PD is the arriving column)
@@ -347,7 +373,7 @@ module cfar_2d #(
 
   // ---------------------------------------------------------------------------------------
   // Output FIFO: one entry per tested cell, the clock after its last column was read
-  localparam int FW = 1 + BR + BD + POW_W + SUM_W + CNT_W + 1;
+  localparam int FW = 1 + BR + BD + 5 * POW_W + SUM_W + CNT_W + 1;
   logic [FW-1:0] fifo_tdata;
 
   buf_out_fifo #(.WIDTH(FW), .DEPTH(4)) u_out (
@@ -355,12 +381,13 @@ module cfar_2d #(
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (step && testing && (s_q >= S_W'(2 * PD))),
-    .in_data       ({last1_q, r1_q, d1_q, detect, cnt, sum_sel, cut}),
+    .in_data       ({last1_q, r1_q, d1_q, nb_dp, nb_dm, nb_rp, nb_rm, detect, cnt, sum_sel,
+                     cut}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
   );
-  assign m_axis_tdata = OUT_W'(fifo_tdata[POW_W + SUM_W + CNT_W:0]);
+  assign m_axis_tdata = OUT_W'(fifo_tdata[5 * POW_W + SUM_W + CNT_W:0]);
   assign m_axis_tuser = fifo_tdata[FW-2 -: BR + BD];
   assign m_axis_tlast = fifo_tdata[FW-1];
 

@@ -66,7 +66,7 @@ module detect_chain #(
   localparam int NCI_W  = ((POW_W + 7) / 8) * 8;
   localparam int CNT_W  = $clog2((2 * PR + 1) * (2 * (GUARD_D + TRAIN_D) + 1));
   localparam int SUM_W  = POW_W + CNT_W;
-  localparam int CELL_W = ((POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8;
+  localparam int CELL_W = ((5 * POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8;
 
   if (POW_W != 32 + $clog2(NUM_TX * NUM_RX) ||
       FRAME_WORDS != MAX_DETECTIONS * ((8 + NUM_RX - 1) / NUM_RX + NUM_TX)

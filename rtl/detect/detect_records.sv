@@ -6,8 +6,9 @@
 // stream can go through axis_packetizer (header/sequence framing, loss detection).
 //
 // Record and trailer layout: docs/detect.md and model/detect_records.py (the host decoder
-// uses that model). Header vector: 8 lanes of 32 bits sent as HDR_WORDS = ceil(8/NUM_RX)
-// words (lanes beyond 8 are zero).
+// uses that model). Header vector: 16 lanes of 32 bits sent as HDR_WORDS = ceil(16/NUM_RX)
+// words (lanes beyond 16 are zero); lanes 8..15 of a record carry the CFAR's four neighbour
+// powers of the cell (range -1/+1, Doppler -1/+1) for the host's peak interpolation.
 // Snapshot ring: written from the Doppler-FFT stream (order r, t, d) through the snap_*
 // port; snap_room is low while the writer is SNAP_ROWS rows ahead of the row the CFAR cells
 // come from, so a snapshot is never overwritten before its cell was decided (the parent
@@ -32,8 +33,8 @@ module detect_records #(
   // Records per frame at most, 1..65535; further detections are counted, flagged, not sent.
   parameter int MAX_DETECTIONS = 256,
   // Derived, do not override: CFAR cell tdata width, header words, record words, frame words.
-  parameter int CELL_W = ((POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8,
-  parameter int HDR_WORDS = (8 + NUM_RX - 1) / NUM_RX,
+  parameter int CELL_W = ((5 * POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8,
+  parameter int HDR_WORDS = (16 + NUM_RX - 1) / NUM_RX,
   parameter int REC_WORDS = HDR_WORDS + NUM_TX,
   parameter int FRAME_WORDS = MAX_DETECTIONS * REC_WORDS + HDR_WORDS
 ) (
@@ -43,7 +44,8 @@ module detect_records #(
   input  wire logic                        snap_wr,
   input  wire logic [NUM_RX*32-1:0]        snap_data,
   output logic                             snap_room,     // a word may be written now
-  // CFAR cells (cfar_2d output): tdata = {detect, count, sum, power}, tuser = {r, d}
+  // CFAR cells (cfar_2d output): tdata = {4 neighbour powers, detect, count, sum, power},
+  // tuser = {r, d}
   input  wire logic [CELL_W-1:0]           s_axis_tdata,
   input  wire logic                        s_axis_tvalid,
   output logic                             s_axis_tready,
@@ -68,7 +70,8 @@ module detect_records #(
   localparam int G_W    = 16;                              // global row counters
   localparam int RC_W   = 17;                              // record counts
   localparam int FW_W   = $clog2(FRAME_WORDS + 1);
-  localparam int HV_W   = ((8 > NUM_RX) ? 8 : NUM_RX) * 32;  // header vector, >= 8 lanes
+  localparam int HV_W   = ((16 > NUM_RX) ? 16 : NUM_RX) * 32;  // header vector, >= 16 lanes
+  localparam int NB_LSB = POW_W + SUM_W + CNT_W + 1;         // first neighbour power bit
   localparam int HS_W   = (HDR_WORDS > 1) ? $clog2(HDR_WORDS) : 1;
   localparam int TS_W   = (NUM_TX > 1) ? $clog2(NUM_TX) : 1;
 
@@ -88,9 +91,9 @@ module detect_records #(
     $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 4..4096",
            N_DOPPLER);
   end
-  if (POW_W < 1 || POW_W > 64 || SUM_W < 1 || SUM_W > 64 || CNT_W < 1 || CNT_W > 16)
+  if (POW_W < 1 || POW_W > 62 || SUM_W < 1 || SUM_W > 64 || CNT_W < 1 || CNT_W > 16)
   begin : g_bad_cell_w
-    $fatal(1, "%m: POW_W=%0d/SUM_W=%0d must be 1..64, CNT_W=%0d 1..16",
+    $fatal(1, "%m: POW_W=%0d must be 1..62, SUM_W=%0d 1..64, CNT_W=%0d 1..16",
            POW_W, SUM_W, CNT_W);
   end
   if (SNAP_ROWS < 4 || SNAP_ROWS > 64 || (1 << BS) != SNAP_ROWS) begin : g_bad_snap_rows
@@ -101,9 +104,9 @@ module detect_records #(
     $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535",
            MAX_DETECTIONS);
   end
-  if (HDR_WORDS != (8 + NUM_RX - 1) / NUM_RX || REC_WORDS != HDR_WORDS + NUM_TX ||
+  if (HDR_WORDS != (16 + NUM_RX - 1) / NUM_RX || REC_WORDS != HDR_WORDS + NUM_TX ||
       FRAME_WORDS != MAX_DETECTIONS * REC_WORDS + HDR_WORDS ||
-      CELL_W != ((POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8) begin : g_bad_derived
+      CELL_W != ((5 * POW_W + SUM_W + CNT_W + 1 + 7) / 8) * 8) begin : g_bad_derived
     $fatal(1, "%m: CELL_W/HDR_WORDS/REC_WORDS/FRAME_WORDS are derived");
   end
 
@@ -140,6 +143,7 @@ module detect_records #(
   typedef enum logic [1:0] {S_CELL, S_REC, S_TRAILER, S_PAD} state_t;
   state_t           state_q;
   logic [POW_W-1:0] c_pow_q;
+  logic [4*POW_W-1:0] c_nb_q;          // neighbour powers, field k at k*POW_W
   logic [SUM_W-1:0] c_sum_q;
   logic [CNT_W-1:0] c_cnt_q;
   logic [BR-1:0]    c_r_q;
@@ -175,6 +179,8 @@ module detect_records #(
     rec_hdr[127:64]  = 64'(c_pow_q);
     rec_hdr[191:128] = 64'(c_sum_q);
     rec_hdr[223:192] = frame_q;
+    for (int k = 0; k < 4; k++)
+      rec_hdr[256 + 64 * k +: 64] = 64'(c_nb_q[k * POW_W +: POW_W]);
     trl_hdr = '0;
     trl_hdr[31:0]    = {8'hDE, 22'd0, sticky_q, trunc_q};
     trl_hdr[63:32]   = 32'(n_rec_q);
@@ -221,6 +227,7 @@ module detect_records #(
   always_ff @(posedge clk) begin
     if (cell_beat) begin
       c_pow_q <= s_pow;
+      c_nb_q  <= s_axis_tdata[NB_LSB +: 4 * POW_W];
       c_sum_q <= s_sum;
       c_cnt_q <= s_cnt;
       c_r_q   <= s_axis_tuser[BD +: BR];

@@ -163,7 +163,7 @@ module radar_pipeline #(
   localparam int LANE_W      = 2 * DATA_W;
   localparam int WORD_W      = NUM_RX * LANE_W;
   localparam int CUBE_WORDS  = NUM_TX * N_RANGE * N_DOPPLER;
-  localparam int HDR_WORDS   = (8 + NUM_RX - 1) / NUM_RX;        // detect_records header
+  localparam int HDR_WORDS   = (16 + NUM_RX - 1) / NUM_RX;       // detect_records header
   localparam int REC_WORDS   = MAX_DETECTIONS * (HDR_WORDS + NUM_TX) + HDR_WORDS;
   // words per frame into the packetizer: the cube (mode 0) or the record stream (mode 1)
   localparam int FRAME_WORDS = (OUTPUT_MODE == 1) ? REC_WORDS : CUBE_WORDS;

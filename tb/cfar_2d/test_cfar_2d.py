@@ -52,8 +52,9 @@ class TB(AxisTB):
             data = b"".join(int(v).to_bytes(self.in_bytes, "little") for v in row)
             await self.source.send(AxiStreamFrame(data))
 
-    async def recv_maps(self, n: int) -> list[list[tuple[int, int, int, int, int, bool]]]:
-        """n frames of output cells as (r, d, power, sum, count, detect) in stream order."""
+    async def recv_maps(self, n: int) -> list[list[tuple]]:
+        """n frames of output cells as (r, d, power, sum, count, detect, neighbours) in
+        stream order."""
         c = self.cfg
         bd = (c.n_doppler - 1).bit_length()
         frames = []
@@ -78,12 +79,13 @@ class TB(AxisTB):
         order = cm.output_order(self.cfg)
         for k, (cells, power) in enumerate(zip(got, sent, strict=True)):
             exp = cm.cfar_2d(power, self.cfg, self.scale)
-            for i, (r, d, pw, s, cnt, det) in enumerate(cells):
+            for i, (r, d, pw, s, cnt, det, nb) in enumerate(cells):
                 er, ed = order[i]
                 want = (int(er), int(ed), int(exp.power[er, ed]), int(exp.train_sum[er, ed]),
-                        int(exp.count[er, ed]), bool(exp.detect[er, ed]))
-                assert (r, d, pw, s, cnt, det) == want, f"frame {k} cell {i}: got " \
-                    f"{(r, d, pw, s, cnt, det)}, expected {want}"
+                        int(exp.count[er, ed]), bool(exp.detect[er, ed]),
+                        tuple(int(v) for v in exp.neighbours[er, ed]))
+                assert (r, d, pw, s, cnt, det, nb) == want, f"frame {k} cell {i}: got " \
+                    f"{(r, d, pw, s, cnt, det, nb)}, expected {want}"
             n_det += int(exp.detect.sum())
         return n_det
 

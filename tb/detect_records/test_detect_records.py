@@ -85,9 +85,7 @@ class TB(AxisTB):
                     await FallingEdge(self.dut.clk)
                 data, tuser = b"", []
                 for r, d in order[q * c.n_doppler:(q + 1) * c.n_doppler]:
-                    v = (int(res.power[r, d]) | (int(res.train_sum[r, d]) << c.pow_w)
-                         | (int(res.count[r, d]) << (c.pow_w + c.sum_w))
-                         | (int(res.detect[r, d]) << (c.pow_w + c.sum_w + c.cnt_w)))
+                    v = cm.pack_cell(res, int(r), int(d), c)
                     data += v.to_bytes(c.out_bytes, "little")
                     tuser += [(int(r) << bd) | int(d)] * c.out_bytes
                 await self.source.send(AxiStreamFrame(data, tuser=tuser))
@@ -99,8 +97,7 @@ class TB(AxisTB):
         for k, (s, p) in enumerate(zip(snaps, maps, strict=True)):
             res = cm.cfar_2d(p, c, scale)
             sv = s.reshape(c.n_range, self.num_tx, c.n_doppler, self.num_rx)
-            recs = [dr.Record(int(r), int(d), int(res.power[r, d]), int(res.train_sum[r, d]),
-                              int(res.count[r, d]), sv[r, :, d, :])
+            recs = [dr.Record.of_cell(res, r, d, sv[r, :, d, :])
                     for r, d in cm.output_order(c) if res.detect[r, d]]
             out.append(dr.encode_frame(recs, len(recs), self.num_tx, self.num_rx,
                                        self.max_det, frame_id=k, sticky=sticky))
