@@ -7,7 +7,10 @@
 //     TLAST on the last cell of every row; no cell before its input (out <= in);
 //   - frame_count counts completed frames (<= input frames);
 //   - status_framing_error is exactly "some input TLAST not on Doppler bin 3" (positions
-//     counted here from the input beats: a beat taken without being used shows here).
+//     counted here from the input beats: a beat taken without being used shows here);
+//   - in the first frame after reset, every output cell carries its own input power and
+//     the powers of its four neighbours (r-1, r+1: 0 beyond rows 0 and 3; d-1, d+1:
+//     circular): checked on one watched cell, any cell (the solver's pick).
 `default_nettype none
 
 module cfar_2d_props (
@@ -60,6 +63,36 @@ module cfar_2d_props (
 
   wire [1:0] exp_r = n_out[3:2];
   wire [1:0] exp_d = 2'(n_out[1:0] + 2'(PD));
+
+  // one watched cell of the first frame after reset (the solver's pick): its input power,
+  // then every output cell whose own or neighbour field is that cell must carry it
+  localparam int NB = POW_W + SUM_W + CNT_W + 1;    // first neighbour field
+  (* anyconst *) logic [3:0] f_idx;                 // watched cell {r, d}
+  logic [POW_W-1:0] f_val;
+  logic             f_have;
+  always_ff @(posedge clk) begin
+    if (rst) f_have <= 1'b0;
+    else if (s_axis_tvalid && s_axis_tready && n_in < 8'd16 && n_in[3:0] == f_idx) begin
+      f_val  <= s_axis_tdata;
+      f_have <= 1'b1;
+    end
+  end
+  wire [1:0] f_r = f_idx[3:2], f_d = f_idx[1:0];
+  always_comb if (past && !rst && m_axis_tvalid && n_out < 8'd16) begin
+    if (f_r == exp_r && f_d == exp_d)
+      assert (f_have && m_axis_tdata[POW_W-1:0] == f_val);
+    if (exp_r == 2'd0) assert (m_axis_tdata[NB +: POW_W] == '0);
+    else if (f_r == exp_r - 2'd1 && f_d == exp_d)
+      assert (f_have && m_axis_tdata[NB +: POW_W] == f_val);
+    if (exp_r == 2'd3) assert (m_axis_tdata[NB + POW_W +: POW_W] == '0);
+    else if (f_r == exp_r + 2'd1 && f_d == exp_d)
+      assert (f_have && m_axis_tdata[NB + POW_W +: POW_W] == f_val);
+    if (f_r == exp_r && f_d == 2'(exp_d - 2'd1))
+      assert (f_have && m_axis_tdata[NB + 2 * POW_W +: POW_W] == f_val);
+    if (f_r == exp_r && f_d == 2'(exp_d + 2'd1))
+      assert (f_have && m_axis_tdata[NB + 3 * POW_W +: POW_W] == f_val);
+  end
+
   always_comb if (past && !rst) begin
     assert (n_out <= n_in);
     if (m_axis_tvalid) begin

@@ -7,9 +7,10 @@ own CFAR (``host.pipeline`` module docstring), on the records alone:
 
 1. keep cells inside ``RadarConfig.detection_bins``;
 2. peak grouping: a record is kept when no detected cell of its 3x3 neighbourhood (both
-   axes circular) is stronger (``host.cfar.local_peaks`` on the map of detected powers;
-   the host's own CFAR compares against every neighbour, detected or not, which differs
-   only when an undetected neighbour is stronger than a detected cell);
+   axes circular) and none of its four direct neighbours (the record's neighbour powers,
+   detected or not) is stronger (``host.cfar.local_peaks`` on the map of detected powers,
+   and the neighbour powers; the host's own CFAR compares against every neighbour, which
+   differs only when an undetected *diagonal* neighbour is stronger than a detected cell);
 3. sidelobe masking against stronger *detected* cells in the same row and column
    (``host.cfar.sidelobe_masked``; a cell strong enough to throw sidelobes above the
    threshold is always detected itself);
@@ -129,7 +130,7 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     i = np.flatnonzero(own & (r >= lo) & (r < hi))
     r, d = r[i], d[i]
     p = pmap[r, d]
-    mx = p.copy()
+    mx = p.copy() if arr.neighbours is None else np.maximum(p, arr.neighbours[i].max(axis=1))
     for a in (-1, 0, 1):
         for b in (-1, 0, 1):
             if a or b:
@@ -155,6 +156,10 @@ def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: Detect
     pmap[arr.range_bin, arr.doppler_bin] = arr.power
     index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
     mask = (pmap > 0) & detection_mask(nr, nd, cfg.detection_bins)
+    if arr.neighbours is not None:           # a direct neighbour, detected or not, is stronger
+        nbmax = np.zeros((nr, nd))
+        nbmax[arr.range_bin, arr.doppler_bin] = arr.neighbours.max(axis=1, initial=0.0)
+        mask &= pmap >= nbmax
     cells = local_peaks(pmap, mask)
     windowed = (params.range_window, params.doppler_window)
     if params.sidelobe_margin_db is not None and len(cells):

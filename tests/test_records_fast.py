@@ -146,11 +146,19 @@ def test_select_records_matches_reference() -> None:
             r, d = np.divmod(c, cfg.n_doppler)
             pw = 10 ** rng.uniform(0, 9, n)
             pw[rng.random(n) < 0.05] = 0.0
-            arr = RecordArrays(r, d, pw, np.ones(n), np.zeros((n, cfg.n_virtual), np.complex64))
-            for p in (DetectionParams(), DetectionParams(sidelobe_margin_db=None),
-                      DetectionParams(range_window=False, doppler_window=False)):
-                np.testing.assert_array_equal(select_records(arr, cfg, p)[0],
-                                              select_records_reference(arr, cfg, p)[0])
+            # neighbour powers: mostly weaker than the cell, sometimes stronger (undetected)
+            nb = pw[:, None] * 10 ** rng.uniform(-3, 0.1, (n, 4))
+            snap = np.zeros((n, cfg.n_virtual), np.complex64)
+            for arr in (RecordArrays(r, d, pw, np.ones(n), snap),
+                        RecordArrays(r, d, pw, np.ones(n), snap, nb)):
+                for p in (DetectionParams(), DetectionParams(sidelobe_margin_db=None),
+                          DetectionParams(range_window=False, doppler_window=False)):
+                    np.testing.assert_array_equal(select_records(arr, cfg, p)[0],
+                                                  select_records_reference(arr, cfg, p)[0])
+            if n > 10:                    # a stronger direct neighbour drops the record
+                kept = set(select_records(RecordArrays(r, d, pw, np.ones(n), snap, nb), cfg,
+                                          DetectionParams())[0].tolist())
+                assert not any(nb[k].max() > pw[k] for k in kept)
 
 
 @pytest.mark.parametrize("sources", [1, 2, 3])

@@ -9,6 +9,7 @@ import threading
 import time
 
 from host.capture import read_capture
+from model.detect_records import frame_words
 from radar.cli import main
 
 
@@ -37,7 +38,8 @@ def test_record_capture_replay_receive(tmp_path, capsys):
                  "--packet-words", "64", "--detect", "fpga", "--out", str(cap)]) == 0
     info, packets = read_capture(cap)
     assert info.records and info.max_detections == 256
-    assert len(list(packets)) == 2 * 13          # 256 * 3 + 2 = 770 words in 64-word packets
+    # 256 records of 4 header + 1 snapshot words, a 4-word trailer: 1284 words, 21 packets
+    assert len(list(packets)) == 2 * -(-frame_words(1, 4, 256) // 64) == 2 * 21
     rc, out = _round_trip(tmp_path, cap, ["--detect", "fpga"])   # geometry learnt
     assert rc == 0
     doc = json.loads(out.read_text())
