@@ -167,7 +167,7 @@ def damaged_streams(draw):
             pk[i], pk[i + 1] = pk[i + 1], pk[i]
         elif op == "cut":
             pk[i] = pk[i][: b * 7]
-        elif op == "flip":
+        elif op == "flip" and pk[i]:          # (a cut may have left it empty)
             j = (b * 131) % len(pk[i])
             pk[i] = pk[i][:j] + bytes([pk[i][j] ^ 0xFF]) + pk[i][j + 1:]
         elif op == "junk":
