@@ -80,6 +80,7 @@ bench: $(STAMP)
 	$(RUN) python -m model.bench_model
 	$(RUN) python -m host.bench_host
 	$(RUN) python -m host.bench_detect
+	$(RUN) python -m host.bench_unfold
 
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
