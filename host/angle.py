@@ -9,6 +9,7 @@ steering vector is ``steering(n, s)`` and the angle spectrum is the inverse DFT 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -292,11 +293,18 @@ def _steering_rows(s: np.ndarray, n: int) -> np.ndarray:
     b0 = int(np.ceil(np.sqrt(n)))
     lo = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(b0)))            # (m, b0)
     hi = np.exp(-1j * np.pi * np.multiply.outer(s, np.arange(-(-n // b0)) * b0))  # (m, n/b0)
-    return (hi[:, :, None] * lo[:, None, :]).reshape(len(s), -1)[:, :n]
+    return (hi[:, :, None] * lo[:, None, :]).reshape(len(s), hi.shape[1] * b0)[:, :n]
+
+
+PeakFinder = Callable[[np.ndarray, int], tuple[np.ndarray, np.ndarray]]
+"""A function (x complex (m, n), n_fft) -> (sin(az) float (m,), |peak|^2 float (m,)) of the
+strongest angle-spectrum peak of each row: :func:`peak_sin_batch` (the ``n_fft``-point
+FFT's), :func:`peak_sin_fast`, or the compiled ``host.cell_kernels.peak_sins``."""
 
 
 def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.ndarray,
-                a1: np.ndarray, p1: np.ndarray, more: np.ndarray, batched: bool = False
+                a1: np.ndarray, p1: np.ndarray, more: np.ndarray, batched: bool = False,
+                peaks: PeakFinder | None = None
                 ) -> AngleArrays:
     """The :class:`AngleArrays` of rows xs (complex (n, n_ch)): the first component (sin
     s1, amplitude a1, power p1, float/complex (n,)) where ``more`` (bool (n,)) is False,
@@ -312,7 +320,7 @@ def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.n
     amp: list = []
     snr: list = []
     if batched:
-        got = estimate_angles_rows(xs[multi], noise[multi], params)
+        got = estimate_angles_rows(xs[multi], noise[multi], params, peaks)
         cell, sin_az, amp, snr = multi[got.cell], got.sin_az, got.amplitude, got.snr_db
     else:
         for i in multi:
@@ -380,7 +388,7 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
     st1 = _steering_rows(s1, n)
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2
-    more = np.zeros(n_rows, bool)
+    maybe = np.zeros(n_rows, bool)
     if params.max_targets > 1:
         res = xs - a1[:, None] * st1
         # upper bound of p2 (1e-9: far above the rounding of either side)
@@ -390,18 +398,34 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
         with np.errstate(divide="ignore", invalid="ignore"):
             maybe = (10 * np.log10(bound * n / noise) >= params.min_snr_db) & (
                 10 * np.log10(p1 / np.maximum(bound, 1e-300)) <= params.dynamic_range_db)
-        rows = np.flatnonzero(maybe)
-        if len(rows):
-            r = res[rows]
-            s2, _ = peak_sin_fast(r, params.n_fft)
-            st2 = _steering_rows(s2, n)
-            p2 = np.abs(np.sum(np.conj(st2) * r, axis=1) / n) ** 2
-            with np.errstate(divide="ignore"):
-                snr2 = 10 * np.log10(p2 * n / noise[rows])
-                more[rows] = (snr2 >= params.min_snr_db) & (
-                    10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
-                    <= params.dynamic_range_db)
-    return _components(xs, noise, params, s1, a1, p1, more, batched=True)
+    return screened_components(xs, noise, params, s1, a1, p1, maybe)
+
+
+def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
+                        s1: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray,
+                        peaks: PeakFinder | None = None) -> AngleArrays:
+    """The second half of :func:`estimate_angles_screened`: rows xs (complex128 (n, n_ch))
+    with their first component (sin s1, amplitude a1, power p1: float/complex (n,)) and
+    the screen ``maybe`` (bool (n,)); the rows that may hold a second component search
+    their residual for it, and those that hold one go through
+    :func:`estimate_angles_rows`. noise: float (n,) per channel, >= 1e-30. ``peaks``: the
+    peak search of the residuals and of :func:`estimate_angles_rows` (default: the
+    residual's :func:`peak_sin_fast`, and there the ``n_fft``-point FFT)."""
+    n = xs.shape[1]
+    more = np.zeros(len(xs), bool)
+    rows = np.flatnonzero(maybe)
+    if params.max_targets > 1 and len(rows):
+        st1 = _steering_rows(s1[rows], n)
+        r = xs[rows] - a1[rows, None] * st1
+        s2, _ = (peaks or peak_sin_fast)(r, params.n_fft)
+        st2 = _steering_rows(s2, n)
+        p2 = np.abs(np.sum(np.conj(st2) * r, axis=1) / n) ** 2
+        with np.errstate(divide="ignore"):
+            snr2 = 10 * np.log10(p2 * n / noise[rows])
+            more[rows] = (snr2 >= params.min_snr_db) & (
+                10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
+                <= params.dynamic_range_db)
+    return _components(xs, noise, params, s1, a1, p1, more, batched=True, peaks=peaks)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
@@ -445,12 +469,19 @@ def _steer(s: np.ndarray, n: int) -> np.ndarray:
     return np.exp((-1j * np.pi * np.arange(n))[None, :] * s[:, None])
 
 
-def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
-                         ) -> AngleArrays:
+def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
+                         peaks: PeakFinder | None = None) -> AngleArrays:
     """:func:`estimate_angles` of every row of x, complex (m, n), noise_per_channel float
     (m,), run on all rows in step (the same components: the same peaks, from the batched
     ``n_fft``-point FFT of :func:`peak_sin_batch`, the same gates, refinement passes in
-    the same order and the same de-duplication), as flat :class:`AngleArrays`."""
+    the same order and the same de-duplication), as flat :class:`AngleArrays`.
+
+    ``peaks``: another peak search (:data:`PeakFinder`; e.g. the compiled
+    ``host.cell_kernels.peak_sins``, the same fine-grid maximum as the FFT's unless two
+    lobes are within the coarse grid's scalloping, ``host.angle.fine_peaks``), with the
+    steering vectors of :func:`_steering_rows` (equal to rounding)."""
+    find = peaks or peak_sin_batch
+    steer = _steer if peaks is None else _steering_rows
     xs = np.asarray(x, dtype=np.complex128)
     m, n = xs.shape
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
@@ -465,8 +496,8 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
         for t in range(kmax):
             if not len(live):
                 break
-            s, _ = peak_sin_batch(residual[live], params.n_fft)
-            a = np.sum(np.conj(_steer(s, n)) * residual[live], axis=1) / n
+            s, _ = find(residual[live], params.n_fft)
+            a = np.sum(np.conj(steer(s, n)) * residual[live], axis=1) / n
             power = np.abs(a) ** 2
             snr_db = 10 * np.log10(power * n / noise[live])
             stop = np.zeros(len(live), bool)
@@ -485,15 +516,15 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
                         others = np.zeros((len(live), n), complex)
                         for i in range(t + 1):
                             if i != j:
-                                others = others + a_c[live, i][:, None] * _steer(s_c[live, i],
+                                others = others + a_c[live, i][:, None] * steer(s_c[live, i],
                                                                                  n)
                         r = xl - others
-                        sj, _ = peak_sin_batch(r, params.n_fft)
+                        sj, _ = find(r, params.n_fft)
                         s_c[live, j] = sj
-                        a_c[live, j] = np.sum(np.conj(_steer(sj, n)) * r, axis=1) / n
+                        a_c[live, j] = np.sum(np.conj(steer(sj, n)) * r, axis=1) / n
             total = np.zeros((len(live), n), complex)
             for i in range(t + 1):
-                total = total + a_c[live, i][:, None] * _steer(s_c[live, i], n)
+                total = total + a_c[live, i][:, None] * steer(s_c[live, i], n)
             residual[live] = xs[live] - total
         snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
     cell, sin_az, amp, snr = [], [], [], []

@@ -15,7 +15,8 @@ cost on the link and on the host. Prints four tables:
    (goal: fits the paper's measured 766 Mbit/s);
 4. host time per frame for 10, 100, 1000 detections on one core, CPU and wall, the replaced
    code ("old": ``Record`` objects, ``process_records_reference``) beside the current one
-   (arrays, ``process_records``) in the same run: DMA bytes -> records (decoder), records ->
+   (arrays, ``process_records``, and the same without the compiled kernels of
+   ``host.cell_kernels``) in the same run: DMA bytes -> records (decoder), records ->
    point cloud, and both (goal <= 5 ms for 1000), on strong isolated targets and on a mixed
    frame (``synthetic_records(varied=True)``). One core: the process is pinned to one CPU
    and the BLAS / OpenMP pools get one thread (set before numpy loads). Table 1 also gives
@@ -279,14 +280,15 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> tuple[float, float]:
 
 
 def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
-                   varied: bool = False
+                   varied: bool = False, compiled: bool = True
                    ) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float],
                               int]:
     """((CPU, wall) ms of DMA bytes -> record arrays, of records -> point cloud, of both
     in one go, points) for one frame of ``n`` synthetic records (``varied``: see
     :func:`synthetic_records`); ``reference``: through the replaced code (``Record``
     objects from ``model.detect_records.decode_frame``, ``record_arrays_reference``,
-    ``process_records_reference``)."""
+    ``process_records_reference``); ``compiled`` False: the current code without the
+    compiled kernels (``host.cell_kernels``)."""
     cfg = get_preset(preset)
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
@@ -301,9 +303,10 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
         return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
 
     def cloud(arr: RecordArrays) -> PointCloud:
-        return process_records(arr, cfg, params, reference=reference)
+        return process_records(arr, cfg, params, reference=reference, compiled=compiled)
 
     arr = decode()
+    cloud(arr)                          # the kernels compile (or load) on their first call
     t_dec = _best_ms(decode, repeat)
     t_pc = _best_ms(lambda: cloud(arr), repeat)
     t_all = _best_ms(lambda: cloud(decode()), repeat)
@@ -395,20 +398,22 @@ def host_table(args: argparse.Namespace) -> None:
     print(f"\n## Host time per full frame, one core (best of {args.repeat}; CPU = "
           f"process_time, wall = perf_counter; old = the replaced code, same run; "
           f"10^6 complex multiplications take {calibration_ms(args.repeat):.2f} ms CPU here)")
-    print("| detections | frame | step | old CPU ms | new CPU ms | old wall ms | new wall ms | "
-          "CPU speed-up |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| detections | frame | step | old CPU ms | new, numpy only, CPU ms | new CPU ms | "
+          "old wall ms | new wall ms | CPU speed-up |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for varied in (False, True):
         for n in (10, 100, 1000):
             od, op, oa, _ = host_time_rows("full", n, args.repeat, reference=True,
                                            varied=varied)
+            _, pp, pa, _ = host_time_rows("full", n, args.repeat, varied=varied,
+                                          compiled=False)
             nd_, np_, na, pts = host_time_rows("full", n, args.repeat, varied=varied)
             kind = "mixed" if varied else "strong"
-            for step, o, w in (("DMA bytes -> records", od, nd_),
-                               (f"records -> point cloud ({pts} points)", op, np_),
-                               ("DMA bytes -> point cloud", oa, na)):
-                print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {w[0]:.2f} | {o[1]:.2f} | "
-                      f"{w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
+            for step, o, p, w in (("DMA bytes -> records", od, nd_, nd_),
+                                  (f"records -> point cloud ({pts} points)", op, pp, np_),
+                                  ("DMA bytes -> point cloud", oa, pa, na)):
+                print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {p[0]:.2f} | {w[0]:.2f} | "
+                      f"{o[1]:.2f} | {w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
     print(f"\nCPU calibration after the runs: {calibration_ms(args.repeat):.2f} ms per 10^6 "
           f"complex multiplications")
 

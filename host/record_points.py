@@ -35,12 +35,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from host.angle import estimate_angles_screened, peak_power_lean
+from host.angle import estimate_angles_screened, peak_power_lean, screened_components
+from host.cell_kernels import class_peaks, first_components, peak_sins
 from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
 from host.pipeline import (
     DetectionParams,
     _cloud,
     _tdm_compensate,
+    _tdm_tx_phasors,
     choose_folds,
     neighbour_offsets,
     points_from_cells,
@@ -188,11 +190,14 @@ def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, params: Detec
 
 def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
                           noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
-                          params: DetectionParams, frame: int = 0) -> PointCloud:
+                          params: DetectionParams, frame: int = 0, compiled: bool = True
+                          ) -> PointCloud:
     """``host.pipeline.points_from_cells`` (steps 3 to 5 there; same arguments, same
     points) with less work: angle peaks (``host.angle.fine_peaks``) only of the TDM alias
     classes in :func:`hypothesis_classes` (the others do not enter ``choose_folds``), and
     the second-component search screened (``host.angle.estimate_angles_screened``).
+    ``compiled``: the class peaks and first angle components by the compiled kernels of
+    ``host.cell_kernels`` (default); False: by numpy (the same values to rounding).
 
     cells: int (n, 2) (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual); power, noise: float (n,); offsets: float (n, 2) bins."""
@@ -206,23 +211,41 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
     sb = signed_bins(nd)[d].astype(np.int64)
     cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
     measured = (sb + offsets[:, 1]) * cfg.velocity_bin_mps
+    fold = np.zeros(n, np.int64)
+    sn_sel = None
     if ntx > 1 and params.unfold_velocity:
         ci, cc = np.nonzero(hypothesis_classes(cfg, measured, params))   # (cell, class) pairs
-        # complex128 before the gather: the same products as x * phasor, one cast per cell
-        xc = _tdm_compensate(cfg, x.astype(np.complex128)[ci], sb[ci] + cc * nd)  # (p, n_v)
-        pw, sn = peak_power_lean(xc, params.angle.n_fft)
+        if compiled:
+            pw, sn = class_peaks(x, ci, _tdm_tx_phasors(cfg, sb[ci] + cc * nd),
+                                 params.angle.n_fft)
+        else:
+            # complex128 before the gather: the same products as x * phasor
+            xc = _tdm_compensate(cfg, x.astype(np.complex128)[ci], sb[ci] + cc * nd)
+            pw, sn = peak_power_lean(xc, params.angle.n_fft)
         class_power = np.zeros((n, ntx))         # absent classes: masked by choose_folds
         class_power[ci, cc] = pw
         pair = np.full((n, ntx), -1, np.int64)
         pair[ci, cc] = np.arange(len(ci))
         fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
-        # the fold's class always holds a hypothesis: its vector and peak were computed
+        # the fold's class always holds a hypothesis: its peak was computed
         sel = pair[np.arange(n), fold % ntx]
-        ang = estimate_angles_screened(xc[sel], noise / nv, params.angle, first_sin=sn[sel])
+        sn_sel = sn[sel]
+        if not compiled:
+            ang = estimate_angles_screened(xc[sel], noise / nv, params.angle, first_sin=sn_sel)
     else:
         fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, cell_snr_db, params)
-        ang = estimate_angles_screened(_tdm_compensate(cfg, x, sb + fold * nd), noise / nv,
-                                       params.angle)
+        if not compiled:
+            ang = estimate_angles_screened(_tdm_compensate(cfg, x, sb + fold * nd), noise / nv,
+                                           params.angle)
+    if compiled:
+        ph = _tdm_tx_phasors(cfg, sb + fold * nd)
+        if sn_sel is None:                       # no TDM test: the peaks of the fold's class
+            sn_sel = class_peaks(x, np.arange(n), ph, params.angle.n_fft)[1]
+        a = params.angle
+        xs, a1, p1, maybe = first_components(x, ph, sn_sel, noise / nv, a.min_snr_db,
+                                             a.dynamic_range_db, a.max_targets > 1)
+        ang = screened_components(xs, np.maximum(noise / nv, 1e-30), a, sn_sel, a1, p1, maybe,
+                                  peaks=peak_sins)
     return _cloud(cfg, params, r, offsets, sb + fold * nd, ambiguous, ang.cell,
                   ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
 
@@ -242,12 +265,14 @@ def _check_channels(arr: RecordArrays, cfg: RadarConfig) -> None:
 
 
 def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
-                    frame: int = 0, reference: bool = False) -> PointCloud:
+                    frame: int = 0, reference: bool = False, compiled: bool = True
+                    ) -> PointCloud:
     """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
     -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``:
     record selection (steps 1 to 3), peak offsets (step 4), :func:`points_from_snapshots`.
     The public records -> point cloud function (CLI, live view). ``reference``: run the
-    replaced implementation (:func:`process_records_reference`; benchmark, tests)."""
+    replaced implementation (:func:`process_records_reference`; benchmark, tests);
+    ``compiled`` False: :func:`points_from_snapshots` in numpy only (benchmark)."""
     params = params or DetectionParams()
     _check_channels(arr, cfg)
     if reference:
@@ -256,7 +281,7 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
     return points_from_snapshots(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
-                                 offsets, cfg, params, frame)
+                                 offsets, cfg, params, frame, compiled)
 
 
 def process_records_reference(arr: RecordArrays, cfg: RadarConfig,

@@ -1,0 +1,431 @@
+"""Compiled (numba) kernels of the per-cell work of the records -> point cloud path
+(``host.record_points.points_from_snapshots``): the same results as the numpy functions
+named below, without numpy's per-call overhead and temporaries, one pass per cell.
+
+- :func:`class_peaks`: the TDM alias classes' angle peaks, ``host.angle.peak_power_lean``
+  of ``host.pipeline._tdm_compensate``'d snapshots. The coarse angle FFT (single
+  precision, as there) runs on blocks of (cell, class) pairs at once, the pairs in the
+  innermost loop (vectorised over the block); the fine-grid search (double precision)
+  runs per pair.
+- :func:`first_components`: the TDM-compensated vector of each cell's chosen class, its
+  first angle component's amplitude and power, and the Cauchy-Schwarz screen for a second
+  one (the first half of ``host.angle.estimate_angles_screened``).
+
+Floating-point sums run in a different order than numpy's (and ``fastmath`` lets the
+compiler reorder them): results agree to rounding; a decision that rests on an exact tie
+(two equal spectrum values) may go the other way. The first call compiles the kernels
+(a few seconds; cached in ``__pycache__`` for the next process).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from host.angle import COARSE_FFT, SECOND_LOBE, _zoom_tables
+
+_BLOCK = 16
+"""(cell, class) pairs per coarse-FFT block: 2 x 128 x 16 float32, 16 KiB, stays in L1."""
+
+
+@numba.njit(cache=True, fastmath=True)
+def _fine_search(xr: np.ndarray, xi: np.ndarray, ca: float, cb: float, cc: float, kc: int,
+                 coarse: int, n_fft: int, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
+                 os_: np.ndarray, yr: np.ndarray, yi: np.ndarray, mag: np.ndarray
+                 ) -> tuple[int, float, float, float]:
+    """``host.angle._refine`` of one row x (float64 xr, xi (n,)) from coarse bin kc, whose
+    coarse magnitudes (float32) at kc - 1, kc, kc + 1 are ca, cb, cc: (fine bin,
+    |X(k - 1)|, |X(k)|, |X(k + 1)|).
+    The window is the 2 half + 1 fine bins centre - half .. centre + half; after
+    demodulating by the centre (dm*: exp(2 pi j v k / n_fft) per fine bin k), bins
+    centre +- o are A_o +- j B_o with A_o, B_o the sums of y_v cos and y_v sin(2 pi v o /
+    n_fft) (oc, os_: float (half, n)): half the multiplications of a complex product per
+    bin. yr, yi (n,), mag (2 half + 1,): scratch."""
+    n = xr.shape[0]
+    half = oc.shape[0]
+    w = 2 * half + 1
+    step = n_fft // coarse
+    den = ca - np.float32(2.0) * cb + cc
+    delta = np.float32(0.0)
+    if den < 0:
+        delta = np.float32(0.5) * (ca - cc) / den
+    delta = min(max(delta, np.float32(-0.5)), np.float32(0.5))
+    centre = (kc * step + int(np.rint(delta * np.float32(step)))) % n_fft
+    max_it = n_fft // half + 2
+    j = 0
+    for it in range(max_it):
+        zr = 0.0
+        zi = 0.0
+        for v in range(n):
+            dr = dmr[centre, v]
+            di = dmi[centre, v]
+            yr[v] = xr[v] * dr - xi[v] * di
+            yi[v] = xr[v] * di + xi[v] * dr
+            zr += yr[v]
+            zi += yi[v]
+        mag[half] = math.sqrt(zr * zr + zi * zi)
+        for o in range(half):
+            ar = 0.0
+            ai = 0.0
+            br = 0.0
+            bi = 0.0
+            for v in range(n):
+                ar += yr[v] * oc[o, v]
+                ai += yi[v] * oc[o, v]
+                br += yr[v] * os_[o, v]
+                bi += yi[v] * os_[o, v]
+            # X(centre + o + 1) = A + j B, X(centre - o - 1) = A - j B
+            pr, pi = ar - bi, ai + br
+            mr, mi = ar + bi, ai - br
+            mag[half + o + 1] = math.sqrt(pr * pr + pi * pi)
+            mag[half - o - 1] = math.sqrt(mr * mr + mi * mi)
+        j = 0
+        for o in range(1, w):
+            if mag[o] > mag[j]:
+                j = o
+        # uphill only when the edge is strictly higher (ties stop here)
+        edge = (j == 0 and mag[0] > mag[1]) or j == w - 1
+        if not edge or it == max_it - 1:
+            break
+        centre = (centre + j - half) % n_fft
+    k = (centre + j - half) % n_fft
+    return k, mag[max(j - 1, 0)], mag[j], mag[min(j + 1, w - 1)]
+
+
+@numba.njit(cache=True, fastmath=True)
+def _interpolated_sin(k0: int, a: float, b: float, c: float, n_fft: int) -> float:
+    """``host.angle._interpolated_sin`` of one peak."""
+    k = (k0 + n_fft // 2) % n_fft
+    den = a - 2.0 * b + c
+    delta = 0.5 * (a - c) / den if den < 0 else 0.0
+    s = 2.0 * (k + delta - n_fft // 2) / n_fft
+    return (s + 1.0) % 2.0 - 1.0
+
+
+@numba.njit(cache=True, fastmath=True)
+def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -> None:
+    """In-place FFT (kernel exp(+2 pi j n k / N), unscaled) of the columns of a block,
+    float32 re, im (N, _BLOCK), N a power of two, the columns innermost (vectorised over
+    them): radix-4 decimation-in-frequency stages, a radix-2 one last when N is not a power
+    of 4; natural order in, digit-reversed order out (:func:`_coarse_tables`). wr, wi:
+    float32 (N,) exp(2 pi j k / N)."""
+    n = re.shape[0]
+    nb = _BLOCK                     # a compile-time trip count: the loops vectorise
+    size = n
+    while size >= 4:
+        q = size // 4
+        stride = n // size
+        for start in range(0, n, size):
+            for k in range(q):
+                w1r = wr[k * stride]
+                w1i = wi[k * stride]
+                w2r = wr[2 * k * stride]
+                w2i = wi[2 * k * stride]
+                w3r = wr[3 * k * stride]
+                w3i = wi[3 * k * stride]
+                i0 = start + k
+                i1 = i0 + q
+                i2 = i1 + q
+                i3 = i2 + q
+                for j in range(nb):
+                    t0r = re[i0, j] + re[i2, j]
+                    t0i = im[i0, j] + im[i2, j]
+                    t1r = re[i0, j] - re[i2, j]
+                    t1i = im[i0, j] - im[i2, j]
+                    t2r = re[i1, j] + re[i3, j]
+                    t2i = im[i1, j] + im[i3, j]
+                    t3r = re[i1, j] - re[i3, j]
+                    t3i = im[i1, j] - im[i3, j]
+                    re[i0, j] = t0r + t2r
+                    im[i0, j] = t0i + t2i
+                    ur = t1r - t3i                 # t1 + j t3
+                    ui = t1i + t3r
+                    re[i1, j] = ur * w1r - ui * w1i
+                    im[i1, j] = ur * w1i + ui * w1r
+                    ur = t0r - t2r
+                    ui = t0i - t2i
+                    re[i2, j] = ur * w2r - ui * w2i
+                    im[i2, j] = ur * w2i + ui * w2r
+                    ur = t1r + t3i                 # t1 - j t3
+                    ui = t1i - t3r
+                    re[i3, j] = ur * w3r - ui * w3i
+                    im[i3, j] = ur * w3i + ui * w3r
+        size = q
+    if size == 2:
+        for start in range(0, n, 2):
+            for j in range(nb):
+                ur = re[start, j]
+                ui = im[start, j]
+                vr = re[start + 1, j]
+                vi = im[start + 1, j]
+                re[start, j] = ur + vr
+                im[start, j] = ui + vi
+                re[start + 1, j] = ur - vr
+                im[start + 1, j] = ui - vi
+
+
+@numba.njit(cache=True, fastmath=True)
+def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarray,
+                 phi: np.ndarray, n_fft: int, second_lobe: float, wr: np.ndarray,
+                 wi: np.ndarray, pos: np.ndarray, dmr: np.ndarray, dmi: np.ndarray,
+                 oc: np.ndarray, os_: np.ndarray, out_pow: np.ndarray, out_sin: np.ndarray
+                 ) -> None:
+    """:func:`class_peaks` on split real/imaginary arrays; wr, wi float32 (coarse,) the
+    coarse FFT's twiddles, pos int (coarse,) where :func:`_block_fft` leaves bin k; dm*,
+    oc, os_: see :func:`_fine_search`."""
+    m = cell.shape[0]
+    nv = xr.shape[1]
+    ntx = phr.shape[1]
+    nrx = nv // ntx
+    coarse = pos.shape[0]
+    nb_ = _BLOCK
+    re2 = np.zeros((coarse, nb_), np.float32)
+    im2 = np.zeros((coarse, nb_), np.float32)
+    re = re2.ravel()                   # the same block, flat: (bin, column) at bin * nb_ + column
+    im = im2.ravel()
+    xcr = np.zeros((nv, nb_))         # the block's compensated rows as columns, double
+    xci = np.zeros((nv, nb_))
+    best = np.empty(nb_, np.float32)
+    kbest = np.empty(nb_, np.float32)
+    top = np.empty(nb_, np.float32)
+    ktop = np.empty(nb_, np.float32)
+    c3 = np.empty((nb_, 3), np.float32)
+    rowr = np.empty(nv)
+    rowi = np.empty(nv)
+    yr = np.empty(nv)
+    yi = np.empty(nv)
+    mag = np.empty(2 * oc.shape[0] + 1)
+    lobe = np.float32(second_lobe)
+    cmask = coarse - 1                        # coarse: a power of two
+    for b0 in range(0, m, nb_):
+        nb = min(nb_, m - b0)
+        for t in range(ntx):                # TDM compensation
+            for j in range(nb):
+                pr = phr[b0 + j, t]
+                pi = phi[b0 + j, t]
+                c = cell[b0 + j]
+                for r in range(nrx):
+                    v = t * nrx + r
+                    xcr[v, j] = xr[c, v] * pr - xi[c, v] * pi
+                    xci[v, j] = xr[c, v] * pi + xi[c, v] * pr
+        # coarse FFT of the block, single precision (as host.angle.fine_peaks), the
+        # zero-padded rows as columns; magnitudes in place
+        for v in range(nv):
+            for j in range(nb_):
+                re[v * nb_ + j] = np.float32(xcr[v, j])
+                im[v * nb_ + j] = np.float32(xci[v, j])
+        re[nv * nb_:] = 0.0
+        im[nv * nb_:] = 0.0
+        _block_fft(re2, im2, wr, wi)
+        for q in range(coarse * nb_):
+            re[q] = np.sqrt(re[q] * re[q] + im[q] * im[q])
+        # the largest coarse bin of each column (natural order, strict >: the first on a
+        # tie, as np.argmax); bins as float32 so that the loop vectorises
+        for j in range(nb_):
+            best[j] = np.float32(-1.0)
+            kbest[j] = np.float32(0.0)
+        for k in range(coarse):
+            q = pos[k] * nb_
+            fk = np.float32(k)
+            for j in range(nb_):
+                val = re[q + j]
+                up = val > best[j]
+                best[j] = val if up else best[j]
+                kbest[j] = fk if up else kbest[j]
+        # the first lobe's 5 bins count as 0 for the runner-up (host.angle.
+        # _peaks_from_coarse sets them so); their values first
+        for j in range(nb_):
+            kc = int(kbest[j])
+            for o in range(3):
+                c3[j, o] = re[pos[(kc + o - 1) & cmask] * nb_ + j]
+            for o in range(-2, 3):
+                re[pos[(kc + o) & cmask] * nb_ + j] = 0.0
+            top[j] = np.float32(-1.0)
+            ktop[j] = np.float32(0.0)
+        for k in range(coarse):
+            q = pos[k] * nb_
+            fk = np.float32(k)
+            for j in range(nb_):
+                val = re[q + j]
+                up = val > top[j]
+                top[j] = val if up else top[j]
+                ktop[j] = fk if up else ktop[j]
+        for j in range(nb):
+            kc = int(kbest[j])
+            for v in range(nv):
+                rowr[v] = xcr[v, j]
+                rowi[v] = xci[v, j]
+            k0, a, b, c = _fine_search(rowr, rowi, c3[j, 0], c3[j, 1], c3[j, 2], kc, coarse,
+                                       n_fft, dmr, dmi, oc, os_, yr, yi, mag)
+            first = c3[j, 1]
+            k2c = int(ktop[j])
+            if top[j] >= lobe * first:
+                k2, a2, b2, c2 = _fine_search(
+                    rowr, rowi, re[pos[(k2c - 1) & cmask] * nb_ + j], re[pos[k2c] * nb_ + j],
+                    re[pos[(k2c + 1) & cmask] * nb_ + j], k2c, coarse, n_fft, dmr, dmi, oc,
+                    os_, yr, yi, mag)
+                if b2 > b:
+                    k0, a, b, c = k2, a2, b2, c2
+            out_pow[b0 + j] = b * b
+            out_sin[b0 + j] = _interpolated_sin(k0, a, b, c, n_fft)
+
+
+@numba.njit(cache=True, fastmath=True)
+def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.ndarray,
+                      s1: np.ndarray, noise: np.ndarray, snr_lin: float, dyn_lin: float,
+                      screen: bool, outr: np.ndarray, outi: np.ndarray, a1: np.ndarray,
+                      p1: np.ndarray, maybe: np.ndarray) -> None:
+    """:func:`first_components` on split real/imaginary arrays (snr_lin, dyn_lin: the
+    gates as power ratios)."""
+    n_rows, nv = xr.shape
+    ntx = phr.shape[1]
+    nrx = nv // ntx
+    b0 = int(math.ceil(math.sqrt(nv)))
+    nhi = -(-nv // b0)
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(nv)
+    sti = np.empty(nv)
+    for i in range(n_rows):
+        for t in range(ntx):
+            pr = phr[i, t]
+            pi = phi[i, t]
+            for r in range(nrx):
+                v = t * nrx + r
+                outr[i, v] = xr[i, v] * pr - xi[i, v] * pi
+                outi[i, v] = xr[i, v] * pi + xi[i, v] * pr
+        # steering exp(-j pi v s), v = q b0 + p, as host.angle._steering_rows
+        s = s1[i]
+        for p in range(b0):
+            lor[p] = math.cos(math.pi * p * s)
+            loi[p] = -math.sin(math.pi * p * s)
+        for q in range(nhi):
+            hr = math.cos(math.pi * q * b0 * s)
+            hi = -math.sin(math.pi * q * b0 * s)
+            for p in range(b0):
+                v = q * b0 + p
+                if v < nv:
+                    str_[v] = hr * lor[p] - hi * loi[p]
+                    sti[v] = hr * loi[p] + hi * lor[p]
+        sr = 0.0
+        si = 0.0
+        for v in range(nv):                    # conj(st) . x
+            sr += str_[v] * outr[i, v] + sti[v] * outi[i, v]
+            si += str_[v] * outi[i, v] - sti[v] * outr[i, v]
+        ar = sr / nv
+        ai = si / nv
+        a1[i] = complex(ar, ai)
+        p1[i] = ar * ar + ai * ai
+        if screen:
+            e = 0.0
+            for v in range(nv):
+                rr = outr[i, v] - (ar * str_[v] - ai * sti[v])
+                ri = outi[i, v] - (ar * sti[v] + ai * str_[v])
+                e += rr * rr + ri * ri
+            bound = e * (1.0 + 1e-9) / nv
+            maybe[i] = (bound * nv >= snr_lin * noise[i]) and (
+                p1[i] <= dyn_lin * max(bound, 1e-300))
+
+
+def _split(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(real, imaginary) float64 C-contiguous copies of complex x."""
+    return np.ascontiguousarray(x.real, dtype=np.float64), np.ascontiguousarray(
+        x.imag, dtype=np.float64)
+
+
+def _coarse_tables(coarse: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(twiddles float32 re, im (coarse,): exp(+2 pi j k / coarse); pos int (coarse,): the
+    row where :func:`_block_fft` leaves bin k, found by transforming a delta at n = 1,
+    whose bin k is exp(2 pi j k / coarse))."""
+    w = np.exp(2j * np.pi * np.arange(coarse) / coarse)
+    wr, wi = w.real.astype(np.float32), w.imag.astype(np.float32)
+    re = np.zeros((coarse, _BLOCK), np.float32)
+    im = np.zeros((coarse, _BLOCK), np.float32)
+    re[1, 0] = 1.0
+    _block_fft(re, im, wr, wi)
+    k = np.round(np.angle(re[:, 0] + 1j * im[:, 0]) * coarse / (2 * np.pi)).astype(np.int64)
+    pos = np.zeros(coarse, np.int64)
+    pos[k % coarse] = np.arange(coarse)
+    if sorted(k % coarse) != list(range(coarse)):
+        raise AssertionError("_block_fft: output order is not a permutation")
+    return wr, wi, pos
+
+
+_TABLES: dict[tuple[int, int, int], tuple[np.ndarray, ...]] = {}
+
+
+def _tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, ...]:
+    """The kernels' constant tables for n channels, computed once per setting."""
+    key = (n, n_fft, half)
+    if key not in _TABLES:
+        demod, _ = _zoom_tables(n, n_fft, half)
+        coarse = min(COARSE_FFT, n_fft)
+        ang = 2 * np.pi * np.outer(np.arange(1, half + 1), np.arange(n)) / n_fft
+        _TABLES[key] = (*_coarse_tables(coarse), *_split(demod), np.cos(ang), np.sin(ang))
+    return _TABLES[key]
+
+
+def class_peaks(x: np.ndarray, cell: np.ndarray, phasors: np.ndarray, n_fft: int,
+                half: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """Angle peak of TDM-compensated snapshots: row p is snapshot x[cell[p]] with TX t's
+    channels times phasors[p, t] (``host.pipeline._tdm_tx_phasors``); returns
+    ``host.angle.peak_power_lean`` of those rows, (peak power float (m,), sin(az) float
+    (m,)).
+
+    x: complex (n, num_tx * num_rx), virtual channel tx * num_rx + rx; cell: int (m,);
+    phasors: complex (m, num_tx)."""
+    m = len(cell)
+    if x.ndim != 2 or phasors.shape != (m, phasors.shape[1]) or phasors.shape[1] < 1 or \
+            x.shape[1] % phasors.shape[1]:
+        raise ValueError(f"class_peaks: snapshots {x.shape}, phasors {phasors.shape} for "
+                         f"{m} pairs")
+    if x.shape[1] > min(COARSE_FFT, n_fft):
+        raise ValueError(f"class_peaks: {x.shape[1]} channels exceed the coarse FFT "
+                         f"({min(COARSE_FFT, n_fft)})")
+    out_pow, out_sin = np.zeros(m), np.zeros(m)
+    if m:
+        wr, wi, pos, dmr, dmi, oc, os_ = _tables(x.shape[1], n_fft, half)
+        xr, xi = _split(x)
+        phr, phi = _split(phasors)
+        _class_peaks(xr, xi, np.ascontiguousarray(cell, dtype=np.int64), phr, phi, n_fft,
+                     SECOND_LOBE, wr, wi, pos, dmr, dmi, oc, os_, out_pow, out_sin)
+    return out_pow, out_sin
+
+
+def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
+                     noise_per_channel: np.ndarray, min_snr_db: float,
+                     dynamic_range_db: float, screen: bool = True
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The first angle component of each TDM-compensated snapshot and the screen for a
+    second (``host.angle.estimate_angles_screened`` up to its residual search):
+    (compensated rows complex128 (n, n_v), amplitude a1 complex (n,), power |a1|^2 float
+    (n,), ``maybe`` bool (n,): the row may hold a second component).
+
+    x: complex (n, num_tx * num_rx); phasors: complex (n, num_tx) per TX
+    (``host.pipeline._tdm_tx_phasors``); first_sin: float (n,) sin(az) of the row's peak;
+    noise_per_channel: float (n,) (clamped to >= 1e-30 as there); ``screen`` False: no
+    second-component screen (``maybe`` all False)."""
+    n = len(x)
+    if x.ndim != 2 or phasors.shape[0] != n or x.shape[1] % max(phasors.shape[1], 1):
+        raise ValueError(f"first_components: snapshots {x.shape}, phasors {phasors.shape}")
+    xr, xi = _split(x)
+    phr, phi = _split(phasors)
+    outr, outi = np.empty_like(xr), np.empty_like(xi)
+    a1, p1, maybe = np.zeros(n, complex), np.zeros(n), np.zeros(n, bool)
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if n:
+        _first_components(xr, xi, phr, phi, np.ascontiguousarray(first_sin, dtype=float),
+                          noise, 10 ** (min_snr_db / 10), 10 ** (dynamic_range_db / 10),
+                          screen, outr, outi, a1, p1, maybe)
+    return outr + 1j * outi, a1, p1, maybe
+
+
+def peak_sins(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
+    """``host.angle.peak_sin_fast`` of the rows of x, complex (m, n): (sin(az) float (m,),
+    |peak|^2 float (m,)); a ``host.angle.PeakFinder``."""
+    x = np.asarray(x)
+    m = len(x)
+    power, sin = class_peaks(x, np.arange(m), np.ones((m, 1), complex), n_fft)
+    return sin, power

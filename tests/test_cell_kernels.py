@@ -1,0 +1,157 @@
+"""The compiled kernels of ``host.cell_kernels`` against the numpy functions they replace
+(``host.angle.peak_power_lean``, ``peak_sin_fast``, the first half of
+``estimate_angles_screened``, ``estimate_angles_rows``), and the compiled record path
+against the numpy one: the same peaks and decisions, floats equal to rounding."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from host.angle import (
+    AngleParams,
+    _steering_rows,
+    estimate_angles_rows,
+    estimate_angles_screened,
+    peak_power_lean,
+    peak_sin_fast,
+    screened_components,
+)
+from host.bench_detect import synthetic_records
+from host.cell_kernels import class_peaks, first_components, peak_sins
+from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors
+from host.record_points import points_from_snapshots, record_offsets, select_records
+from host.records import record_arrays
+from model.config import get_preset
+
+
+def _rows(rng: np.random.Generator, m: int, n: int, targets: int = 3) -> np.ndarray:
+    """m rows of n channels: up to ``targets`` plane waves 0..40 dB over unit noise, some
+    pairs a beamwidth apart (two lobes of nearly equal height), complex64."""
+    v = np.arange(n)
+    x = (rng.normal(size=(m, n)) + 1j * rng.normal(size=(m, n))) / np.sqrt(2)
+    s0 = rng.uniform(-0.95, 0.95, m)
+    for t in range(targets):
+        amp = 10 ** rng.uniform(0, 2, m) * (rng.random(m) < [1.0, 0.5, 0.3][t])
+        s = s0 + 2.0 / n * (t if rng.random() < 0.5 else rng.uniform(-20, 20))
+        x += amp[:, None] * np.exp(-1j * np.pi * v * s[:, None])
+    return x.astype(np.complex64)
+
+
+@pytest.mark.parametrize("n_fft", [1024, 256, 64])
+def test_class_peaks_are_peak_power_lean(n_fft: int) -> None:
+    """Every (cell, class) pair of 4-TX snapshots, random phasors and cell order; rows that
+    are 0 (every bin ties) and constant; blocks not filled to the end."""
+    cfg = get_preset("full")
+    rng = np.random.default_rng(5)
+    n = 203
+    x = _rows(rng, n, cfg.n_virtual)
+    x[7] = 0
+    x[8] = 1 + 1j
+    cell = rng.integers(0, n, 3 * n + 5)
+    cell[:2] = (7, 8)
+    k = rng.integers(-cfg.n_doppler // 2, cfg.n_doppler // 2, len(cell)) + \
+        rng.integers(0, cfg.num_tx, len(cell)) * cfg.n_doppler
+    ph = _tdm_tx_phasors(cfg, k)
+    got_p, got_s = class_peaks(x, cell, ph, n_fft)
+    want_p, want_s = peak_power_lean(_tdm_compensate(cfg, x.astype(complex)[cell], k), n_fft)
+    np.testing.assert_allclose(got_p, want_p, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(got_s, want_s, rtol=0, atol=1e-12)
+    assert got_p[0] == 0 and np.isfinite(got_s).all()
+
+
+@pytest.mark.parametrize("n", [4, 16, 64, 128])
+def test_peak_sins_are_peak_sin_fast(n: int) -> None:
+    """Single rows of several array sizes (paper-fpga's 4 channels up to the coarse FFT's
+    length)."""
+    rng = np.random.default_rng(n)
+    x = _rows(rng, 150, n).astype(complex)
+    s, p = peak_sins(x, 1024)
+    ws, wp = peak_sin_fast(x, 1024)
+    np.testing.assert_allclose(s, ws, atol=1e-12)
+    np.testing.assert_allclose(p, wp, rtol=1e-9)
+    assert peak_sins(np.zeros((0, n)), 1024)[0].shape == (0,)
+
+
+def test_kernel_inputs_are_checked() -> None:
+    with pytest.raises(ValueError, match="exceed the coarse FFT"):
+        class_peaks(np.zeros((2, 256), complex), np.zeros(2, np.int64), np.ones((2, 1)), 1024)
+    with pytest.raises(ValueError, match="phasors"):
+        class_peaks(np.zeros((2, 64), complex), np.zeros(3, np.int64), np.ones((2, 4)), 1024)
+    with pytest.raises(ValueError, match="phasors"):
+        first_components(np.zeros((2, 64), complex), np.ones((2, 3)), np.zeros(2),
+                         np.ones(2), 12.0, 20.0)
+
+
+def test_first_components_are_the_screened_ones() -> None:
+    """The compensated rows, first amplitude and power, and the screen, against the numpy
+    expressions of ``estimate_angles_screened``; the components after it the same."""
+    cfg = get_preset("full")
+    rng = np.random.default_rng(9)
+    n = 300
+    x = _rows(rng, n, cfg.n_virtual)
+    k = rng.integers(-cfg.n_doppler, cfg.n_doppler, n)
+    ph = _tdm_tx_phasors(cfg, k)
+    xc = _tdm_compensate(cfg, x.astype(complex), k)
+    s1, _ = peak_sin_fast(xc, 1024)
+    noise = rng.uniform(0.5, 2, n)
+    p = AngleParams()
+    xs, a1, p1, maybe = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db)
+    np.testing.assert_allclose(xs, xc, rtol=1e-12, atol=1e-9)
+    want_a = np.sum(np.conj(_steering_rows(s1, cfg.n_virtual)) * xc, axis=1) / cfg.n_virtual
+    np.testing.assert_allclose(a1, want_a, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(p1, np.abs(want_a) ** 2, rtol=1e-9)
+    res = xc - want_a[:, None] * _steering_rows(s1, cfg.n_virtual)
+    bound = np.sum(np.abs(res) ** 2, axis=1) / cfg.n_virtual
+    want_maybe = (bound * cfg.n_virtual / noise >= 10 ** (p.min_snr_db / 10)) & (
+        np.abs(want_a) ** 2 / bound <= 10 ** (p.dynamic_range_db / 10))
+    np.testing.assert_array_equal(maybe, want_maybe)
+    assert 0 < maybe.sum() < n
+    none = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db, screen=False)
+    assert not none[3].any()
+    # and the components that follow: the numpy screened estimator's
+    got = screened_components(xs, noise, p, s1, a1, p1, maybe)
+    want = estimate_angles_screened(xc, noise, p, first_sin=s1)
+    np.testing.assert_array_equal(got.cell, want.cell)
+    np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
+
+
+def test_relax_with_compiled_peaks() -> None:
+    """``estimate_angles_rows`` with the compiled peak search: the components of the FFT
+    peak search (the fine-grid maximum is the same on these rows)."""
+    rng = np.random.default_rng(13)
+    x = _rows(rng, 150, 64).astype(complex)
+    noise = rng.uniform(0.5, 2.0, 150)
+    for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256)):
+        got = estimate_angles_rows(x, noise, p, peaks=peak_sins)
+        want = estimate_angles_rows(x, noise, p)
+        assert len(want.cell) > 150
+        np.testing.assert_array_equal(got.cell, want.cell)
+        np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
+        np.testing.assert_allclose(got.amplitude, want.amplitude, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("preset", ["full", "paper-fpga"])
+def test_compiled_record_path_is_the_numpy_one(preset: str) -> None:
+    """Strong and mixed synthetic frames (aliased velocities, two targets in every 8th
+    cell), several settings: the same points through the kernels as through numpy."""
+    cfg = get_preset(preset)
+    for recs in (synthetic_records(cfg, 400, seed=4),
+                 synthetic_records(cfg, 400, seed=5, varied=True)):
+        arr = record_arrays(recs, cfg.n_virtual, 37.0)
+        for params in (DetectionParams(), DetectionParams(max_speed_mps=30.0),
+                       DetectionParams(unfold_velocity=False)):
+            idx, _ = select_records(arr, cfg, params)
+            cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
+            off = record_offsets(arr.power[idx], arr.neighbours[idx], cells[:, 0],
+                                 cfg.n_range)
+            args = (cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx], off, cfg,
+                    params)
+            a = points_from_snapshots(*args, compiled=True)
+            b = points_from_snapshots(*args, compiled=False)
+            assert len(a) == len(b) > 300
+            for f in ("range_bin", "doppler_bin", "ambiguous"):
+                np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
+            for f in ("range_m", "azimuth_deg", "radial_velocity_mps", "snr_db", "rcs_dbsm"):
+                np.testing.assert_allclose(getattr(a, f), getattr(b, f), rtol=1e-9,
+                                           atol=1e-9)
