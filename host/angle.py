@@ -488,6 +488,7 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
     kmax = params.max_targets
     s_c = np.zeros((m, kmax))
     a_c = np.zeros((m, kmax), complex)
+    st_c = np.zeros((m, kmax, n), complex)  # steer(s_c): each computed once per estimate
     count = np.zeros(m, np.int64)
     first = np.zeros(m)
     residual = xs.copy()
@@ -497,7 +498,8 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
             if not len(live):
                 break
             s, _ = find(residual[live], params.n_fft)
-            a = np.sum(np.conj(steer(s, n)) * residual[live], axis=1) / n
+            st = steer(s, n)
+            a = np.sum(np.conj(st) * residual[live], axis=1) / n
             power = np.abs(a) ** 2
             snr_db = 10 * np.log10(power * n / noise[live])
             stop = np.zeros(len(live), bool)
@@ -506,43 +508,42 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
                     10 * np.log10(first[live] / power) > params.dynamic_range_db)
             keep = ~stop
             live, s, a, power = live[keep], s[keep], a[keep], power[keep]
-            s_c[live, t], a_c[live, t] = s, a
+            s_c[live, t], a_c[live, t], st_c[live, t] = s, a, st[keep]
             count[live] = t + 1
             first[live] = np.where(first[live] != 0, first[live], power)
             if t:
                 xl = xs[live]
+                stl = st_c[live, :t + 1]            # (live, t + 1, n), kept in step below
                 for _ in range(params.refine_iterations):
                     for j in range(t + 1):
                         others = np.zeros((len(live), n), complex)
                         for i in range(t + 1):
                             if i != j:
-                                others = others + a_c[live, i][:, None] * steer(s_c[live, i],
-                                                                                 n)
+                                others = others + a_c[live, i][:, None] * stl[:, i]
                         r = xl - others
                         sj, _ = find(r, params.n_fft)
                         s_c[live, j] = sj
-                        a_c[live, j] = np.sum(np.conj(steer(sj, n)) * r, axis=1) / n
+                        stl[:, j] = steer(sj, n)
+                        a_c[live, j] = np.sum(np.conj(stl[:, j]) * r, axis=1) / n
+                st_c[live, :t + 1] = stl
             total = np.zeros((len(live), n), complex)
             for i in range(t + 1):
-                total = total + a_c[live, i][:, None] * steer(s_c[live, i], n)
+                total = total + a_c[live, i][:, None] * st_c[live, i]
             residual[live] = xs[live] - total
         snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
-    cell, sin_az, amp, snr = [], [], [], []
-    for row in range(m):
-        k = int(count[row])
-        # strongest first (a stable sort, as sorted()), then drop collapsed components
-        order = sorted(range(k), key=lambda i: -abs(a_c[row, i]))
-        kept: list[int] = []
-        for i in order:
-            if all(abs(s_c[row, i] - s_c[row, u]) > 0.5 / n for u in kept):
-                kept.append(i)
-        for i in kept:
-            cell.append(row)
-            sin_az.append(float(s_c[row, i]))
-            amp.append(complex(a_c[row, i]))
-            snr.append(float(snr_c[row, i]))
-    return AngleArrays(np.array(cell, np.int64), np.array(sin_az), np.array(amp, complex),
-                       np.array(snr))
+    # per row: strongest first (a stable sort, as sorted()), then drop collapsed components
+    # (within 0.5 / n in sin of a kept, stronger one); all rows at once
+    valid = np.arange(kmax)[None, :] < count[:, None]
+    order = np.argsort(np.where(valid, -np.abs(a_c), np.inf), axis=1, kind="stable")
+    s_o = np.take_along_axis(s_c, order, axis=1)
+    kept = np.take_along_axis(valid, order, axis=1)
+    for p in range(kmax):
+        for u in range(p):
+            kept[:, p] &= ~kept[:, u] | (np.abs(s_o[:, p] - s_o[:, u]) > 0.5 / n)
+    rows, pos = np.nonzero(kept)
+    comp = order[rows, pos]
+    return AngleArrays(rows.astype(np.int64), s_c[rows, comp], a_c[rows, comp],
+                       snr_c[rows, comp])
 
 
 def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams

@@ -30,6 +30,7 @@ Steps (DESIGN.md section 1, host side):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -340,14 +341,23 @@ def _cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np
         rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
 
 
+@lru_cache(maxsize=8)
+def _unit_circle(n: int) -> np.ndarray:
+    """exp(-2 pi j m / n) for m = 0..n-1, complex (n,), read-only."""
+    w = np.exp(-2j * np.pi * np.arange(n) / n)
+    w.flags.writeable = False
+    return w
+
+
 def _tdm_tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     """:func:`_tdm_comp`'s phasors per TX, complex (..., num_tx): the phase depends on the
-    channel's TX only, so one complex exponential per TX gives the same values."""
+    channel's TX only, so one complex exponential per TX gives the same values (looked up:
+    the phase k t / (n_doppler num_tx) turns is an integer multiple of one step)."""
     k = np.asarray(k)
     k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     k = signed_bin(k, cfg.n_doppler)
-    return np.exp(-2j * np.pi * np.multiply.outer(k, np.arange(cfg.num_tx))
-                  / (cfg.n_doppler * cfg.num_tx))
+    n = cfg.n_doppler * cfg.num_tx
+    return _unit_circle(n)[np.multiply.outer(k, np.arange(cfg.num_tx)) % n]
 
 
 def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarray:
