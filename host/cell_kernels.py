@@ -298,12 +298,20 @@ def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.n
                 outi[i, v] = xr[i, v] * pi + xi[i, v] * pr
         # steering exp(-j pi v s), v = q b0 + p, as host.angle._steering_rows
         s = s1[i]
-        for p in range(b0):
-            lor[p] = math.cos(math.pi * p * s)
-            loi[p] = -math.sin(math.pi * p * s)
+        c1 = math.cos(math.pi * s)
+        d1 = -math.sin(math.pi * s)
+        cb = math.cos(math.pi * b0 * s)
+        db = -math.sin(math.pi * b0 * s)
+        lor[0] = 1.0
+        loi[0] = 0.0
+        for p in range(1, b0):            # powers of exp(-j pi s): a few ulp off the exp
+            lor[p] = lor[p - 1] * c1 - loi[p - 1] * d1
+            loi[p] = lor[p - 1] * d1 + loi[p - 1] * c1
+        hr = 1.0
+        hi = 0.0
         for q in range(nhi):
-            hr = math.cos(math.pi * q * b0 * s)
-            hi = -math.sin(math.pi * q * b0 * s)
+            if q:
+                hr, hi = hr * cb - hi * db, hr * db + hi * cb
             for p in range(b0):
                 v = q * b0 + p
                 if v < nv:
