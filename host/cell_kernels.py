@@ -167,6 +167,27 @@ def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -
 
 
 @numba.njit(cache=True, fastmath=True)
+def _column_max(mag: np.ndarray, pos: np.ndarray, best: np.ndarray, kbest: np.ndarray
+                ) -> None:
+    """The largest coarse bin of each column of a block (``mag`` float32 (coarse *
+    _BLOCK,) flat, bin k in row pos[k]): its value into best and its bin into kbest (float32
+    (_BLOCK,), so that the loop vectorises); natural bin order with a strict >: the first
+    bin on a tie, as np.argmax."""
+    nb = _BLOCK
+    for j in range(nb):
+        best[j] = np.float32(-1.0)
+        kbest[j] = np.float32(0.0)
+    for k in range(pos.shape[0]):
+        q = pos[k] * nb
+        fk = np.float32(k)
+        for j in range(nb):
+            val = mag[q + j]
+            up = val > best[j]
+            best[j] = val if up else best[j]
+            kbest[j] = fk if up else kbest[j]
+
+
+@numba.njit(cache=True, fastmath=True)
 def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarray,
                  phi: np.ndarray, n_fft: int, second_lobe: float, wr: np.ndarray,
                  wi: np.ndarray, pos: np.ndarray, dmr: np.ndarray, dmi: np.ndarray,
@@ -221,19 +242,7 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
         _block_fft(re2, im2, wr, wi)
         for q in range(coarse * nb_):
             re[q] = np.sqrt(re[q] * re[q] + im[q] * im[q])
-        # the largest coarse bin of each column (natural order, strict >: the first on a
-        # tie, as np.argmax); bins as float32 so that the loop vectorises
-        for j in range(nb_):
-            best[j] = np.float32(-1.0)
-            kbest[j] = np.float32(0.0)
-        for k in range(coarse):
-            q = pos[k] * nb_
-            fk = np.float32(k)
-            for j in range(nb_):
-                val = re[q + j]
-                up = val > best[j]
-                best[j] = val if up else best[j]
-                kbest[j] = fk if up else kbest[j]
+        _column_max(re, pos, best, kbest)     # the largest coarse bin of each column
         # the first lobe's 5 bins count as 0 for the runner-up (host.angle.
         # _peaks_from_coarse sets them so); their values first
         for j in range(nb_):
@@ -242,16 +251,7 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
                 c3[j, o] = re[pos[(kc + o - 1) & cmask] * nb_ + j]
             for o in range(-2, 3):
                 re[pos[(kc + o) & cmask] * nb_ + j] = 0.0
-            top[j] = np.float32(-1.0)
-            ktop[j] = np.float32(0.0)
-        for k in range(coarse):
-            q = pos[k] * nb_
-            fk = np.float32(k)
-            for j in range(nb_):
-                val = re[q + j]
-                up = val > top[j]
-                top[j] = val if up else top[j]
-                ktop[j] = fk if up else ktop[j]
+        _column_max(re, pos, top, ktop)
         for j in range(nb):
             kc = int(kbest[j])
             for v in range(nv):

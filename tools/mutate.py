@@ -511,6 +511,10 @@ EQUIVALENT: dict[str, str] = {
     "cfar_2d:rel:14": (
         "if (hi > PR) hi = PR with >= instead of >: the two differ only at hi == PR, where "
         "the assignment writes the value hi already has"),
+    "detect_records:noreset:6": (
+        "st_q left out of reset: reset leaves the FSM in S_CELL, and every entry to S_REC "
+        "(the only state that advances st_q or issues a snapshot word addressed by it) "
+        "loads st_q with 0 first, so its reset value is never used"),
     "corner_turn:drop:4": (
         "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
         "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
