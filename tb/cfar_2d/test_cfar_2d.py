@@ -135,6 +135,27 @@ async def test_random_stalls(dut):
 
 
 @cocotb.test()
+async def test_programmed_scale_table(dut):
+    """A ``cfg_scale`` table that is not the Pfa-derived one: every edge entry different
+    (rows cut below and above by the same count get different scales), so each range-edge
+    row must pick its own entry."""
+    tb = TB(dut)
+    c = tb.cfg
+    f = tb.rng.uniform(0.5, 2.0, len(tb.scale))
+    tb.scale = np.clip(np.rint(tb.scale * f), 1, (1 << c.scale_w) - 1).astype(np.int64)
+    assert len(set(tb.scale.tolist())) == len(tb.scale)
+    dut.cfg_scale.value = cm.pack_scale(tb.scale, c)
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.2, 1))
+    tb.set_backpressure_generator(random_pause(0.2, 2))
+    maps = [tb.random_map() for _ in range(2)]
+    rx = cocotb.start_soon(tb.recv_maps(2))
+    for m in maps:
+        await tb.send_map(m)
+    tb.check(await rx, maps)
+
+
+@cocotb.test()
 async def test_framing_error(dut):
     """A misplaced TLAST is flagged (sticky); cells are still placed by count."""
     tb = TB(dut)
