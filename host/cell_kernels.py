@@ -170,21 +170,21 @@ def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -
 def _column_max(mag: np.ndarray, pos: np.ndarray, best: np.ndarray, kbest: np.ndarray
                 ) -> None:
     """The largest coarse bin of each column of a block (``mag`` float32 (coarse *
-    _BLOCK,) flat, bin k in row pos[k]): its value into best and its bin into kbest (float32
-    (_BLOCK,), so that the loop vectorises); natural bin order with a strict >: the first
-    bin on a tie, as np.argmax."""
+    _BLOCK,) flat, squared magnitudes, bin k in row pos[k]): its value into best and its bin
+    into kbest (float32 (_BLOCK,)); natural bin order with a strict >: the first bin on a
+    tie, as np.argmax (of the squares: two magnitudes that round to the same float32 but
+    whose squares differ are no tie here)."""
     nb = _BLOCK
-    for j in range(nb):
-        best[j] = np.float32(-1.0)
-        kbest[j] = np.float32(0.0)
-    for k in range(pos.shape[0]):
-        q = pos[k] * nb
-        fk = np.float32(k)
-        for j in range(nb):
-            val = mag[q + j]
-            up = val > best[j]
-            best[j] = val if up else best[j]
-            kbest[j] = fk if up else kbest[j]
+    for j in range(nb):             # one column at a time: the running maximum in registers
+        b = np.float32(-1.0)
+        kb = 0
+        for k in range(pos.shape[0]):
+            val = mag[pos[k] * nb + j]
+            if val > b:
+                b = val
+                kb = k
+        best[j] = b
+        kbest[j] = np.float32(kb)
 
 
 @numba.njit(cache=True, fastmath=True)
@@ -240,15 +240,17 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
         re[nv * nb_:] = 0.0
         im[nv * nb_:] = 0.0
         _block_fft(re2, im2, wr, wi)
+        # squared magnitudes (the maxima are the same; a square root only where a
+        # magnitude is used)
         for q in range(coarse * nb_):
-            re[q] = np.sqrt(re[q] * re[q] + im[q] * im[q])
+            re[q] = re[q] * re[q] + im[q] * im[q]
         _column_max(re, pos, best, kbest)     # the largest coarse bin of each column
         # the first lobe's 5 bins count as 0 for the runner-up (host.angle.
-        # _peaks_from_coarse sets them so); their values first
+        # _peaks_from_coarse sets them so); their magnitudes first
         for j in range(nb_):
             kc = int(kbest[j])
             for o in range(3):
-                c3[j, o] = re[pos[(kc + o - 1) & cmask] * nb_ + j]
+                c3[j, o] = np.sqrt(re[pos[(kc + o - 1) & cmask] * nb_ + j])
             for o in range(-2, 3):
                 re[pos[(kc + o) & cmask] * nb_ + j] = 0.0
         _column_max(re, pos, top, ktop)
@@ -261,11 +263,11 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
                                        n_fft, dmr, dmi, oc, os_, yr, yi, mag)
             first = c3[j, 1]
             k2c = int(ktop[j])
-            if top[j] >= lobe * first:
+            if np.sqrt(top[j]) >= lobe * first:
                 k2, a2, b2, c2 = _fine_search(
-                    rowr, rowi, re[pos[(k2c - 1) & cmask] * nb_ + j], re[pos[k2c] * nb_ + j],
-                    re[pos[(k2c + 1) & cmask] * nb_ + j], k2c, coarse, n_fft, dmr, dmi, oc,
-                    os_, yr, yi, mag)
+                    rowr, rowi, np.sqrt(re[pos[(k2c - 1) & cmask] * nb_ + j]),
+                    np.sqrt(re[pos[k2c] * nb_ + j]), np.sqrt(re[pos[(k2c + 1) & cmask] * nb_ + j]),
+                    k2c, coarse, n_fft, dmr, dmi, oc, os_, yr, yi, mag)
                 if b2 > b:
                     k0, a, b, c = k2, a2, b2, c2
             out_pow[b0 + j] = b * b

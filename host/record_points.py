@@ -80,7 +80,9 @@ def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
     j = order[lo[q] + np.arange(len(q)) - first]
     val = weight[j] * env[(pos_q[q] - pos_all[j]) % len(env)]
     out = np.zeros(len(key_q))
-    np.maximum.at(out, q, val)
+    has = lens > 0                  # q runs in blocks, one per cell: a segmented maximum
+    if has.any():
+        out[has] = np.maximum.reduceat(val, (np.cumsum(lens) - lens)[has])
     return out
 
 
