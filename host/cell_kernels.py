@@ -188,17 +188,16 @@ def _column_max(mag: np.ndarray, pos: np.ndarray, best: np.ndarray, kbest: np.nd
 
 
 @numba.njit(cache=True, fastmath=True)
-def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarray,
-                 phi: np.ndarray, n_fft: int, second_lobe: float, wr: np.ndarray,
-                 wi: np.ndarray, pos: np.ndarray, dmr: np.ndarray, dmi: np.ndarray,
-                 oc: np.ndarray, os_: np.ndarray, out_pow: np.ndarray, out_sin: np.ndarray
-                 ) -> None:
-    """:func:`class_peaks` on split real/imaginary arrays; wr, wi float32 (coarse,) the
+def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
+                 second_lobe: float, wr: np.ndarray, wi: np.ndarray, pos: np.ndarray,
+                 dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray, os_: np.ndarray,
+                 out_pow: np.ndarray, out_sin: np.ndarray) -> None:
+    """:func:`class_peaks` (x, ph complex128); wr, wi float32 (coarse,) the
     coarse FFT's twiddles, pos int (coarse,) where :func:`_block_fft` leaves bin k; dm*,
     oc, os_: see :func:`_fine_search`."""
     m = cell.shape[0]
-    nv = xr.shape[1]
-    ntx = phr.shape[1]
+    nv = x.shape[1]
+    ntx = ph.shape[1]
     nrx = nv // ntx
     coarse = pos.shape[0]
     nb_ = _BLOCK
@@ -224,13 +223,15 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
         nb = min(nb_, m - b0)
         for t in range(ntx):                # TDM compensation
             for j in range(nb):
-                pr = phr[b0 + j, t]
-                pi = phi[b0 + j, t]
+                pr = ph[b0 + j, t].real
+                pi = ph[b0 + j, t].imag
                 c = cell[b0 + j]
                 for r in range(nrx):
                     v = t * nrx + r
-                    xcr[v, j] = xr[c, v] * pr - xi[c, v] * pi
-                    xci[v, j] = xr[c, v] * pi + xi[c, v] * pr
+                    xr = x[c, v].real
+                    xi = x[c, v].imag
+                    xcr[v, j] = xr * pr - xi * pi
+                    xci[v, j] = xr * pi + xi * pr
         # coarse FFT of the block, single precision (as host.angle.fine_peaks), the
         # zero-padded rows as columns; magnitudes in place
         for v in range(nv):
@@ -275,14 +276,13 @@ def _class_peaks(xr: np.ndarray, xi: np.ndarray, cell: np.ndarray, phr: np.ndarr
 
 
 @numba.njit(cache=True, fastmath=True)
-def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.ndarray,
-                      s1: np.ndarray, noise: np.ndarray, snr_lin: float, dyn_lin: float,
-                      screen: bool, outr: np.ndarray, outi: np.ndarray, a1: np.ndarray,
-                      p1: np.ndarray, maybe: np.ndarray) -> None:
-    """:func:`first_components` on split real/imaginary arrays (snr_lin, dyn_lin: the
-    gates as power ratios)."""
-    n_rows, nv = xr.shape
-    ntx = phr.shape[1]
+def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.ndarray,
+                      snr_lin: float, dyn_lin: float, screen: bool, out: np.ndarray,
+                      a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray) -> None:
+    """:func:`first_components` (x, ph, out complex128; snr_lin, dyn_lin: the gates as
+    power ratios)."""
+    n_rows, nv = x.shape
+    ntx = ph.shape[1]
     nrx = nv // ntx
     b0 = int(math.ceil(math.sqrt(nv)))
     nhi = -(-nv // b0)
@@ -290,14 +290,19 @@ def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.n
     loi = np.empty(b0)
     str_ = np.empty(nv)
     sti = np.empty(nv)
+    outr = np.empty(nv)
+    outi = np.empty(nv)
     for i in range(n_rows):
         for t in range(ntx):
-            pr = phr[i, t]
-            pi = phi[i, t]
+            pr = ph[i, t].real
+            pi = ph[i, t].imag
             for r in range(nrx):
                 v = t * nrx + r
-                outr[i, v] = xr[i, v] * pr - xi[i, v] * pi
-                outi[i, v] = xr[i, v] * pi + xi[i, v] * pr
+                xr = x[i, v].real
+                xi = x[i, v].imag
+                outr[v] = xr * pr - xi * pi
+                outi[v] = xr * pi + xi * pr
+                out[i, v] = complex(outr[v], outi[v])
         # steering exp(-j pi v s), v = q b0 + p, as host.angle._steering_rows
         s = s1[i]
         c1 = math.cos(math.pi * s)
@@ -322,8 +327,8 @@ def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.n
         sr = 0.0
         si = 0.0
         for v in range(nv):                    # conj(st) . x
-            sr += str_[v] * outr[i, v] + sti[v] * outi[i, v]
-            si += str_[v] * outi[i, v] - sti[v] * outr[i, v]
+            sr += str_[v] * outr[v] + sti[v] * outi[v]
+            si += str_[v] * outi[v] - sti[v] * outr[v]
         ar = sr / nv
         ai = si / nv
         a1[i] = complex(ar, ai)
@@ -331,12 +336,17 @@ def _first_components(xr: np.ndarray, xi: np.ndarray, phr: np.ndarray, phi: np.n
         if screen:
             e = 0.0
             for v in range(nv):
-                rr = outr[i, v] - (ar * str_[v] - ai * sti[v])
-                ri = outi[i, v] - (ar * sti[v] + ai * str_[v])
+                rr = outr[v] - (ar * str_[v] - ai * sti[v])
+                ri = outi[v] - (ar * sti[v] + ai * str_[v])
                 e += rr * rr + ri * ri
             bound = e * (1.0 + 1e-9) / nv
             maybe[i] = (bound * nv >= snr_lin * noise[i]) and (
                 p1[i] <= dyn_lin * max(bound, 1e-300))
+
+
+def _c128(x: np.ndarray) -> np.ndarray:
+    """x as a C-contiguous complex128 array (no copy when it is one)."""
+    return np.ascontiguousarray(x, dtype=np.complex128)
 
 
 def _split(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -397,10 +407,8 @@ def class_peaks(x: np.ndarray, cell: np.ndarray, phasors: np.ndarray, n_fft: int
     out_pow, out_sin = np.zeros(m), np.zeros(m)
     if m:
         wr, wi, pos, dmr, dmi, oc, os_ = _tables(x.shape[1], n_fft, half)
-        xr, xi = _split(x)
-        phr, phi = _split(phasors)
-        _class_peaks(xr, xi, np.ascontiguousarray(cell, dtype=np.int64), phr, phi, n_fft,
-                     SECOND_LOBE, wr, wi, pos, dmr, dmi, oc, os_, out_pow, out_sin)
+        _class_peaks(_c128(x), np.ascontiguousarray(cell, dtype=np.int64), _c128(phasors),
+                     n_fft, SECOND_LOBE, wr, wi, pos, dmr, dmi, oc, os_, out_pow, out_sin)
     return out_pow, out_sin
 
 
@@ -420,16 +428,15 @@ def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
     n = len(x)
     if x.ndim != 2 or phasors.shape[0] != n or x.shape[1] % max(phasors.shape[1], 1):
         raise ValueError(f"first_components: snapshots {x.shape}, phasors {phasors.shape}")
-    xr, xi = _split(x)
-    phr, phi = _split(phasors)
-    outr, outi = np.empty_like(xr), np.empty_like(xi)
+    out = np.empty(x.shape, np.complex128)
     a1, p1, maybe = np.zeros(n, complex), np.zeros(n), np.zeros(n, bool)
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
     if n:
-        _first_components(xr, xi, phr, phi, np.ascontiguousarray(first_sin, dtype=float),
+        _first_components(_c128(x), _c128(phasors),
+                          np.ascontiguousarray(first_sin, dtype=float),
                           noise, 10 ** (min_snr_db / 10), 10 ** (dynamic_range_db / 10),
-                          screen, outr, outi, a1, p1, maybe)
-    return outr + 1j * outi, a1, p1, maybe
+                          screen, out, a1, p1, maybe)
+    return out, a1, p1, maybe
 
 
 def peak_sins(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:

@@ -73,6 +73,13 @@ class TB(AxisTB):
             frames.append(cells)
         return frames
 
+    async def run_maps(self, maps: list[np.ndarray]) -> int:
+        """Send the maps, receive as many frames and check them (:meth:`check`)."""
+        rx = cocotb.start_soon(self.recv_maps(len(maps)))
+        for m in maps:
+            await self.send_map(m)
+        return self.check(await rx, maps)
+
     def check(self, got: list, sent: list[np.ndarray]) -> int:
         """Compare every cell with the model; returns the number of detections."""
         n_det = 0
@@ -148,11 +155,7 @@ async def test_programmed_scale_table(dut):
     await tb.reset()
     tb.set_idle_generator(random_pause(0.2, 1))
     tb.set_backpressure_generator(random_pause(0.2, 2))
-    maps = [tb.random_map() for _ in range(2)]
-    rx = cocotb.start_soon(tb.recv_maps(2))
-    for m in maps:
-        await tb.send_map(m)
-    tb.check(await rx, maps)
+    assert await tb.run_maps([tb.random_map() for _ in range(2)]) > 0
 
 
 @cocotb.test()
