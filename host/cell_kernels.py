@@ -111,9 +111,16 @@ def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -
     them): radix-4 decimation-in-frequency stages, a radix-2 one last when N is not a power
     of 4; natural order in, digit-reversed order out (:func:`_coarse_tables`). wr, wi:
     float32 (N,) exp(2 pi j k / N)."""
+    _fft_stages(re, im, wr, wi, re.shape[0])
+
+
+@numba.njit(cache=True, fastmath=True)
+def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, size: int
+                ) -> None:
+    """The stages of :func:`_block_fft` from sub-transform length ``size`` down (``size``
+    = N: all of them; N / 4 after :func:`_padded_first_stage`)."""
     n = re.shape[0]
     nb = _BLOCK                     # a compile-time trip count: the loops vectorise
-    size = n
     while size >= 4:
         q = size // 4
         stride = n // size
@@ -167,6 +174,44 @@ def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -
 
 
 @numba.njit(cache=True, fastmath=True)
+def _padded_first_stage(xr: np.ndarray, xi: np.ndarray, re: np.ndarray, im: np.ndarray,
+                        wr: np.ndarray, wi: np.ndarray) -> None:
+    """The first radix-4 stage of :func:`_block_fft` on columns zero-padded to N: xr, xi
+    float64 (N / 2, _BLOCK) in (rows past the data 0), float32 re, im (N, _BLOCK) out (the
+    inputs N / 2 .. N - 1 are 0, so each butterfly reads two values, rounded to single
+    precision as the FFT input)."""
+    n = re.shape[0]
+    nb = _BLOCK
+    q = n // 4
+    for k in range(q):
+        w1r = wr[k]
+        w1i = wi[k]
+        w2r = wr[2 * k]
+        w2i = wi[2 * k]
+        w3r = wr[3 * k]
+        w3i = wi[3 * k]
+        for j in range(nb):
+            ar = np.float32(xr[k, j])
+            ai = np.float32(xi[k, j])
+            br = np.float32(xr[k + q, j])
+            bi = np.float32(xi[k + q, j])
+            re[k, j] = ar + br
+            im[k, j] = ai + bi
+            ur = ar - bi                       # a + j b
+            ui = ai + br
+            re[k + q, j] = ur * w1r - ui * w1i
+            im[k + q, j] = ur * w1i + ui * w1r
+            ur = ar - br
+            ui = ai - bi
+            re[k + 2 * q, j] = ur * w2r - ui * w2i
+            im[k + 2 * q, j] = ur * w2i + ui * w2r
+            ur = ar + bi                       # a - j b
+            ui = ai - br
+            re[k + 3 * q, j] = ur * w3r - ui * w3i
+            im[k + 3 * q, j] = ur * w3i + ui * w3r
+
+
+@numba.njit(cache=True, fastmath=True)
 def _column_max(mag: np.ndarray, pos: np.ndarray, best: np.ndarray, kbest: np.ndarray
                 ) -> None:
     """The largest coarse bin of each column of a block (``mag`` float32 (coarse *
@@ -205,8 +250,9 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
     im2 = np.zeros((coarse, nb_), np.float32)
     re = re2.ravel()                   # the same block, flat: (bin, column) at bin * nb_ + column
     im = im2.ravel()
-    xcr = np.zeros((nv, nb_))         # the block's compensated rows as columns, double
-    xci = np.zeros((nv, nb_))
+    # the block's compensated rows as columns, double; rows nv.. stay 0 (the FFT's padding)
+    xcr = np.zeros((max(nv, coarse // 2), nb_))
+    xci = np.zeros((max(nv, coarse // 2), nb_))
     best = np.empty(nb_, np.float32)
     kbest = np.empty(nb_, np.float32)
     top = np.empty(nb_, np.float32)
@@ -234,13 +280,17 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
                     xci[v, j] = xr * pi + xi * pr
         # coarse FFT of the block, single precision (as host.angle.fine_peaks), the
         # zero-padded rows as columns; magnitudes in place
-        for v in range(nv):
-            for j in range(nb_):
-                re[v * nb_ + j] = np.float32(xcr[v, j])
-                im[v * nb_ + j] = np.float32(xci[v, j])
-        re[nv * nb_:] = 0.0
-        im[nv * nb_:] = 0.0
-        _block_fft(re2, im2, wr, wi)
+        if 2 * nv <= coarse:
+            _padded_first_stage(xcr, xci, re2, im2, wr, wi)
+            _fft_stages(re2, im2, wr, wi, coarse // 4)
+        else:
+            for v in range(nv):
+                for j in range(nb_):
+                    re[v * nb_ + j] = np.float32(xcr[v, j])
+                    im[v * nb_ + j] = np.float32(xci[v, j])
+            re[nv * nb_:] = 0.0
+            im[nv * nb_:] = 0.0
+            _block_fft(re2, im2, wr, wi)
         # squared magnitudes (the maxima are the same; a square root only where a
         # magnitude is used)
         for q in range(coarse * nb_):
