@@ -119,24 +119,34 @@ class DetectionParams:
             check_window(self.cfar, (cfg.n_range, cfg.n_doppler))
 
 
-def _dirichlet(x: np.ndarray, n: int) -> np.ndarray:
-    """sum_{t<n} exp(-j 2 pi x t / n) for real x with |x| < n, complex like x."""
-    den = np.sin(np.pi * x / n)
+def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:
+    """The real factor of the Dirichlet kernel D(y) = sum_{t<n} exp(-j 2 pi y t / n) =
+    exp(-j pi y (n - 1) / n) sin(pi y) / sin(pi y / n), float like y (|y| < n; n at y = 0);
+    sin_pi_y: sin(pi y), given (callers share it)."""
+    den = np.sin(np.pi * y / n)
     small = np.abs(den) < 1e-12
-    ratio = np.where(small, n, np.sin(np.pi * x) / np.where(small, 1.0, den))
-    return np.exp(-1j * np.pi * x * (n - 1) / n) * ratio
+    return np.where(small, n, sin_pi_y / np.where(small, 1.0, den))
 
 
 def _window_response(n: int, offset: np.ndarray | float, windowed: bool) -> np.ndarray:
     """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
     a bin centre, float (m,) or scalar; W is the DFT of the periodic Hann window
     (``model.reference.hann_periodic``: 0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the
-    Dirichlet kernel D) or of the rectangular one (D)."""
+    Dirichlet kernel D) or of the rectangular one (D). The three kernels share their phase
+    up to exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
+    |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
+    R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
     x = np.asarray(offset, dtype=float)
-    if windowed:
-        w = 0.5 * _dirichlet(x, n) - 0.25 * _dirichlet(x - 1, n) - 0.25 * _dirichlet(x + 1, n)
-        return np.abs(w) / (n / 2)
-    return np.abs(_dirichlet(x, n)) / n
+    s = np.sin(np.pi * x)
+    r0 = _dirichlet_ratio(x, n, s)
+    if not windowed:
+        return np.abs(r0) / n
+    rm = _dirichlet_ratio(x - 1, n, -s)
+    rp = _dirichlet_ratio(x + 1, n, -s)
+    phi = np.pi * (n - 1) / n
+    re = 0.5 * r0 - 0.25 * np.cos(phi) * (rm + rp)
+    im = 0.25 * np.sin(phi) * (rp - rm)
+    return np.hypot(re, im) / (n / 2)
 
 
 def gaussian_offset(lm: np.ndarray | float, c: np.ndarray | float, lp: np.ndarray | float
