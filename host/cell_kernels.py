@@ -496,3 +496,95 @@ def peak_sins(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     m = len(x)
     power, sin = class_peaks(x, np.arange(m), np.ones((m, 1), complex), n_fft)
     return sin, power
+
+
+@numba.njit(cache=True)
+def _beats(p: np.ndarray, best: int, margin: float) -> bool:
+    """Class ``best``'s power beats every other present class's by ``margin`` (absent
+    classes: -inf; none other present: True)."""
+    mo = -np.inf
+    for c in range(p.shape[0]):
+        if c != best and p[c] > mo:
+            mo = p[c]
+    return mo == -np.inf or p[best] >= margin * mo
+
+
+@numba.njit(cache=True)
+def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, ms: np.ndarray,
+                    vmax: float, max_speed: float, test: bool, margin: float,
+                    min_snr: float, fold: np.ndarray, ambiguous: np.ndarray) -> None:
+    """:func:`fold_decisions` into fold, ambiguous (int64, bool (n,))."""
+    ntx = cp.shape[1]
+    h = ms.shape[0]
+    period = 2.0 * vmax
+    hyp = np.empty(h, np.bool_)
+    p = np.empty(ntx)
+    present = np.empty(ntx, np.bool_)
+    for i in range(v.shape[0]):
+        lo = math.ceil((-max_speed - v[i]) / period)
+        hi = math.floor((max_speed - v[i]) / period)
+        count = 0
+        for k in range(h):
+            hyp[k] = lo <= ms[k] <= hi
+            count += hyp[k]
+        if count == 0:                     # no hypothesis within max_speed: m = 0
+            for k in range(h):
+                hyp[k] = ms[k] == 0
+            count = 1
+        if test and count > 1:
+            for c in range(ntx):
+                present[c] = False
+            for k in range(h):
+                if hyp[k]:
+                    present[ms[k] % ntx] = True
+            for c in range(ntx):
+                p[c] = cp[i, c] if present[c] else -np.inf
+            best = 0
+            for c in range(1, ntx):
+                if p[c] > p[best]:
+                    best = c
+            beats_all = _beats(p, best, margin)
+            if best != 0 and not (beats_all and snr[i] >= min_snr):
+                if present[0]:             # back to the unshifted class when it holds one
+                    best = 0
+                beats_all = _beats(p, best, margin)
+            if beats_all:
+                count = 0
+                for k in range(h):
+                    hyp[k] = hyp[k] and ms[k] % ntx == best
+                    count += hyp[k]
+        kbest = -1
+        dbest = np.inf
+        for k in range(h):                 # the hypothesis nearest zero velocity
+            if hyp[k]:
+                d = abs(v[i] + 2.0 * ms[k] * vmax)
+                if d < dbest:
+                    dbest = d
+                    kbest = k
+        fold[i] = ms[kbest]
+        ambiguous[i] = count > 1 or ms[kbest] != 0
+
+
+def fold_decisions(class_power: np.ndarray, velocity_mps: np.ndarray, snr_db: np.ndarray,
+                   orders: np.ndarray, max_velocity_mps: float, max_speed_mps: float,
+                   test: bool, margin: float, min_snr_db: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The velocity-unfolding decision of ``host.pipeline._choose_fold`` for every cell:
+    (alias order int (n,), ambiguous bool (n,)). Hypotheses: the alias orders m in
+    ``orders`` (int (h,), sorted, 0 among them) with |v + 2 m max_velocity| <=
+    max_speed_mps (m = 0 when none is). With ``test`` and more than one hypothesis the TDM
+    test keeps those of the alias class (m mod num_tx) whose power in class_power (float
+    (n, num_tx)) beats every other present class's by ``margin`` (a power ratio), falling
+    back to class 0 below min_snr_db (snr_db float (n,)); the order nearest zero velocity
+    wins. velocity_mps: float (n,) measured (aliased)."""
+    n = len(velocity_mps)
+    fold = np.zeros(n, np.int64)
+    ambiguous = np.zeros(n, bool)
+    if n:
+        _fold_decisions(np.ascontiguousarray(class_power, dtype=float),
+                        np.ascontiguousarray(velocity_mps, dtype=float),
+                        np.ascontiguousarray(snr_db, dtype=float),
+                        np.ascontiguousarray(orders, dtype=np.int64), float(max_velocity_mps),
+                        float(max_speed_mps), bool(test), float(margin), float(min_snr_db),
+                        fold, ambiguous)
+    return fold, ambiguous

@@ -41,6 +41,7 @@ from host.angle import (
     peak_power_batch,
     peak_power_fast,
 )
+from host.cell_kernels import fold_decisions
 from host.cfar import (
     CfarParams,
     cfar_threshold,
@@ -381,50 +382,21 @@ def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarra
 
 def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.ndarray,
                  snr_db: np.ndarray, params: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_choose_fold` of every cell at once: (alias order int (n,), ambiguous bool (n,)).
+    """:func:`_choose_fold` of every cell at once (compiled,
+    ``host.cell_kernels.fold_decisions``): (alias order int (n,), ambiguous bool (n,)).
     class_power: float (n, num_tx) (``_class_powers``; (n, 0) when the TDM test does not
     run); velocity_mps, snr_db: float (n,)."""
-    n = len(velocity_mps)
     v = np.asarray(velocity_mps, dtype=float)
     period = 2.0 * cfg.max_velocity_mps
+    # the alias orders any cell may take (and 0): |v + m period| <= max_speed
     lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
     hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
-    m_lo = int(min(lo.min(initial=0), 0))
-    m_hi = int(max(hi.max(initial=0), 0))
-    ms = np.arange(m_lo, m_hi + 1)                                       # (h,)
-    hyp = (ms[None, :] >= lo[:, None]) & (ms[None, :] <= hi[:, None])    # (n, h)
-    none = ~hyp.any(axis=1)
-    hyp[none, ms.tolist().index(0)] = True                               # "or [0]"
-    count = hyp.sum(axis=1)
-    ntx = cfg.num_tx
-    if ntx > 1 and params.unfold_velocity and class_power.shape[1] == ntx:
-        run = count > 1
-        cls = ms % ntx                                                   # (h,)
-        present = np.zeros((n, ntx), bool)
-        for c in range(ntx):
-            present[:, c] = (hyp & (cls == c)[None, :]).any(axis=1)
-        p = np.where(present, class_power, -np.inf)
-        margin = 10 ** (params.unfold_margin_db / 10)
-        rows = np.arange(n)
-
-        def beats(best: np.ndarray) -> np.ndarray:
-            others = p.copy()
-            others[rows, best] = -np.inf
-            mo = others.max(axis=1)
-            return (mo == -np.inf) | (p[rows, best] >= margin * mo)
-
-        best = np.argmax(p, axis=1)
-        beats_all = beats(best)
-        back = (best != 0) & ~(beats_all & (snr_db >= params.unfold_min_snr_db))
-        best = np.where(back & present[:, 0], 0, best)
-        beats_all = np.where(back, beats(best), beats_all)
-        keep = run & beats_all
-        hyp = np.where(keep[:, None], hyp & (cls[None, :] == best[:, None]), hyp)
-        count = hyp.sum(axis=1)
-    dist = np.where(hyp, np.abs(v[:, None] + 2.0 * ms[None, :] * cfg.max_velocity_mps),
-                    np.inf)
-    m = ms[np.argmin(dist, axis=1)]
-    return m, (count > 1) | (m != 0)
+    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
+    test = cfg.num_tx > 1 and params.unfold_velocity and class_power.shape[1] == cfg.num_tx
+    return fold_decisions(class_power if test else np.zeros((len(v), cfg.num_tx)), v,
+                          np.asarray(snr_db, dtype=float), ms, cfg.max_velocity_mps,
+                          params.max_speed_mps, test, 10 ** (params.unfold_margin_db / 10),
+                          params.unfold_min_snr_db)
 
 
 def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
