@@ -302,9 +302,14 @@ strongest angle-spectrum peak of each row: :func:`peak_sin_batch` (the ``n_fft``
 FFT's), :func:`peak_sin_fast`, or the compiled ``host.cell_kernels.peak_sins``."""
 
 
+Steering = Callable[[np.ndarray, int], np.ndarray]
+"""A function (s float (m,), n) -> exp(-j pi v s), complex (m, n): :func:`_steering_rows`
+or the compiled ``host.cell_kernels.steering_rows``."""
+
+
 def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.ndarray,
                 a1: np.ndarray, p1: np.ndarray, more: np.ndarray, batched: bool = False,
-                peaks: PeakFinder | None = None
+                peaks: PeakFinder | None = None, steer: Steering | None = None
                 ) -> AngleArrays:
     """The :class:`AngleArrays` of rows xs (complex (n, n_ch)): the first component (sin
     s1, amplitude a1, power p1, float/complex (n,)) where ``more`` (bool (n,)) is False,
@@ -320,7 +325,7 @@ def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.n
     amp: list = []
     snr: list = []
     if batched:
-        got = estimate_angles_rows(xs[multi], noise[multi], params, peaks)
+        got = estimate_angles_rows(xs[multi], noise[multi], params, peaks, steer)
         cell, sin_az, amp, snr = multi[got.cell], got.sin_az, got.amplitude, got.snr_db
     else:
         for i in multi:
@@ -403,29 +408,33 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
 
 def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
                         s1: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray,
-                        peaks: PeakFinder | None = None) -> AngleArrays:
+                        peaks: PeakFinder | None = None, steer: Steering | None = None
+                        ) -> AngleArrays:
     """The second half of :func:`estimate_angles_screened`: rows xs (complex128 (n, n_ch))
     with their first component (sin s1, amplitude a1, power p1: float/complex (n,)) and
     the screen ``maybe`` (bool (n,)); the rows that may hold a second component search
     their residual for it, and those that hold one go through
     :func:`estimate_angles_rows`. noise: float (n,) per channel, >= 1e-30. ``peaks``: the
     peak search of the residuals and of :func:`estimate_angles_rows` (default: the
-    residual's :func:`peak_sin_fast`, and there the ``n_fft``-point FFT)."""
+    residual's :func:`peak_sin_fast`, and there the ``n_fft``-point FFT); ``steer``: the
+    steering vectors (default :func:`_steering_rows`)."""
     n = xs.shape[1]
     more = np.zeros(len(xs), bool)
     rows = np.flatnonzero(maybe)
     if params.max_targets > 1 and len(rows):
-        st1 = _steering_rows(s1[rows], n)
+        steer_fn = steer or _steering_rows
+        st1 = steer_fn(s1[rows], n)
         r = xs[rows] - a1[rows, None] * st1
         s2, _ = (peaks or peak_sin_fast)(r, params.n_fft)
-        st2 = _steering_rows(s2, n)
+        st2 = steer_fn(s2, n)
         p2 = np.abs(np.sum(np.conj(st2) * r, axis=1) / n) ** 2
         with np.errstate(divide="ignore"):
             snr2 = 10 * np.log10(p2 * n / noise[rows])
             more[rows] = (snr2 >= params.min_snr_db) & (
                 10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
                 <= params.dynamic_range_db)
-    return _components(xs, noise, params, s1, a1, p1, more, batched=True, peaks=peaks)
+    return _components(xs, noise, params, s1, a1, p1, more, batched=True, peaks=peaks,
+                       steer=steer)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
@@ -470,7 +479,8 @@ def _steer(s: np.ndarray, n: int) -> np.ndarray:
 
 
 def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
-                         peaks: PeakFinder | None = None) -> AngleArrays:
+                         peaks: PeakFinder | None = None, steer: Steering | None = None
+                         ) -> AngleArrays:
     """:func:`estimate_angles` of every row of x, complex (m, n), noise_per_channel float
     (m,), run on all rows in step (the same components: the same peaks, from the batched
     ``n_fft``-point FFT of :func:`peak_sin_batch`, the same gates, refinement passes in
@@ -479,9 +489,10 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
     ``peaks``: another peak search (:data:`PeakFinder`; e.g. the compiled
     ``host.cell_kernels.peak_sins``, the same fine-grid maximum as the FFT's unless two
     lobes are within the coarse grid's scalloping, ``host.angle.fine_peaks``), with the
-    steering vectors of :func:`_steering_rows` (equal to rounding)."""
+    steering vectors of ``steer`` (default :func:`_steering_rows`; equal to rounding).
+    Without ``peaks``, :func:`_steer` (the same expression as :func:`steering`)."""
     find = peaks or peak_sin_batch
-    steer = _steer if peaks is None else _steering_rows
+    steer = _steer if peaks is None else (steer or _steering_rows)
     xs = np.asarray(x, dtype=np.complex128)
     m, n = xs.shape
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)

@@ -326,6 +326,61 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
 
 
 @numba.njit(cache=True, fastmath=True)
+def _steer_row(s: float, str_: np.ndarray, sti: np.ndarray, lor: np.ndarray,
+               loi: np.ndarray) -> None:
+    """exp(-j pi v s) for v = 0..n-1 into str_, sti (float (n,)), as
+    ``host.angle._steering_rows``: v = q b0 + p with b0 = len(lor) = ceil(sqrt(n)), the
+    products of powers of exp(-j pi s) and of exp(-j pi b0 s) (two sines and cosines; the
+    powers are a few ulp off the exponentials). lor, loi (b0,): scratch."""
+    nv = str_.shape[0]
+    b0 = lor.shape[0]
+    c1 = math.cos(math.pi * s)
+    d1 = -math.sin(math.pi * s)
+    cb = math.cos(math.pi * b0 * s)
+    db = -math.sin(math.pi * b0 * s)
+    lor[0] = 1.0
+    loi[0] = 0.0
+    for p in range(1, b0):
+        lor[p] = lor[p - 1] * c1 - loi[p - 1] * d1
+        loi[p] = lor[p - 1] * d1 + loi[p - 1] * c1
+    hr = 1.0
+    hi = 0.0
+    for q in range(-(-nv // b0)):
+        if q:
+            hr, hi = hr * cb - hi * db, hr * db + hi * cb
+        for p in range(b0):
+            v = q * b0 + p
+            if v < nv:
+                str_[v] = hr * lor[p] - hi * loi[p]
+                sti[v] = hr * loi[p] + hi * lor[p]
+
+
+@numba.njit(cache=True, fastmath=True)
+def _steering(s: np.ndarray, out: np.ndarray) -> None:
+    """:func:`steering_rows` into out (complex128 (m, n))."""
+    m, n = out.shape
+    b0 = int(math.ceil(math.sqrt(n)))
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(n)
+    sti = np.empty(n)
+    for i in range(m):
+        _steer_row(s[i], str_, sti, lor, loi)
+        for v in range(n):
+            out[i, v] = complex(str_[v], sti[v])
+
+
+def steering_rows(s: np.ndarray, n: int) -> np.ndarray:
+    """``host.angle._steering_rows``: exp(-j pi v s) for v = 0..n-1 of every s (float
+    (m,)), complex (m, n); equal to rounding."""
+    s = np.ascontiguousarray(s, dtype=float)
+    out = np.empty((len(s), n), np.complex128)
+    if len(s):
+        _steering(s, out)
+    return out
+
+
+@numba.njit(cache=True, fastmath=True)
 def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.ndarray,
                       snr_lin: float, dyn_lin: float, screen: bool, out: np.ndarray,
                       a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray) -> None:
@@ -335,7 +390,6 @@ def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.n
     ntx = ph.shape[1]
     nrx = nv // ntx
     b0 = int(math.ceil(math.sqrt(nv)))
-    nhi = -(-nv // b0)
     lor = np.empty(b0)
     loi = np.empty(b0)
     str_ = np.empty(nv)
@@ -353,27 +407,7 @@ def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.n
                 outr[v] = xr * pr - xi * pi
                 outi[v] = xr * pi + xi * pr
                 out[i, v] = complex(outr[v], outi[v])
-        # steering exp(-j pi v s), v = q b0 + p, as host.angle._steering_rows
-        s = s1[i]
-        c1 = math.cos(math.pi * s)
-        d1 = -math.sin(math.pi * s)
-        cb = math.cos(math.pi * b0 * s)
-        db = -math.sin(math.pi * b0 * s)
-        lor[0] = 1.0
-        loi[0] = 0.0
-        for p in range(1, b0):            # powers of exp(-j pi s): a few ulp off the exp
-            lor[p] = lor[p - 1] * c1 - loi[p - 1] * d1
-            loi[p] = lor[p - 1] * d1 + loi[p - 1] * c1
-        hr = 1.0
-        hi = 0.0
-        for q in range(nhi):
-            if q:
-                hr, hi = hr * cb - hi * db, hr * db + hi * cb
-            for p in range(b0):
-                v = q * b0 + p
-                if v < nv:
-                    str_[v] = hr * lor[p] - hi * loi[p]
-                    sti[v] = hr * loi[p] + hi * lor[p]
+        _steer_row(s1[i], str_, sti, lor, loi)
         sr = 0.0
         si = 0.0
         for v in range(nv):                    # conj(st) . x

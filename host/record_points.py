@@ -36,7 +36,7 @@ from functools import lru_cache
 import numpy as np
 
 from host.angle import estimate_angles_screened, peak_power_lean, screened_components
-from host.cell_kernels import class_peaks, first_components, peak_sins
+from host.cell_kernels import class_peaks, first_components, peak_sins, steering_rows
 from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
 from host.pipeline import (
     DetectionParams,
@@ -247,7 +247,7 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
         xs, a1, p1, maybe = first_components(x, ph, sn_sel, noise / nv, a.min_snr_db,
                                              a.dynamic_range_db, a.max_targets > 1)
         ang = screened_components(xs, np.maximum(noise / nv, 1e-30), a, sn_sel, a1, p1, maybe,
-                                  peaks=peak_sins)
+                                  peaks=peak_sins, steer=steering_rows)
     return _cloud(cfg, params, r, offsets, sb + fold * nd, ambiguous, ang.cell,
                   ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
 

@@ -18,7 +18,7 @@ from host.angle import (
     screened_components,
 )
 from host.bench_detect import synthetic_records
-from host.cell_kernels import class_peaks, first_components, peak_sins
+from host.cell_kernels import class_peaks, first_components, peak_sins, steering_rows
 from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors
 from host.record_points import points_from_snapshots, record_offsets, select_records
 from host.records import record_arrays
@@ -73,6 +73,13 @@ def test_peak_sins_are_peak_sin_fast(n: int) -> None:
     assert peak_sins(np.zeros((0, n)), 1024)[0].shape == (0,)
 
 
+@pytest.mark.parametrize("n", [1, 4, 17, 64])
+def test_steering_rows_are_the_numpy_ones(n: int) -> None:
+    s = np.random.default_rng(n).uniform(-1, 1, 200)
+    np.testing.assert_allclose(steering_rows(s, n), _steering_rows(s, n), rtol=0, atol=1e-13)
+    assert steering_rows(np.zeros(0), n).shape == (0, n)
+
+
 def test_kernel_inputs_are_checked() -> None:
     with pytest.raises(ValueError, match="exceed the coarse FFT"):
         class_peaks(np.zeros((2, 256), complex), np.zeros(2, np.int64), np.ones((2, 1)), 1024)
@@ -123,7 +130,7 @@ def test_relax_with_compiled_peaks() -> None:
     x = _rows(rng, 150, 64).astype(complex)
     noise = rng.uniform(0.5, 2.0, 150)
     for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256)):
-        got = estimate_angles_rows(x, noise, p, peaks=peak_sins)
+        got = estimate_angles_rows(x, noise, p, peaks=peak_sins, steer=steering_rows)
         want = estimate_angles_rows(x, noise, p)
         assert len(want.cell) > 150
         np.testing.assert_array_equal(got.cell, want.cell)
