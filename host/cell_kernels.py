@@ -10,6 +10,10 @@ named below, without numpy's per-call overhead and temporaries, one pass per cel
 - :func:`first_components`: the TDM-compensated vector of each cell's chosen class, its
   first angle component's amplitude and power, and the Cauchy-Schwarz screen for a second
   one (the first half of ``host.angle.estimate_angles_screened``).
+- :func:`peak_sins`, :func:`steering_rows`: the peak search and steering vectors of RELAX
+  (``host.angle.estimate_angles_rows``) and of the residual search.
+- :func:`fold_decisions`: the velocity-unfolding decision of every cell
+  (``host.pipeline.choose_folds``, the per-cell ``_choose_fold``; both paths use it).
 
 Floating-point sums run in a different order than numpy's (and ``fastmath`` lets the
 compiler reorder them): results agree to rounding; a decision that rests on an exact tie
