@@ -626,3 +626,99 @@ def fold_decisions(class_power: np.ndarray, velocity_mps: np.ndarray, snr_db: np
                         float(max_speed_mps), bool(test), float(margin), float(min_snr_db),
                         fold, ambiguous)
     return fold, ambiguous
+
+
+@numba.njit(cache=True)
+def _select(r: np.ndarray, d: np.ndarray, power: np.ndarray, nbmax: np.ndarray, nr: int,
+            nd: int, lo: int, hi: int, sidelobes: bool, env_r: np.ndarray,
+            env_d: np.ndarray) -> np.ndarray:
+    """:func:`select_cells` (nbmax: float (n,) the largest neighbour power, 0 when not
+    known; env_*: the sidelobe envelopes times the margin)."""
+    n = r.shape[0]
+    pmap = np.zeros((nr, nd))
+    idx1 = np.zeros((nr, nd), np.int64)         # record index + 1 (the last one wins)
+    for i in range(n):
+        pmap[r[i], d[i]] = power[i]
+        idx1[r[i], d[i]] = i + 1
+    own = np.zeros(n, np.bool_)                  # the records that are the map's non-zeros
+    for i in range(n):
+        own[i] = idx1[r[i], d[i]] == i + 1 and pmap[r[i], d[i]] > 0
+    cand = np.empty(n, np.int64)
+    nc = 0
+    for i in range(n):
+        if not own[i] or r[i] < lo or r[i] >= hi:
+            continue
+        p = pmap[r[i], d[i]]
+        mx = max(p, nbmax[i])
+        for a in range(-1, 2):
+            for b in range(-1, 2):
+                if a or b:
+                    mx = max(mx, pmap[(r[i] + a) % nr, (d[i] + b) % nd])
+        if p >= mx:
+            cand[nc] = i
+            nc += 1
+    cand = cand[:nc]
+    cand = cand[np.argsort(r[cand] * nd + d[cand], kind="mergesort")]
+    if not sidelobes or nc == 0:
+        return cand
+    # the non-zero cells grouped by column and by row (counting sort)
+    col_start = np.zeros(nd + 1, np.int64)
+    row_start = np.zeros(nr + 1, np.int64)
+    for i in range(n):
+        if own[i]:
+            col_start[d[i] + 1] += 1
+            row_start[r[i] + 1] += 1
+    for k in range(nd):
+        col_start[k + 1] += col_start[k]
+    for k in range(nr):
+        row_start[k + 1] += row_start[k]
+    col_rows = np.empty(col_start[nd], np.int64)
+    row_cols = np.empty(row_start[nr], np.int64)
+    col_fill = col_start[:nd].copy()
+    row_fill = row_start[:nr].copy()
+    for i in range(n):
+        if own[i]:
+            col_rows[col_fill[d[i]]] = r[i]
+            col_fill[d[i]] += 1
+            row_cols[row_fill[r[i]]] = d[i]
+            row_fill[r[i]] += 1
+    keep = np.empty(nc, np.bool_)
+    for c in range(nc):
+        i = cand[c]
+        p = pmap[r[i], d[i]]
+        masked = False
+        for k in range(col_start[d[i]], col_start[d[i] + 1]):
+            rr = col_rows[k]
+            if pmap[rr, d[i]] * env_r[(r[i] - rr) % nr] > p:
+                masked = True
+        for k in range(row_start[r[i]], row_start[r[i] + 1]):
+            dd = row_cols[k]
+            if pmap[r[i], dd] * env_d[(d[i] - dd) % nd] > p:
+                masked = True
+        keep[c] = not masked
+    return cand[keep]
+
+
+def select_cells(range_bin: np.ndarray, doppler_bin: np.ndarray, power: np.ndarray,
+                 neighbour_max: np.ndarray | None, shape: tuple[int, int],
+                 bins: tuple[int, int], envelopes: tuple[np.ndarray, np.ndarray] | None
+                 ) -> np.ndarray:
+    """The records that become points (``host.record_points.select_records``): indices int
+    (m,) in (range, Doppler) order of the records that hold their cell (the last record of a
+    cell wins, power > 0), lie in range bins ``bins`` = [lo, hi), are no weaker than any
+    of the 8 cells around them on the map of detected powers (both axes circular) nor than
+    ``neighbour_max`` (float (n,), their largest neighbour power, detected or not), and,
+    with ``envelopes`` (range, Doppler sidelobe envelopes times the margin, float
+    (n_range,), (n_doppler,)), are not below the sidelobes of a detected cell in their
+    column or row. range_bin, doppler_bin: int (n,); power: float (n,); shape: (n_range,
+    n_doppler)."""
+    n = len(range_bin)
+    nbmax = np.zeros(n) if neighbour_max is None else np.asarray(neighbour_max, dtype=float)
+    z = np.zeros(1)
+    env_r, env_d = envelopes if envelopes is not None else (z, z)
+    return _select(np.ascontiguousarray(range_bin, dtype=np.int64),
+                   np.ascontiguousarray(doppler_bin, dtype=np.int64),
+                   np.ascontiguousarray(power, dtype=float), np.ascontiguousarray(nbmax),
+                   int(shape[0]), int(shape[1]), int(bins[0]), int(bins[1]),
+                   envelopes is not None, np.ascontiguousarray(env_r, dtype=float),
+                   np.ascontiguousarray(env_d, dtype=float))

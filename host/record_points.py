@@ -36,7 +36,13 @@ from functools import lru_cache
 import numpy as np
 
 from host.angle import estimate_angles_screened, peak_power_lean, screened_components
-from host.cell_kernels import class_peaks, first_components, peak_sins, steering_rows
+from host.cell_kernels import (
+    class_peaks,
+    first_components,
+    peak_sins,
+    select_cells,
+    steering_rows,
+)
 from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
 from host.pipeline import (
     DetectionParams,
@@ -65,27 +71,6 @@ def record_offsets(power: np.ndarray, neighbours: np.ndarray, range_bin: np.ndar
     return neighbour_offsets(logc, lognb, (r > 0) & (r < n_range - 1))
 
 
-def _group_max(key_q: np.ndarray, key_all: np.ndarray, weight: np.ndarray,
-               order: np.ndarray, env: np.ndarray, pos_q: np.ndarray, pos_all: np.ndarray
-               ) -> np.ndarray:
-    """max over cells j with key_all[j] == key_q[i] of weight[j] * env[(pos_q[i] -
-    pos_all[j]) mod len(env)], float (m,) (0 when there is none); ``order``: int, the
-    permutation that sorts key_all."""
-    ks = key_all[order]
-    lo = np.searchsorted(ks, key_q, "left")
-    hi = np.searchsorted(ks, key_q, "right")
-    lens = hi - lo
-    q = np.repeat(np.arange(len(key_q)), lens)
-    first = np.repeat(np.cumsum(lens) - lens, lens)
-    j = order[lo[q] + np.arange(len(q)) - first]
-    val = weight[j] * env[(pos_q[q] - pos_all[j]) % len(env)]
-    out = np.zeros(len(key_q))
-    has = lens > 0                  # q runs in blocks, one per cell: a segmented maximum
-    if has.any():
-        out[has] = np.maximum.reduceat(val, (np.cumsum(lens) - lens)[has])
-    return out
-
-
 @lru_cache(maxsize=16)
 def _envelope(n: int, windowed: bool, margin_db: float) -> np.ndarray:
     """``host.cfar.sidelobe_envelope`` times the margin, float (n,), computed once per
@@ -95,59 +80,21 @@ def _envelope(n: int, windowed: bool, margin_db: float) -> np.ndarray:
     return env
 
 
-def sparse_sidelobe_masked(pmap: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
-                           margin_db: float, nonzero: tuple[np.ndarray, np.ndarray] | None = None
-                           ) -> np.ndarray:
-    """``host.cfar.sidelobe_masked`` of a map that is 0 except at detected cells (the
-    records' map): only detected cells of the same column / row can mask, so the test runs
-    over those pairs instead of whole columns and rows (same result). pmap: float
-    (n_range, n_doppler); cells: int (m, 2); ``nonzero``: (rows, columns) of pmap's
-    non-zero cells when the caller knows them. Returns bool (m,)."""
-    nr, nd = pmap.shape
-    env_r = _envelope(nr, windowed[0], margin_db)
-    env_d = _envelope(nd, windowed[1], margin_db)
-    rr, dd = np.nonzero(pmap) if nonzero is None else nonzero
-    w = pmap[rr, dd]
-    r, d = cells[:, 0], cells[:, 1]
-    col = _group_max(d, dd, w, np.argsort(dd, kind="stable"), env_r, r, rr)
-    row = _group_max(r, rr, w, np.argsort(rr, kind="stable"), env_d, d, dd)
-    p = pmap[r, d]
-    return (col > p) | (row > p)
-
-
 def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
-                   ) -> tuple[np.ndarray, np.ndarray]:
+                   ) -> tuple[np.ndarray, None]:
     """Indices (int (m,)) of the records that become points (steps 1 to 3), in (range,
-    Doppler) order, and the map of detected powers, float (n_range, n_doppler) (0 where
-    nothing was detected). Works on the records alone (a 3x3 gather per record, pairs of
-    records in a row or column), with the result of ``host.cfar.local_peaks`` and
+    Doppler) order, and None (the reference returns its map there). Works on the records
+    alone (compiled, ``host.cell_kernels.select_cells``: a 3x3 gather per record, pairs
+    of detected cells in a row or column), with the result of ``host.cfar.local_peaks`` and
     ``host.cfar.sidelobe_masked`` on the map (:func:`select_records_reference`)."""
     nr, nd = cfg.n_range, cfg.n_doppler
-    pmap = np.zeros((nr, nd))
-    index1 = np.zeros((nr, nd), np.int64)     # record index + 1 (zeros: pages never touched
-    pmap[arr.range_bin, arr.doppler_bin] = arr.power          # cost nothing)
-    index1[arr.range_bin, arr.doppler_bin] = np.arange(1, len(arr) + 1)
-    lo, hi = cfg.detection_bins
-    r, d = arr.range_bin, arr.doppler_bin
-    own = (index1[r, d] == np.arange(1, len(arr) + 1)) & (pmap[r, d] > 0)  # pmap's non-zeros
-    nonzero = (r[own], d[own])
-    i = np.flatnonzero(own & (r >= lo) & (r < hi))
-    r, d = r[i], d[i]
-    p = pmap[r, d]
-    mx = p.copy() if arr.neighbours is None else np.maximum(p, arr.neighbours[i].max(axis=1))
-    for a in (-1, 0, 1):
-        for b in (-1, 0, 1):
-            if a or b:
-                np.maximum(mx, pmap[(r + a) % nr, (d + b) % nd], out=mx)
-    peak = p >= mx
-    i, r, d = i[peak], r[peak], d[peak]
-    order = np.argsort(r * nd + d, kind="stable")
-    i, cells = i[order], np.stack([r[order], d[order]], axis=1)
-    windowed = (params.range_window, params.doppler_window)
-    if params.sidelobe_margin_db is not None and len(cells):
-        i = i[~sparse_sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db,
-                                      nonzero)]
-    return i, pmap
+    envelopes = None
+    if params.sidelobe_margin_db is not None:
+        envelopes = (_envelope(nr, params.range_window, params.sidelobe_margin_db),
+                     _envelope(nd, params.doppler_window, params.sidelobe_margin_db))
+    nbmax = None if arr.neighbours is None else arr.neighbours.max(axis=1, initial=0.0)
+    return select_cells(arr.range_bin, arr.doppler_bin, arr.power, nbmax, (nr, nd),
+                        cfg.detection_bins, envelopes), None
 
 
 def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
