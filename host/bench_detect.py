@@ -15,12 +15,13 @@ cost on the link and on the host. Prints four tables:
    (goal: fits the paper's measured 766 Mbit/s);
 4. host time per frame for 10, 100, 1000 detections on one core, CPU and wall, the replaced
    code ("old": ``Record`` objects, ``process_records_reference``) beside the current one
-   (arrays, ``process_records``, and the same without the compiled kernels of
-   ``host.cell_kernels``) in the same run: DMA bytes -> records (decoder), records ->
-   point cloud, and both (goal <= 5 ms for 1000), on strong isolated targets and on a mixed
-   frame (``synthetic_records(varied=True)``). One core: the process is pinned to one CPU
-   and the BLAS / OpenMP pools get one thread (set before numpy loads). Table 1 also gives
-   the azimuth errors of both, and in how many scenes old and new clouds agree.
+   (arrays, ``process_records``, and the same with the angle work of
+   ``points_from_snapshots`` in numpy, ``compiled=False``) in the same run: DMA bytes ->
+   records (decoder), records -> point cloud, and both (goal <= 5 ms for 1000), on strong
+   isolated targets and on a mixed frame (``synthetic_records(varied=True)``). One core:
+   the process is pinned to one CPU and the BLAS / OpenMP pools get one thread (set before
+   numpy loads). Table 1 also gives the azimuth errors of both, and in how many scenes old
+   and new clouds agree.
 
     python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
                                 [--repeat 5] [--host-only]
@@ -287,8 +288,8 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
     in one go, points) for one frame of ``n`` synthetic records (``varied``: see
     :func:`synthetic_records`); ``reference``: through the replaced code (``Record``
     objects from ``model.detect_records.decode_frame``, ``record_arrays_reference``,
-    ``process_records_reference``); ``compiled`` False: the current code without the
-    compiled kernels (``host.cell_kernels``)."""
+    ``process_records_reference``); ``compiled`` False: the current code with the angle
+    work of ``points_from_snapshots`` in numpy."""
     cfg = get_preset(preset)
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
@@ -398,7 +399,8 @@ def host_table(args: argparse.Namespace) -> None:
     print(f"\n## Host time per full frame, one core (best of {args.repeat}; CPU = "
           f"process_time, wall = perf_counter; old = the replaced code, same run; "
           f"10^6 complex multiplications take {calibration_ms(args.repeat):.2f} ms CPU here)")
-    print("| detections | frame | step | old CPU ms | new, numpy only, CPU ms | new CPU ms | "
+    print("| detections | frame | step | old CPU ms | new, angle work in numpy, CPU ms | "
+          "new CPU ms | "
           "old wall ms | new wall ms | CPU speed-up |")
     print("|---|---|---|---|---|---|---|---|---|")
     for varied in (False, True):

@@ -145,8 +145,9 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
     points) with less work: angle peaks (``host.angle.fine_peaks``) only of the TDM alias
     classes in :func:`hypothesis_classes` (the others do not enter ``choose_folds``), and
     the second-component search screened (``host.angle.estimate_angles_screened``).
-    ``compiled``: the class peaks and first angle components by the compiled kernels of
-    ``host.cell_kernels`` (default); False: by numpy (the same values to rounding).
+    ``compiled``: the class peaks, first angle components, steering vectors and RELAX peak
+    searches by the compiled kernels of ``host.cell_kernels`` (default); False: by numpy
+    (the same values to rounding).
 
     cells: int (n, 2) (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual); power, noise: float (n,); offsets: float (n, 2) bins."""
@@ -221,7 +222,7 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     record selection (steps 1 to 3), peak offsets (step 4), :func:`points_from_snapshots`.
     The public records -> point cloud function (CLI, live view). ``reference``: run the
     replaced implementation (:func:`process_records_reference`; benchmark, tests);
-    ``compiled`` False: :func:`points_from_snapshots` in numpy only (benchmark)."""
+    ``compiled`` False: the angle work of :func:`points_from_snapshots` in numpy (benchmark)."""
     params = params or DetectionParams()
     _check_channels(arr, cfg)
     if reference:
