@@ -283,7 +283,7 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
                     xcr[v, j] = xr * pr - xi * pi
                     xci[v, j] = xr * pi + xi * pr
         # coarse FFT of the block, single precision (as host.angle.fine_peaks), the
-        # zero-padded rows as columns; magnitudes in place
+        # zero-padded rows as columns
         if 2 * nv <= coarse:
             _padded_first_stage(xcr, xci, re2, im2, wr, wi)
             _fft_stages(re2, im2, wr, wi, coarse // 4)

@@ -380,6 +380,20 @@ def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarra
     return (xt * ph[..., None]).reshape(*ph.shape[:-1], cfg.n_virtual)
 
 
+def alias_orders(cfg: RadarConfig, velocity_mps: np.ndarray, params: DetectionParams
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The velocity hypotheses of every cell: alias orders m with |v + 2 m max_velocity| <=
+    max_speed_mps, as (lo, hi) int (n,), the range lo..hi of each cell (empty when lo > hi:
+    the cell then takes m = 0), and ms int (h,), every order any cell may take, and 0.
+    velocity_mps: float (n,) measured (aliased)."""
+    v = np.asarray(velocity_mps, dtype=float)
+    period = 2.0 * cfg.max_velocity_mps
+    lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
+    hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
+    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
+    return lo, hi, ms
+
+
 def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.ndarray,
                  snr_db: np.ndarray, params: DetectionParams) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_choose_fold` of every cell at once (compiled,
@@ -387,11 +401,7 @@ def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.nda
     class_power: float (n, num_tx) (``_class_powers``; (n, 0) when the TDM test does not
     run); velocity_mps, snr_db: float (n,)."""
     v = np.asarray(velocity_mps, dtype=float)
-    period = 2.0 * cfg.max_velocity_mps
-    # the alias orders any cell may take (and 0): |v + m period| <= max_speed
-    lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
-    hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
-    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
+    _, _, ms = alias_orders(cfg, v, params)
     test = cfg.num_tx > 1 and params.unfold_velocity and class_power.shape[1] == cfg.num_tx
     return fold_decisions(class_power if test else np.zeros((len(v), cfg.num_tx)), v,
                           np.asarray(snr_db, dtype=float), ms, cfg.max_velocity_mps,

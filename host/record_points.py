@@ -49,6 +49,7 @@ from host.pipeline import (
     _cloud,
     _tdm_compensate,
     _tdm_tx_phasors,
+    alias_orders,
     choose_folds,
     neighbour_offsets,
     points_from_cells,
@@ -81,9 +82,9 @@ def _envelope(n: int, windowed: bool, margin_db: float) -> np.ndarray:
 
 
 def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
-                   ) -> tuple[np.ndarray, None]:
+                   ) -> np.ndarray:
     """Indices (int (m,)) of the records that become points (steps 1 to 3), in (range,
-    Doppler) order, and None (the reference returns its map there). Works on the records
+    Doppler) order. Works on the records
     alone (compiled, ``host.cell_kernels.select_cells``: a 3x3 gather per record, pairs
     of detected cells in a row or column), with the result of ``host.cfar.local_peaks`` and
     ``host.cfar.sidelobe_masked`` on the map (:func:`select_records_reference`)."""
@@ -94,13 +95,14 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
                      _envelope(nd, params.doppler_window, params.sidelobe_margin_db))
     nbmax = None if arr.neighbours is None else arr.neighbours.max(axis=1, initial=0.0)
     return select_cells(arr.range_bin, arr.doppler_bin, arr.power, nbmax, (nr, nd),
-                        cfg.detection_bins, envelopes), None
+                        cfg.detection_bins, envelopes)
 
 
 def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
                              ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`select_records` on the whole map (``host.cfar.local_peaks``,
-    ``host.cfar.sidelobe_masked``): the specification, and the benchmark's old path."""
+    ``host.cfar.sidelobe_masked``): the specification, and the benchmark's old path; also
+    returns that map of detected powers, float (n_range, n_doppler)."""
     nr, nd = cfg.n_range, cfg.n_doppler
     pmap = np.zeros((nr, nd))
     index = np.full((nr, nd), -1, np.int64)
@@ -124,14 +126,10 @@ def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, params: Detec
     hypotheses of ``host.pipeline.choose_folds``: |v + 2 m vmax| <= max_speed, m = 0 when
     none is), bool (n, num_tx); velocity_mps: float (n,) measured (aliased). Only these
     classes' powers enter the unfolding decision."""
-    v = np.asarray(velocity_mps, dtype=float)
-    period = 2.0 * cfg.max_velocity_mps
-    lo = np.ceil((-params.max_speed_mps - v) / period).astype(np.int64)
-    hi = np.floor((params.max_speed_mps - v) / period).astype(np.int64)
-    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
+    lo, hi, ms = alias_orders(cfg, velocity_mps, params)
     hyp = (ms[None, :] >= lo[:, None]) & (ms[None, :] <= hi[:, None])
     hyp[~hyp.any(axis=1), ms.tolist().index(0)] = True
-    present = np.zeros((len(v), cfg.num_tx), bool)
+    present = np.zeros((len(lo), cfg.num_tx), bool)
     for c in range(cfg.num_tx):
         present[:, c] = hyp[:, ms % cfg.num_tx == c].any(axis=1)
     return present
@@ -227,7 +225,7 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     _check_channels(arr, cfg)
     if reference:
         return process_records_reference(arr, cfg, params, frame)
-    idx, _ = select_records(arr, cfg, params)
+    idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
     return points_from_snapshots(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
@@ -243,7 +241,7 @@ def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
     ``select_records_reference`` and ``host.pipeline.points_from_cells_reference``."""
     params = params or DetectionParams()
     _check_channels(arr, cfg)
-    idx, _ = select_records(arr, cfg, params)
+    idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
     return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],

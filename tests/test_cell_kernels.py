@@ -148,7 +148,7 @@ def test_compiled_record_path_is_the_numpy_one(preset: str) -> None:
         arr = record_arrays(recs, cfg.n_virtual, 37.0)
         for params in (DetectionParams(), DetectionParams(max_speed_mps=30.0),
                        DetectionParams(unfold_velocity=False)):
-            idx, _ = select_records(arr, cfg, params)
+            idx = select_records(arr, cfg, params)
             cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
             off = record_offsets(arr.power[idx], arr.neighbours[idx], cells[:, 0],
                                  cfg.n_range)

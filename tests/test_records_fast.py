@@ -153,11 +153,11 @@ def test_select_records_matches_reference() -> None:
                         RecordArrays(r, d, pw, np.ones(n), snap, nb)):
                 for p in (DetectionParams(), DetectionParams(sidelobe_margin_db=None),
                           DetectionParams(range_window=False, doppler_window=False)):
-                    np.testing.assert_array_equal(select_records(arr, cfg, p)[0],
+                    np.testing.assert_array_equal(select_records(arr, cfg, p),
                                                   select_records_reference(arr, cfg, p)[0])
             if n > 10:                    # a stronger direct neighbour drops the record
                 kept = set(select_records(RecordArrays(r, d, pw, np.ones(n), snap, nb), cfg,
-                                          DetectionParams())[0].tolist())
+                                          DetectionParams()).tolist())
                 assert not any(nb[k].max() > pw[k] for k in kept)
 
 
@@ -220,7 +220,7 @@ def test_points_match_reference(preset: str) -> None:
             np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9, err_msg=f.name)
         else:
             np.testing.assert_array_equal(a, b, err_msg=f.name)
-    idx, _ = select_records(arr, cfg, params)
+    idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     off = np.zeros((len(idx), 2))
     a = points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx], off, cfg,
