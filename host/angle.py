@@ -390,10 +390,22 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
         z = np.zeros(0)
         return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
     s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
+    a1, p1, maybe = first_component_screen(xs, noise, params, s1)
+    return screened_components(xs, noise, params, s1, a1, p1, maybe)
+
+
+def first_component_screen(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
+                           s1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The first half of :func:`estimate_angles_screened`: the first component of rows xs
+    (complex128 (n, n_ch)) at sin s1 (float (n,)), amplitude a1 complex (n,) and power p1
+    float (n,), and ``maybe`` bool (n,): the Cauchy-Schwarz bound of the residual leaves
+    room for a second component (all False when ``params.max_targets`` is 1). noise: float
+    (n,) per channel, >= 1e-30."""
+    n = xs.shape[1]
     st1 = _steering_rows(s1, n)
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2
-    maybe = np.zeros(n_rows, bool)
+    maybe = np.zeros(len(xs), bool)
     if params.max_targets > 1:
         res = xs - a1[:, None] * st1
         # upper bound of p2 (1e-9: far above the rounding of either side)
@@ -403,7 +415,7 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
         with np.errstate(divide="ignore", invalid="ignore"):
             maybe = (10 * np.log10(bound * n / noise) >= params.min_snr_db) & (
                 10 * np.log10(p1 / np.maximum(bound, 1e-300)) <= params.dynamic_range_db)
-    return screened_components(xs, noise, params, s1, a1, p1, maybe)
+    return a1, p1, maybe
 
 
 def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
