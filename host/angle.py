@@ -127,13 +127,17 @@ def _zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]
     return demod, offs
 
 
+ZOOM_HALF = 2
+"""The fine-grid search of :func:`fine_peaks` evaluates 2 ZOOM_HALF + 1 fine bins per step."""
+
+
 SECOND_LOBE = 0.8
 """A coarse local maximum at least this fraction of the coarse maximum (amplitude) is
 refined as well (two nearly equal lobes: the coarse grid's scalloping, at most 0.91 dB
 at 2x oversampling, could rank them wrongly)."""
 
 
-def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
+def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = ZOOM_HALF
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Maximum of |angle spectrum| on the ``n_fft``-point grid, found without the
     ``n_fft``-point FFT: a ``coarse``-point FFT (single precision) picks the lobe (the
@@ -155,7 +159,7 @@ def fine_peaks(x: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 
     return _peaks_from_coarse(np.asarray(x, dtype=np.complex128), cm, n_fft, half)
 
 
-def fine_peaks_lean(xd: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = 2
+def fine_peaks_lean(xd: np.ndarray, n_fft: int, coarse: int = COARSE_FFT, half: int = ZOOM_HALF
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`fine_peaks` (same result) of xd, complex128 (m, n), with one copy less: the
     single-precision rows are written into the zero-padded FFT buffer directly and the

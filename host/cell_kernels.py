@@ -28,7 +28,10 @@ import math
 import numba
 import numpy as np
 
-from host.angle import COARSE_FFT, SECOND_LOBE, _zoom_tables
+from host.angle import COARSE_FFT, SECOND_LOBE, ZOOM_HALF, _zoom_tables
+
+if ZOOM_HALF != 2:
+    raise ImportError("host.cell_kernels: _fine_search sums a 5-bin window (ZOOM_HALF = 2)")
 
 _BLOCK = 16
 """(cell, class) pairs per coarse-FFT block: 2 x 128 x 16 float32, 16 KiB, stays in L1."""
@@ -37,18 +40,17 @@ _BLOCK = 16
 @numba.njit(cache=True, fastmath=True)
 def _fine_search(xr: np.ndarray, xi: np.ndarray, ca: float, cb: float, cc: float, kc: int,
                  coarse: int, n_fft: int, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
-                 os_: np.ndarray, yr: np.ndarray, yi: np.ndarray, mag: np.ndarray
-                 ) -> tuple[int, float, float, float]:
+                 os_: np.ndarray, mag: np.ndarray) -> tuple[int, float, float, float]:
     """``host.angle._refine`` of one row x (float64 xr, xi (n,)) from coarse bin kc, whose
     coarse magnitudes (float32) at kc - 1, kc, kc + 1 are ca, cb, cc: (fine bin,
     |X(k - 1)|, |X(k)|, |X(k + 1)|).
-    The window is the 2 half + 1 fine bins centre - half .. centre + half; after
-    demodulating by the centre (dm*: exp(2 pi j v k / n_fft) per fine bin k), bins
-    centre +- o are A_o +- j B_o with A_o, B_o the sums of y_v cos and y_v sin(2 pi v o /
-    n_fft) (oc, os_: float (half, n)): half the multiplications of a complex product per
-    bin. yr, yi (n,), mag (2 half + 1,): scratch."""
+    The window is the 5 fine bins centre - 2 .. centre + 2 (``host.angle.ZOOM_HALF``);
+    with y = x demodulated by the centre (dm*: exp(2 pi j v k / n_fft) per fine bin k),
+    bins centre +- o are A_o +- j B_o with A_o, B_o the sums of y_v cos and y_v sin(2 pi v o
+    / n_fft) (oc, os_: float (2, n)): half the multiplications of a complex product per
+    bin, all ten sums in one pass over the channels. mag (5,): scratch."""
     n = xr.shape[0]
-    half = oc.shape[0]
+    half = ZOOM_HALF
     w = 2 * half + 1
     step = n_fft // coarse
     den = ca - np.float32(2.0) * cb + cc
@@ -62,29 +64,39 @@ def _fine_search(xr: np.ndarray, xi: np.ndarray, ca: float, cb: float, cc: float
     for it in range(max_it):
         zr = 0.0
         zi = 0.0
+        a1r = 0.0
+        a1i = 0.0
+        b1r = 0.0
+        b1i = 0.0
+        a2r = 0.0
+        a2i = 0.0
+        b2r = 0.0
+        b2i = 0.0
         for v in range(n):
             dr = dmr[centre, v]
             di = dmi[centre, v]
-            yr[v] = xr[v] * dr - xi[v] * di
-            yi[v] = xr[v] * di + xi[v] * dr
-            zr += yr[v]
-            zi += yi[v]
-        mag[half] = math.sqrt(zr * zr + zi * zi)
-        for o in range(half):
-            ar = 0.0
-            ai = 0.0
-            br = 0.0
-            bi = 0.0
-            for v in range(n):
-                ar += yr[v] * oc[o, v]
-                ai += yi[v] * oc[o, v]
-                br += yr[v] * os_[o, v]
-                bi += yi[v] * os_[o, v]
-            # X(centre + o + 1) = A + j B, X(centre - o - 1) = A - j B
-            pr, pi = ar - bi, ai + br
-            mr, mi = ar + bi, ai - br
-            mag[half + o + 1] = math.sqrt(pr * pr + pi * pi)
-            mag[half - o - 1] = math.sqrt(mr * mr + mi * mi)
+            yr = xr[v] * dr - xi[v] * di
+            yi = xr[v] * di + xi[v] * dr
+            zr += yr
+            zi += yi
+            c1 = oc[0, v]
+            s1 = os_[0, v]
+            c2 = oc[1, v]
+            s2 = os_[1, v]
+            a1r += yr * c1
+            a1i += yi * c1
+            b1r += yr * s1
+            b1i += yi * s1
+            a2r += yr * c2
+            a2i += yi * c2
+            b2r += yr * s2
+            b2i += yi * s2
+        # X(centre + o) = A_o + j B_o, X(centre - o) = A_o - j B_o
+        mag[0] = math.sqrt((a2r + b2i) ** 2 + (a2i - b2r) ** 2)
+        mag[1] = math.sqrt((a1r + b1i) ** 2 + (a1i - b1r) ** 2)
+        mag[2] = math.sqrt(zr * zr + zi * zi)
+        mag[3] = math.sqrt((a1r - b1i) ** 2 + (a1i + b1r) ** 2)
+        mag[4] = math.sqrt((a2r - b2i) ** 2 + (a2i + b2r) ** 2)
         j = 0
         for o in range(1, w):
             if mag[o] > mag[j]:
@@ -115,14 +127,16 @@ def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -
     them): radix-4 decimation-in-frequency stages, a radix-2 one last when N is not a power
     of 4; natural order in, digit-reversed order out (:func:`_coarse_tables`). wr, wi:
     float32 (N,) exp(2 pi j k / N)."""
-    _fft_stages(re, im, wr, wi, re.shape[0])
+    _fft_stages(re, im, wr, wi, re.shape[0], True)
 
 
 @numba.njit(cache=True, fastmath=True)
-def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, size: int
-                ) -> None:
+def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, size: int,
+                radix2: bool) -> None:
     """The stages of :func:`_block_fft` from sub-transform length ``size`` down (``size``
-    = N: all of them; N / 4 after :func:`_padded_first_stage`)."""
+    = N: all of them; N / 4 after :func:`_padded_first_stage`); ``radix2`` False: without
+    the final radix-2 stage (N not a power of 4; the caller fuses it with its next pass,
+    :func:`_squares_fused`)."""
     n = re.shape[0]
     nb = _BLOCK                     # a compile-time trip count: the loops vectorise
     while size >= 4:
@@ -164,7 +178,7 @@ def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, 
                     re[i3, j] = ur * w3r - ui * w3i
                     im[i3, j] = ur * w3i + ui * w3r
         size = q
-    if size == 2:
+    if size == 2 and radix2:
         for start in range(0, n, 2):
             for j in range(nb):
                 ur = re[start, j]
@@ -216,39 +230,61 @@ def _padded_first_stage(xr: np.ndarray, xi: np.ndarray, re: np.ndarray, im: np.n
 
 
 @numba.njit(cache=True, fastmath=True)
-def _column_max(mag: np.ndarray, pos: np.ndarray, best: np.ndarray, kbest: np.ndarray
-                ) -> None:
-    """The largest coarse bin of each column of a block (``mag`` float32 (coarse *
-    _BLOCK,) flat, squared magnitudes, bin k in row pos[k]): its value into best and its bin
-    into kbest (float32 (_BLOCK,)); natural bin order with a strict >: the first bin on a
-    tie, as np.argmax (of the squares: two magnitudes that round to the same float32 but
-    whose squares differ are no tie here)."""
+def _squares_fused(re: np.ndarray, im: np.ndarray, rank: np.ndarray, sq: np.ndarray) -> None:
+    """|X|^2 of a block transformed by ``_fft_stages(..., radix2=False)`` into sq (float32
+    (_BLOCK, N), bin k of column j at sq[j, k]): the final radix-2 stage first when N is
+    not a power of 4 (rows 2 i, 2 i + 1 are the inputs of one butterfly). re, im float32
+    (N * _BLOCK,) flat; rank int (N,): the bin in each row after the full transform."""
     nb = _BLOCK
-    for j in range(nb):             # one column at a time: the running maximum in registers
-        b = np.float32(-1.0)
-        kb = 0
-        for k in range(pos.shape[0]):
-            val = mag[pos[k] * nb + j]
-            if val > b:
-                b = val
-                kb = k
-        best[j] = b
-        kbest[j] = np.float32(kb)
+    n = rank.shape[0]
+    if n & 0x55555555:                          # a power of 4: no radix-2 stage
+        for q in range(n):
+            k = rank[q]
+            for j in range(nb):
+                sq[j, k] = re[q * nb + j] * re[q * nb + j] + im[q * nb + j] * im[q * nb + j]
+        return
+    for start in range(0, n, 2):
+        k0 = rank[start]
+        k1 = rank[start + 1]
+        q = start * nb
+        for j in range(nb):
+            sr = re[q + j] + re[q + nb + j]
+            si = im[q + j] + im[q + nb + j]
+            dr = re[q + j] - re[q + nb + j]
+            di = im[q + j] - im[q + nb + j]
+            sq[j, k0] = sr * sr + si * si
+            sq[j, k1] = dr * dr + di * di
+
+
+@numba.njit(cache=True)
+def _argmax_bits(bits: np.ndarray) -> int:
+    """np.argmax of a row of non-negative float32 values given as their int32 bit patterns
+    (bits (n,); ordered as the values): two integer reductions (they vectorise; a float
+    maximum with an index does not)."""
+    n = bits.shape[0]
+    mx = np.int32(-1)
+    for k in range(n):
+        v = bits[k]
+        mx = v if v > mx else mx
+    first = n
+    for k in range(n):
+        first = min(first, k if bits[k] == mx else n)
+    return first
 
 
 @numba.njit(cache=True, fastmath=True)
 def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
-                 second_lobe: float, wr: np.ndarray, wi: np.ndarray, pos: np.ndarray,
+                 second_lobe: float, wr: np.ndarray, wi: np.ndarray, rank: np.ndarray,
                  dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray, os_: np.ndarray,
                  out_pow: np.ndarray, out_sin: np.ndarray) -> None:
     """:func:`class_peaks` (x, ph complex128); wr, wi float32 (coarse,) the
-    coarse FFT's twiddles, pos int (coarse,) where :func:`_block_fft` leaves bin k; dm*,
+    coarse FFT's twiddles, rank int (coarse,) the bin :func:`_block_fft` leaves in each row; dm*,
     oc, os_: see :func:`_fine_search`."""
     m = cell.shape[0]
     nv = x.shape[1]
     ntx = ph.shape[1]
     nrx = nv // ntx
-    coarse = pos.shape[0]
+    coarse = rank.shape[0]
     nb_ = _BLOCK
     re2 = np.zeros((coarse, nb_), np.float32)
     im2 = np.zeros((coarse, nb_), np.float32)
@@ -257,16 +293,11 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
     # the block's compensated rows as columns, double; rows nv.. stay 0 (the FFT's padding)
     xcr = np.zeros((max(nv, coarse // 2), nb_))
     xci = np.zeros((max(nv, coarse // 2), nb_))
-    best = np.empty(nb_, np.float32)
-    kbest = np.empty(nb_, np.float32)
-    top = np.empty(nb_, np.float32)
-    ktop = np.empty(nb_, np.float32)
-    c3 = np.empty((nb_, 3), np.float32)
+    sq = np.empty((nb_, coarse), np.float32)   # squared magnitudes, a row per column
+    sqb = sq.view(np.int32)
     rowr = np.empty(nv)
     rowi = np.empty(nv)
-    yr = np.empty(nv)
-    yi = np.empty(nv)
-    mag = np.empty(2 * oc.shape[0] + 1)
+    mag = np.empty(2 * ZOOM_HALF + 1)
     lobe = np.float32(second_lobe)
     cmask = coarse - 1                        # coarse: a power of two
     for b0 in range(0, m, nb_):
@@ -286,7 +317,7 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
         # zero-padded rows as columns
         if 2 * nv <= coarse:
             _padded_first_stage(xcr, xci, re2, im2, wr, wi)
-            _fft_stages(re2, im2, wr, wi, coarse // 4)
+            _fft_stages(re2, im2, wr, wi, coarse // 4, False)
         else:
             for v in range(nv):
                 for j in range(nb_):
@@ -294,35 +325,31 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
                     im[v * nb_ + j] = np.float32(xci[v, j])
             re[nv * nb_:] = 0.0
             im[nv * nb_:] = 0.0
-            _block_fft(re2, im2, wr, wi)
-        # squared magnitudes (the maxima are the same; a square root only where a
-        # magnitude is used)
-        for q in range(coarse * nb_):
-            re[q] = re[q] * re[q] + im[q] * im[q]
-        _column_max(re, pos, best, kbest)     # the largest coarse bin of each column
-        # the first lobe's 5 bins count as 0 for the runner-up (host.angle.
-        # _peaks_from_coarse sets them so); their magnitudes first
-        for j in range(nb_):
-            kc = int(kbest[j])
-            for o in range(3):
-                c3[j, o] = np.sqrt(re[pos[(kc + o - 1) & cmask] * nb_ + j])
-            for o in range(-2, 3):
-                re[pos[(kc + o) & cmask] * nb_ + j] = 0.0
-        _column_max(re, pos, top, ktop)
+            _fft_stages(re2, im2, wr, wi, coarse, False)
+        # squared magnitudes, natural bin order, one row per column (the maxima are the
+        # same; a square root only where a magnitude is used)
+        _squares_fused(re, im, rank, sq)
         for j in range(nb):
-            kc = int(kbest[j])
+            row = sq[j]
+            kc = _argmax_bits(sqb[j])
+            ca = np.sqrt(row[(kc - 1) & cmask])
+            first = np.sqrt(row[kc])
+            cc = np.sqrt(row[(kc + 1) & cmask])
+            # the first lobe's 5 bins count as 0 for the runner-up (host.angle.
+            # _peaks_from_coarse sets them so)
+            for o in range(-2, 3):
+                row[(kc + o) & cmask] = 0.0
+            k2c = _argmax_bits(sqb[j])
             for v in range(nv):
                 rowr[v] = xcr[v, j]
                 rowi[v] = xci[v, j]
-            k0, a, b, c = _fine_search(rowr, rowi, c3[j, 0], c3[j, 1], c3[j, 2], kc, coarse,
-                                       n_fft, dmr, dmi, oc, os_, yr, yi, mag)
-            first = c3[j, 1]
-            k2c = int(ktop[j])
-            if np.sqrt(top[j]) >= lobe * first:
+            k0, a, b, c = _fine_search(rowr, rowi, ca, first, cc, kc, coarse,
+                                       n_fft, dmr, dmi, oc, os_, mag)
+            if np.sqrt(row[k2c]) >= lobe * first:
                 k2, a2, b2, c2 = _fine_search(
-                    rowr, rowi, np.sqrt(re[pos[(k2c - 1) & cmask] * nb_ + j]),
-                    np.sqrt(re[pos[k2c] * nb_ + j]), np.sqrt(re[pos[(k2c + 1) & cmask] * nb_ + j]),
-                    k2c, coarse, n_fft, dmr, dmi, oc, os_, yr, yi, mag)
+                    rowr, rowi, np.sqrt(row[(k2c - 1) & cmask]),
+                    np.sqrt(row[k2c]), np.sqrt(row[(k2c + 1) & cmask]),
+                    k2c, coarse, n_fft, dmr, dmi, oc, os_, mag)
                 if b2 > b:
                     k0, a, b, c = k2, a2, b2, c2
             out_pow[b0 + j] = b * b
@@ -444,8 +471,8 @@ def _split(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _coarse_tables(coarse: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(twiddles float32 re, im (coarse,): exp(+2 pi j k / coarse); pos int (coarse,): the
-    row where :func:`_block_fft` leaves bin k, found by transforming a delta at n = 1,
+    """(twiddles float32 re, im (coarse,): exp(+2 pi j k / coarse); rank int (coarse,): the
+    bin :func:`_block_fft` leaves in each row, found by transforming a delta at n = 1,
     whose bin k is exp(2 pi j k / coarse))."""
     w = np.exp(2j * np.pi * np.arange(coarse) / coarse)
     wr, wi = w.real.astype(np.float32), w.imag.astype(np.float32)
@@ -454,19 +481,19 @@ def _coarse_tables(coarse: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     re[1, 0] = 1.0
     _block_fft(re, im, wr, wi)
     k = np.round(np.angle(re[:, 0] + 1j * im[:, 0]) * coarse / (2 * np.pi)).astype(np.int64)
-    pos = np.zeros(coarse, np.int64)
-    pos[k % coarse] = np.arange(coarse)
-    if sorted(k % coarse) != list(range(coarse)):
+    rank = k % coarse
+    if sorted(rank) != list(range(coarse)):
         raise AssertionError("_block_fft: output order is not a permutation")
-    return wr, wi, pos
+    return wr, wi, rank
 
 
-_TABLES: dict[tuple[int, int, int], tuple[np.ndarray, ...]] = {}
+_TABLES: dict[tuple[int, int], tuple[np.ndarray, ...]] = {}
 
 
-def _tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, ...]:
+def _tables(n: int, n_fft: int) -> tuple[np.ndarray, ...]:
     """The kernels' constant tables for n channels, computed once per setting."""
-    key = (n, n_fft, half)
+    key = (n, n_fft)
+    half = ZOOM_HALF
     if key not in _TABLES:
         demod, _ = _zoom_tables(n, n_fft, half)
         coarse = min(COARSE_FFT, n_fft)
@@ -475,8 +502,8 @@ def _tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, ...]:
     return _TABLES[key]
 
 
-def class_peaks(x: np.ndarray, cell: np.ndarray, phasors: np.ndarray, n_fft: int,
-                half: int = 2) -> tuple[np.ndarray, np.ndarray]:
+def class_peaks(x: np.ndarray, cell: np.ndarray, phasors: np.ndarray, n_fft: int
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Angle peak of TDM-compensated snapshots: row p is snapshot x[cell[p]] with TX t's
     channels times phasors[p, t] (``host.pipeline._tdm_tx_phasors``); returns
     ``host.angle.peak_power_lean`` of those rows, (peak power float (m,), sin(az) float
@@ -494,9 +521,9 @@ def class_peaks(x: np.ndarray, cell: np.ndarray, phasors: np.ndarray, n_fft: int
                          f"({min(COARSE_FFT, n_fft)})")
     out_pow, out_sin = np.zeros(m), np.zeros(m)
     if m:
-        wr, wi, pos, dmr, dmi, oc, os_ = _tables(x.shape[1], n_fft, half)
+        wr, wi, rank, dmr, dmi, oc, os_ = _tables(x.shape[1], n_fft)
         _class_peaks(_c128(x), np.ascontiguousarray(cell, dtype=np.int64), _c128(phasors),
-                     n_fft, SECOND_LOBE, wr, wi, pos, dmr, dmi, oc, os_, out_pow, out_sin)
+                     n_fft, SECOND_LOBE, wr, wi, rank, dmr, dmi, oc, os_, out_pow, out_sin)
     return out_pow, out_sin
 
 
