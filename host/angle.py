@@ -313,12 +313,12 @@ or the compiled ``host.cell_kernels.steering_rows``."""
 
 def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.ndarray,
                 a1: np.ndarray, p1: np.ndarray, more: np.ndarray, batched: bool = False,
-                peaks: PeakFinder | None = None, steer: Steering | None = None
-                ) -> AngleArrays:
+                peaks: PeakFinder | None = None, steer: Steering | None = None,
+                relax: RowsEstimator | None = None) -> AngleArrays:
     """The :class:`AngleArrays` of rows xs (complex (n, n_ch)): the first component (sin
     s1, amplitude a1, power p1, float/complex (n,)) where ``more`` (bool (n,)) is False,
     :func:`estimate_angles` of the row where it is True (``batched``: of all those rows at
-    once, :func:`estimate_angles_rows`)."""
+    once, :func:`estimate_angles_rows` with ``peaks`` and ``steer``, or ``relax``)."""
     n_rows, n = xs.shape
     snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
     multi = np.flatnonzero(more)
@@ -329,7 +329,8 @@ def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.n
     amp: list = []
     snr: list = []
     if batched:
-        got = estimate_angles_rows(xs[multi], noise[multi], params, peaks, steer)
+        got = relax(xs[multi], noise[multi], params) if relax else estimate_angles_rows(
+            xs[multi], noise[multi], params, peaks, steer)
         cell, sin_az, amp, snr = multi[got.cell], got.sin_az, got.amplitude, got.snr_db
     else:
         for i in multi:
@@ -424,8 +425,8 @@ def first_component_screen(xs: np.ndarray, noise: np.ndarray, params: AngleParam
 
 def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
                         s1: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray,
-                        peaks: PeakFinder | None = None, steer: Steering | None = None
-                        ) -> AngleArrays:
+                        peaks: PeakFinder | None = None, steer: Steering | None = None,
+                        relax: RowsEstimator | None = None) -> AngleArrays:
     """The second half of :func:`estimate_angles_screened`: rows xs (complex128 (n, n_ch))
     with their first component (sin s1, amplitude a1, power p1: float/complex (n,)) and
     the screen ``maybe`` (bool (n,)); the rows that may hold a second component search
@@ -433,7 +434,8 @@ def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
     :func:`estimate_angles_rows`. noise: float (n,) per channel, >= 1e-30. ``peaks``: the
     peak search of the residuals and of :func:`estimate_angles_rows` (default: the
     residual's :func:`peak_sin_fast`, and there the ``n_fft``-point FFT); ``steer``: the
-    steering vectors (default :func:`_steering_rows`)."""
+    steering vectors (default :func:`_steering_rows`); ``relax``: the rows with several
+    components through this instead (``host.cell_kernels.relax_rows``)."""
     n = xs.shape[1]
     more = np.zeros(len(xs), bool)
     rows = np.flatnonzero(maybe)
@@ -450,7 +452,7 @@ def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
                 10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
                 <= params.dynamic_range_db)
     return _components(xs, noise, params, s1, a1, p1, more, batched=True, peaks=peaks,
-                       steer=steer)
+                       steer=steer, relax=relax)
 
 
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
@@ -557,6 +559,23 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
             for i in range(t + 1):
                 total = total + a_c[live, i][:, None] * st_c[live, i]
             residual[live] = xs[live] - total
+    return kept_components(s_c, a_c, count, noise, n)
+
+
+RowsEstimator = Callable[[np.ndarray, np.ndarray, AngleParams], AngleArrays]
+"""A function (x complex (m, n), noise_per_channel float (m,), params) -> the
+:class:`AngleArrays` of :func:`estimate_angles_rows`: that function with its default peak
+search, or the compiled ``host.cell_kernels.relax_rows``."""
+
+
+def kept_components(s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray, noise: np.ndarray,
+                    n: int) -> AngleArrays:
+    """The end of :func:`estimate_angles_rows`: the components found per row (sin s_c float
+    (m, k), amplitude a_c complex (m, k), the first count int (m,) slots of each row valid;
+    noise float (m,) per channel, n channels) strongest first, without the collapsed ones,
+    as flat :class:`AngleArrays`."""
+    kmax = s_c.shape[1]
+    with np.errstate(divide="ignore"):
         snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
     # per row: strongest first (a stable sort, as sorted()), then drop collapsed components
     # (within 0.5 / n in sin of a kept, stronger one); all rows at once

@@ -12,6 +12,8 @@ named below, without numpy's per-call overhead and temporaries, one pass per cel
   one (the first half of ``host.angle.estimate_angles_screened``).
 - :func:`peak_sins`, :func:`steering_rows`: the peak search and steering vectors of RELAX
   (``host.angle.estimate_angles_rows``) and of the residual search.
+- :func:`relax_rows`: RELAX itself (``host.angle.estimate_angles_rows`` with those two),
+  every pass's batch of rows through the :func:`class_peaks` machinery.
 - :func:`fold_decisions`: the velocity-unfolding decision of every cell
   (``host.pipeline.choose_folds``, the per-cell ``_choose_fold``; both paths use it).
 
@@ -28,7 +30,15 @@ import math
 import numba
 import numpy as np
 
-from host.angle import COARSE_FFT, SECOND_LOBE, ZOOM_HALF, _zoom_tables
+from host.angle import (
+    COARSE_FFT,
+    SECOND_LOBE,
+    ZOOM_HALF,
+    AngleArrays,
+    AngleParams,
+    _zoom_tables,
+    kept_components,
+)
 
 if ZOOM_HALF != 2:
     raise ImportError("host.cell_kernels: _fine_search sums a 5-bin window (ZOOM_HALF = 2)")
@@ -561,6 +571,126 @@ def peak_sins(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     m = len(x)
     power, sin = class_peaks(x, np.arange(m), np.ones((m, 1), complex), n_fft)
     return sin, power
+
+
+@numba.njit(cache=True, fastmath=True, error_model="numpy")
+def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
+           dyn_db: float, n_fft: int, second_lobe: float, wr: np.ndarray, wi: np.ndarray,
+           rank: np.ndarray, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
+           os_: np.ndarray, s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray) -> None:
+    """:func:`relax_rows` into s_c, a_c, count (float, complex (m, k), int (m,); zeros
+    in): ``host.angle.estimate_angles_rows``'s passes, the peak search of each batch of
+    live rows by :func:`_class_peaks` (unit phasors), steering by :func:`_steer_row`."""
+    m, n = xs.shape
+    kmax = s_c.shape[1]
+    b0 = int(math.ceil(math.sqrt(n)))
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(n)
+    sti = np.empty(n)
+    st_c = np.zeros((m, kmax, n), np.complex128)    # steering of s_c, once per estimate
+    first = np.zeros(m)
+    residual = xs.copy()
+    batch = np.empty((m, n), np.complex128)
+    rows = np.arange(m)
+    ones = np.ones((m, 1), np.complex128)
+    out_pow = np.empty(m)
+    out_sin = np.empty(m)
+    live = np.arange(m)                  # rows still adding components, all with t comps
+    nl = m
+    for t in range(kmax):
+        if nl == 0:
+            break
+        for p in range(nl):
+            batch[p] = residual[live[p]]
+        _class_peaks(batch[:nl], rows[:nl], ones[:nl], n_fft, second_lobe, wr, wi, rank,
+                     dmr, dmi, oc, os_, out_pow[:nl], out_sin[:nl])
+        kept = 0
+        for p in range(nl):
+            i = live[p]
+            s = out_sin[p]
+            _steer_row(s, str_, sti, lor, loi)
+            ar = 0.0
+            ai = 0.0
+            for v in range(n):               # conj(st) . residual
+                xr = residual[i, v].real
+                xi = residual[i, v].imag
+                ar += str_[v] * xr + sti[v] * xi
+                ai += str_[v] * xi - sti[v] * xr
+            a = complex(ar / n, ai / n)
+            power = a.real * a.real + a.imag * a.imag
+            if t:
+                snr_db = 10 * np.log10(power * n / noise[i])
+                if snr_db < min_snr_db or 10 * np.log10(first[i] / power) > dyn_db:
+                    continue
+            s_c[i, t] = s
+            a_c[i, t] = a
+            for v in range(n):
+                st_c[i, t, v] = complex(str_[v], sti[v])
+            count[i] = t + 1
+            if first[i] == 0:
+                first[i] = power
+            live[kept] = i
+            kept += 1
+        nl = kept
+        if t:
+            for _ in range(refine):
+                for j in range(t + 1):
+                    for p in range(nl):      # the row without the other components
+                        i = live[p]
+                        for v in range(n):
+                            o = 0j
+                            for q in range(t + 1):
+                                if q != j:
+                                    o += a_c[i, q] * st_c[i, q, v]
+                            batch[p, v] = xs[i, v] - o
+                    _class_peaks(batch[:nl], rows[:nl], ones[:nl], n_fft, second_lobe, wr,
+                                 wi, rank, dmr, dmi, oc, os_, out_pow[:nl], out_sin[:nl])
+                    for p in range(nl):
+                        i = live[p]
+                        s = out_sin[p]
+                        _steer_row(s, str_, sti, lor, loi)
+                        ar = 0.0
+                        ai = 0.0
+                        for v in range(n):
+                            xr = batch[p, v].real
+                            xi = batch[p, v].imag
+                            ar += str_[v] * xr + sti[v] * xi
+                            ai += str_[v] * xi - sti[v] * xr
+                            st_c[i, j, v] = complex(str_[v], sti[v])
+                        s_c[i, j] = s
+                        a_c[i, j] = complex(ar / n, ai / n)
+        for p in range(nl):
+            i = live[p]
+            for v in range(n):
+                tot = 0j
+                for q in range(t + 1):
+                    tot += a_c[i, q] * st_c[i, q, v]
+                residual[i, v] = xs[i, v] - tot
+
+
+def relax_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
+               ) -> AngleArrays:
+    """``host.angle.estimate_angles_rows(x, noise_per_channel, params, peak_sins,
+    steering_rows)`` compiled (the same components to rounding): x complex (m, n),
+    noise_per_channel float (m,); a ``host.angle.RowsEstimator``."""
+    xs = _c128(x)
+    m, n = xs.shape
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if noise.shape != (m,):
+        raise ValueError(f"relax_rows: {m} rows, noise {noise.shape}")
+    if n > min(COARSE_FFT, params.n_fft):
+        raise ValueError(f"relax_rows: {n} channels exceed the coarse FFT "
+                         f"({min(COARSE_FFT, params.n_fft)})")
+    s_c = np.zeros((m, params.max_targets))
+    a_c = np.zeros((m, params.max_targets), np.complex128)
+    count = np.zeros(m, np.int64)
+    if m:
+        wr, wi, rank, dmr, dmi, oc, os_ = _tables(n, params.n_fft)
+        _relax(xs, noise, params.refine_iterations, params.min_snr_db,
+               params.dynamic_range_db, params.n_fft, SECOND_LOBE, wr, wi, rank, dmr, dmi,
+               oc, os_, s_c, a_c, count)
+    return kept_components(s_c, a_c, count, noise, n)
 
 
 @numba.njit(cache=True)

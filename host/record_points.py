@@ -40,6 +40,7 @@ from host.cell_kernels import (
     class_peaks,
     first_components,
     peak_sins,
+    relax_rows,
     select_cells,
     steering_rows,
 )
@@ -193,7 +194,7 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
         xs, a1, p1, maybe = first_components(x, ph, sn_sel, noise / nv, a.min_snr_db,
                                              a.dynamic_range_db, a.max_targets > 1)
         ang = screened_components(xs, np.maximum(noise / nv, 1e-30), a, sn_sel, a1, p1, maybe,
-                                  peaks=peak_sins, steer=steering_rows)
+                                  peaks=peak_sins, steer=steering_rows, relax=relax_rows)
     return _cloud(cfg, params, r, offsets, sb + fold * nd, ambiguous, ang.cell,
                   ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
 

@@ -1,6 +1,6 @@
 """The compiled kernels of ``host.cell_kernels`` against the numpy functions they replace
 (``host.angle.peak_power_lean``, ``peak_sin_fast``, the first half of
-``estimate_angles_screened``, ``estimate_angles_rows``), and the compiled record path
+``estimate_angles_screened``, ``estimate_angles_rows``, RELAX itself), and the compiled record path
 against the numpy one: the same peaks and decisions, floats equal to rounding."""
 
 from __future__ import annotations
@@ -19,7 +19,13 @@ from host.angle import (
     screened_components,
 )
 from host.bench_detect import synthetic_records
-from host.cell_kernels import class_peaks, first_components, peak_sins, steering_rows
+from host.cell_kernels import (
+    class_peaks,
+    first_components,
+    peak_sins,
+    relax_rows,
+    steering_rows,
+)
 from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors
 from host.record_points import points_from_snapshots, record_offsets, select_records
 from host.records import record_arrays
@@ -133,6 +139,32 @@ def test_relax_with_compiled_peaks() -> None:
         np.testing.assert_array_equal(got.cell, want.cell)
         np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
         np.testing.assert_allclose(got.amplitude, want.amplitude, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [16, 64])
+def test_relax_rows_is_estimate_angles_rows(n: int) -> None:
+    """The compiled RELAX: the components of ``estimate_angles_rows`` with the same peak
+    search and steering (three settings; rows of noise only, of zeros, and one row)."""
+    rng = np.random.default_rng(21)
+    x = _rows(rng, 200, n).astype(complex)
+    x[:10] = (rng.normal(size=(10, n)) + 1j * rng.normal(size=(10, n))) / np.sqrt(2)
+    x[10:13] = 0.0
+    noise = rng.uniform(0.5, 2.0, 200)
+    for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256),
+              AngleParams(max_targets=4, refine_iterations=0, min_snr_db=6.0)):
+        for rows in (slice(None), slice(5, 6)):
+            got = relax_rows(x[rows], noise[rows], p)
+            want = estimate_angles_rows(x[rows], noise[rows], p, peaks=peak_sins,
+                                        steer=steering_rows)
+            np.testing.assert_array_equal(got.cell, want.cell)
+            np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
+            np.testing.assert_allclose(got.amplitude, want.amplitude, rtol=1e-9, atol=1e-9)
+            np.testing.assert_allclose(got.snr_db, want.snr_db, atol=1e-9)
+    counts = np.bincount(relax_rows(x, noise, AngleParams()).cell, minlength=200)
+    assert (counts[13:] >= 1).all() and (counts >= 2).sum() > 40 and (counts == 3).any()
+    assert len(relax_rows(np.zeros((0, n)), np.zeros(0), AngleParams()).cell) == 0
+    with pytest.raises(ValueError, match="noise"):
+        relax_rows(x, noise[:3], AngleParams())
 
 
 @pytest.mark.parametrize("preset", ["full", "paper-fpga"])
