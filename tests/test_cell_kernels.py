@@ -67,17 +67,18 @@ def test_class_peaks_are_peak_power_lean(n_fft: int) -> None:
     assert got_p[0] == 0 and np.isfinite(got_s).all()
 
 
-@pytest.mark.parametrize("n", [4, 16, 64, 128])
-def test_peak_sins_are_peak_sin_fast(n: int) -> None:
+@pytest.mark.parametrize("n, n_fft", [(4, 1024), (16, 1024), (64, 1024), (128, 1024),
+                                       (4, 16), (16, 16), (16, 32), (32, 32), (8, 64)])
+def test_peak_sins_are_peak_sin_fast(n: int, n_fft: int) -> None:
     """Single rows of several array sizes (paper-fpga's 4 channels up to the coarse FFT's
-    length)."""
-    rng = np.random.default_rng(n)
+    length) and coarse FFT lengths (128, 64, 32 and 16 points; zero-padded or not)."""
+    rng = np.random.default_rng(n + n_fft)
     x = _rows(rng, 150, n).astype(complex)
-    s, p = peak_sins(x, 1024)
-    ws, wp = peak_sin_fast(x, 1024)
+    s, p = peak_sins(x, n_fft)
+    ws, wp = peak_sin_fast(x, n_fft)
     np.testing.assert_allclose(s, ws, atol=1e-12)
     np.testing.assert_allclose(p, wp, rtol=1e-9)
-    assert peak_sins(np.zeros((0, n)), 1024)[0].shape == (0,)
+    assert peak_sins(np.zeros((0, n)), n_fft)[0].shape == (0,)
 
 
 @pytest.mark.parametrize("n", [1, 4, 17, 64])
