@@ -368,7 +368,8 @@ def _tdm_tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     k = signed_bin(k, cfg.n_doppler)
     n = cfg.n_doppler * cfg.num_tx
-    return _unit_circle(n)[np.multiply.outer(k, np.arange(cfg.num_tx)) % n]
+    m = np.multiply.outer(k, np.arange(cfg.num_tx))
+    return _unit_circle(n)[m & (n - 1) if n & (n - 1) == 0 else m % n]   # & : mod 2^b
 
 
 def _tdm_compensate(cfg: RadarConfig, x: np.ndarray, k: np.ndarray) -> np.ndarray:

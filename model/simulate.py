@@ -65,8 +65,9 @@ def subarray_factor_power(cfg: RadarConfig, azimuth_deg: np.ndarray) -> np.ndarr
     m = cfg.subarray_elements
     s = np.sin(np.radians(np.asarray(azimuth_deg, dtype=float)))
     k = np.arange(m) - (m - 1) / 2.0
-    af = np.exp(1j * np.pi * np.multiply.outer(s, k)).sum(axis=-1)
-    return np.abs(af) ** 2 / m**2
+    # the element positions are symmetric about the centre: AF = sum_k cos(pi s k), real
+    af = np.cos(np.pi * np.multiply.outer(s, k)).sum(axis=-1)
+    return af**2 / m**2
 
 
 def tx_gain(cfg: RadarConfig, azimuth_deg: np.ndarray, beamforming: bool) -> np.ndarray:
