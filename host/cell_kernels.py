@@ -573,6 +573,23 @@ def peak_sins(x: np.ndarray, n_fft: int) -> tuple[np.ndarray, np.ndarray]:
     return sin, power
 
 
+@numba.njit(cache=True, fastmath=True)
+def _project(s: float, row: np.ndarray, str_: np.ndarray, sti: np.ndarray, lor: np.ndarray,
+             loi: np.ndarray) -> complex:
+    """The amplitude conj(st) . row / n of the component at sin(az) s in row (complex (n,)),
+    its steering vector st left in str_, sti (:func:`_steer_row`; lor, loi: scratch)."""
+    n = row.shape[0]
+    _steer_row(s, str_, sti, lor, loi)
+    ar = 0.0
+    ai = 0.0
+    for v in range(n):
+        xr = row[v].real
+        xi = row[v].imag
+        ar += str_[v] * xr + sti[v] * xi
+        ai += str_[v] * xi - sti[v] * xr
+    return complex(ar / n, ai / n)
+
+
 @numba.njit(cache=True, fastmath=True, error_model="numpy")
 def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
            dyn_db: float, n_fft: int, second_lobe: float, wr: np.ndarray, wi: np.ndarray,
@@ -609,15 +626,7 @@ def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
         for p in range(nl):
             i = live[p]
             s = out_sin[p]
-            _steer_row(s, str_, sti, lor, loi)
-            ar = 0.0
-            ai = 0.0
-            for v in range(n):               # conj(st) . residual
-                xr = residual[i, v].real
-                xi = residual[i, v].imag
-                ar += str_[v] * xr + sti[v] * xi
-                ai += str_[v] * xi - sti[v] * xr
-            a = complex(ar / n, ai / n)
+            a = _project(s, residual[i], str_, sti, lor, loi)
             power = a.real * a.real + a.imag * a.imag
             if t:
                 snr_db = 10 * np.log10(power * n / noise[i])
@@ -648,18 +657,10 @@ def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
                                  wi, rank, dmr, dmi, oc, os_, out_pow[:nl], out_sin[:nl])
                     for p in range(nl):
                         i = live[p]
-                        s = out_sin[p]
-                        _steer_row(s, str_, sti, lor, loi)
-                        ar = 0.0
-                        ai = 0.0
+                        s_c[i, j] = out_sin[p]
+                        a_c[i, j] = _project(out_sin[p], batch[p], str_, sti, lor, loi)
                         for v in range(n):
-                            xr = batch[p, v].real
-                            xi = batch[p, v].imag
-                            ar += str_[v] * xr + sti[v] * xi
-                            ai += str_[v] * xi - sti[v] * xr
                             st_c[i, j, v] = complex(str_[v], sti[v])
-                        s_c[i, j] = s
-                        a_c[i, j] = complex(ar / n, ai / n)
         for p in range(nl):
             i = live[p]
             for v in range(n):
