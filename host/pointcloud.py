@@ -71,7 +71,8 @@ class PointCloud:
         c, s = np.cos(az), np.sin(az)
         return cls(
             range_m=r, azimuth_deg=np.degrees(az), radial_velocity_mps=vr,
-            x_m=r * c, y_m=r * s, vx_mps=vr * c, vy_mps=vr * s, power_db=np.asarray(power_db, dtype=float),
+            x_m=r * c, y_m=r * s, vx_mps=vr * c, vy_mps=vr * s,
+            power_db=np.asarray(power_db, dtype=float),
             snr_db=np.asarray(snr_db, dtype=float), rcs_dbsm=np.asarray(rcs_dbsm, dtype=float),
             range_bin=np.asarray(range_bin, dtype=int), doppler_bin=np.asarray(doppler_bin,
                                                                                dtype=int),

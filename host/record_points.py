@@ -127,13 +127,13 @@ def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, params: Detec
     hypotheses of ``host.pipeline.choose_folds``: |v + 2 m vmax| <= max_speed, m = 0 when
     none is), bool (n, num_tx); velocity_mps: float (n,) measured (aliased). Only these
     classes' powers enter the unfolding decision."""
-    lo, hi, ms = alias_orders(cfg, velocity_mps, params)
-    hyp = (ms[None, :] >= lo[:, None]) & (ms[None, :] <= hi[:, None])
-    hyp[~hyp.any(axis=1), ms.tolist().index(0)] = True
-    present = np.zeros((len(lo), cfg.num_tx), bool)
-    for c in range(cfg.num_tx):
-        present[:, c] = hyp[:, ms % cfg.num_tx == c].any(axis=1)
-    return present
+    lo, hi, _ = alias_orders(cfg, velocity_mps, params)
+    count = hi - lo + 1                        # consecutive orders lo..hi (none: m = 0)
+    first = np.where(count > 0, lo, 0)
+    count = np.maximum(count, 1)
+    c = np.arange(cfg.num_tx)
+    # class c holds an order of lo..hi when the first one at or after lo is within it
+    return (c[None, :] - first[:, None]) % cfg.num_tx < count[:, None]
 
 
 def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,

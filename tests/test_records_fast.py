@@ -31,9 +31,11 @@ from host.pipeline import (
     peak_offsets,
     points_from_cells,
     points_from_cells_reference,
+    velocity_hypotheses,
 )
 from host.pointcloud import PointCloud
 from host.record_points import (
+    hypothesis_classes,
     points_from_snapshots,
     process_records,
     process_records_reference,
@@ -203,6 +205,21 @@ def test_choose_folds_matches_per_cell_decision() -> None:
                 powers = {c: float(p) for c, p in enumerate(use[i])}
                 assert (m[i], amb[i]) == _choose_fold(powers, cfg, float(v[i]), float(snr[i]),
                                                       params)
+
+
+def test_hypothesis_classes_are_the_per_cell_hypotheses() -> None:
+    """The alias classes of ``velocity_hypotheses`` (m = 0 when no order is within
+    max_speed), at random velocities, the alias boundaries and several max_speed_mps."""
+    rng = np.random.default_rng(6)
+    for preset in ("full", "paper-fpga"):
+        cfg = get_preset(preset)
+        v = np.concatenate([rng.uniform(-1, 1, 300), [-1.0, 1.0, 0.0]]) * cfg.max_velocity_mps
+        for speed in (100.0, 30.0, 1.0, 0.01, 400.0):
+            params = DetectionParams(max_speed_mps=speed)
+            got = hypothesis_classes(cfg, v, params)
+            for i in range(len(v)):
+                classes = {m % cfg.num_tx for m in velocity_hypotheses(cfg, float(v[i]), speed)}
+                assert set(np.flatnonzero(got[i])) == classes, (preset, speed, v[i])
 
 
 @pytest.mark.parametrize("preset", ["full", "paper-fpga"])
