@@ -73,6 +73,16 @@ def warn(lines: Iterable[str], command: str) -> None:
         print(f"radar {command}: warning: {line}", file=sys.stderr)
 
 
+def note_compile(command: str) -> None:
+    """One ``radar <command>: ...`` line on stderr when the host's compiled kernels
+    (``host.cell_kernels``) are not cached yet: the first records -> point cloud call then
+    takes 20-30 s longer (once per checkout)."""
+    from host.cell_kernels import uncompiled_kernels  # numba: only where records are
+    if uncompiled_kernels():
+        print(f"radar {command}: compiling the host kernels (host/cell_kernels.py, numba; "
+              "first run in this checkout, 20-30 s)", file=sys.stderr)
+
+
 def out_file(path: str, suffix: str, option: str) -> Path:
     """``path`` checked to end in ``suffix``, its folder created."""
     p = Path(path)

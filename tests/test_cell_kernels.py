@@ -5,6 +5,12 @@ against the numpy one: the same peaks and decisions, floats equal to rounding.""
 
 from __future__ import annotations
 
+import ast
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -30,6 +36,7 @@ from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors
 from host.record_points import points_from_snapshots, record_offsets, select_records
 from host.records import record_arrays
 from model.config import get_preset
+from radar.common import note_compile
 
 
 def _rows(rng: np.random.Generator, m: int, n: int, targets: int = 3) -> np.ndarray:
@@ -86,6 +93,27 @@ def test_steering_rows_are_the_numpy_ones(n: int) -> None:
     s = np.random.default_rng(n).uniform(-1, 1, 200)
     np.testing.assert_allclose(steering_rows(s, n), _steering_rows(s, n), rtol=0, atol=1e-13)
     assert steering_rows(np.zeros(0), n).shape == (0, n)
+
+
+def test_uncompiled_kernels_are_named(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """With an empty numba cache every kernel is named (the CLI then says it compiles);
+    after a call, its kernels are cached."""
+    code = ("import host.cell_kernels as K, numpy as np; print(sorted(K.uncompiled_kernels()));"
+            "K.steering_rows(np.zeros(2), 4); print(sorted(K.uncompiled_kernels()))")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True, cwd=Path(__file__).parents[1]).stdout.split("\n")
+    before, after = ast.literal_eval(out[0]), ast.literal_eval(out[1])
+    assert {"_class_peaks", "_relax", "_steering", "_steer_row"} <= set(before)
+    assert "_steering" in before and "_steering" not in after and "_relax" in after
+    import host.cell_kernels as kernels
+    monkeypatch.setattr(kernels, "uncompiled_kernels", lambda: ["_relax"])
+    note_compile("detect")
+    assert "radar detect: compiling the host kernels" in capsys.readouterr().err
+    monkeypatch.setattr(kernels, "uncompiled_kernels", lambda: [])
+    note_compile("detect")
+    assert capsys.readouterr().err == ""
 
 
 def test_kernel_inputs_are_checked() -> None:

@@ -35,6 +35,7 @@ from radar.common import (
     count,
     detection_params,
     ego_speed_mps,
+    note_compile,
     out_file,
     progress,
     scene_of,
@@ -92,6 +93,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             dcfg = fpga_config(args, cfg, params)
             gain = chain_gain(cfg, get_source(args.backend).chain)
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
+            note_compile("detect")
             for f in frames:
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
                 arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)

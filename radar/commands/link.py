@@ -33,6 +33,7 @@ from radar.common import (
     check,
     count,
     detection_params,
+    note_compile,
     out_file,
     progress,
     scene_of,
@@ -185,6 +186,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
     if decoder and cfg:
         params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
+    if records and decoder and cfg:
+        note_compile("receive")
     try:
         for f in frames:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,

@@ -43,6 +43,7 @@ from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.scene import Scene
 from model.simulate import simulate_scene
+from radar.common import note_compile
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
 
@@ -138,6 +139,7 @@ class Processor:
         self._slot: _CubeJob | _RecordJob | None = None
         self._skipped = 0
         self.errors = 0
+        self._first_records = True
 
     def _put(self, job: _CubeJob | _RecordJob) -> None:
         with self._cond:
@@ -212,6 +214,9 @@ class Processor:
                     f"frame {job.frame_id}: {len(records) - len(inside)} record(s) outside "
                     f"the {cfg.n_range} x {cfg.n_doppler} map dropped")
         arr = record_arrays(inside, cfg.n_virtual, job.gain)
+        if self._first_records:             # the kernels may compile now (once per checkout)
+            self._first_records = False
+            note_compile("view")
         cloud = process_records(arr, cfg, self.params, frame=job.frame_id)
         objects = self._objects(cloud)
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=job.frame_id, cfg=cfg,
