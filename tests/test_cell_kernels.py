@@ -124,6 +124,8 @@ def test_kernel_inputs_are_checked() -> None:
     with pytest.raises(ValueError, match="phasors"):
         first_components(np.zeros((2, 64), complex), np.ones((2, 3)), np.zeros(2),
                          np.ones(2), 12.0, 20.0)
+    with pytest.raises(ValueError, match="exceed the coarse FFT"):
+        relax_rows(np.zeros((2, 64), complex), np.ones(2), AngleParams(n_fft=32))
 
 
 def test_first_components_are_the_screened_ones() -> None:
