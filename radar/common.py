@@ -73,10 +73,18 @@ def warn(lines: Iterable[str], command: str) -> None:
         print(f"radar {command}: warning: {line}", file=sys.stderr)
 
 
+_compile_noted = False
+
+
 def note_compile(command: str) -> None:
-    """One ``radar <command>: ...`` line on stderr when the host's compiled kernels
-    (``host.cell_kernels``) are not cached yet: the first records -> point cloud call then
-    takes 20-30 s longer (once per checkout)."""
+    """Once per process, right before the first records -> point cloud call: one
+    ``radar <command>: ...`` line on stderr when the host's compiled kernels
+    (``host.cell_kernels``) are not cached yet (that call then takes 20-30 s longer, once
+    per checkout)."""
+    global _compile_noted
+    if _compile_noted:
+        return
+    _compile_noted = True
     from host.cell_kernels import uncompiled_kernels  # numba: only where records are
     if uncompiled_kernels():
         print(f"radar {command}: compiling the host kernels (host/cell_kernels.py, numba; "

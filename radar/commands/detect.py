@@ -93,10 +93,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
             dcfg = fpga_config(args, cfg, params)
             gain = chain_gain(cfg, get_source(args.backend).chain)
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
-            note_compile("detect")
             for f in frames:
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
                 arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
+                note_compile("detect")
                 cloud = process_records(arr, cfg, params, frame=k)
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),

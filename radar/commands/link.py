@@ -186,8 +186,6 @@ def cmd_receive(args: argparse.Namespace) -> int:
     if decoder and cfg:
         params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
-    if records and decoder and cfg:
-        note_compile("receive")
     try:
         for f in frames:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
@@ -196,6 +194,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 gain = chain_gain(cfg, PipelineParams(packet_words=decoder.packet_words))
                 if records:
                     arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
+                    note_compile("receive")
                     cloud = process_records(arr, cfg, params, frame=f.frame_id)
                     entry.update({"records": len(f.records), "detections": f.detections,
                                   "truncated": f.truncated})

@@ -139,7 +139,6 @@ class Processor:
         self._slot: _CubeJob | _RecordJob | None = None
         self._skipped = 0
         self.errors = 0
-        self._first_records = True
 
     def _put(self, job: _CubeJob | _RecordJob) -> None:
         with self._cond:
@@ -214,9 +213,7 @@ class Processor:
                     f"frame {job.frame_id}: {len(records) - len(inside)} record(s) outside "
                     f"the {cfg.n_range} x {cfg.n_doppler} map dropped")
         arr = record_arrays(inside, cfg.n_virtual, job.gain)
-        if self._first_records:             # the kernels may compile now (once per checkout)
-            self._first_records = False
-            note_compile("view")
+        note_compile("view")                # the kernels may compile now (once per checkout)
         cloud = process_records(arr, cfg, self.params, frame=job.frame_id)
         objects = self._objects(cloud)
         frame = ViewFrame(seq=self.feed.next_seq(), frame_id=job.frame_id, cfg=cfg,
