@@ -21,7 +21,8 @@ cost on the link and on the host. Prints four tables:
    isolated targets and on a mixed frame (``synthetic_records(varied=True)``). One core:
    the process is pinned to one CPU and the BLAS / OpenMP pools get one thread (set before
    numpy loads). Table 1 also gives the azimuth errors of both, and in how many scenes old
-   and new clouds agree.
+   and new clouds agree. Then where the 1000-detection frames spend their time, per step of
+   ``process_records``.
 
     python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
                                 [--repeat 5] [--host-only]
@@ -41,11 +42,14 @@ if __name__ == "__main__":     # one core: one-thread BLAS / OpenMP pools, befor
 import argparse  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import fields
+from typing import Any
 
 import numpy as np
 
+from host import record_points
 from host.cfar import CfarParams
 from host.evaluate import match_targets
 from host.pipeline import DetectionParams, _tdm_comp, process_cube
@@ -280,6 +284,22 @@ def _best_ms(fn: Callable[[], object], repeat: int) -> tuple[float, float]:
     return cpu * 1e3, wall * 1e3
 
 
+def _frame_packets(cfg: RadarConfig, n: int, varied: bool) -> list[bytes]:
+    """The UDP payloads of one frame of ``n`` synthetic records (:func:`synthetic_records`)."""
+    frame = encode_frame(synthetic_records(cfg, n, varied=varied), n, cfg.num_tx, cfg.num_rx,
+                         n)
+    return [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[cfg.name])]
+
+
+def _decoded(packets: list[bytes], cfg: RadarConfig, dcfg: DetectConfig,
+             reference: bool = False) -> RecordArrays:
+    """The record arrays the host decoder makes of a frame's payloads (DMA bytes)."""
+    dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[cfg.name], reference=reference)
+    got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
+    return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual,
+                         chain_gain(cfg, PipelineParams()))
+
+
 def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
                    varied: bool = False, compiled: bool = True
                    ) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float],
@@ -293,15 +313,10 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
     cfg = get_preset(preset)
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
-    frame = encode_frame(synthetic_records(cfg, n, varied=varied), n, cfg.num_tx, cfg.num_rx,
-                         n)
-    packets = [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[preset])]
-    gain = chain_gain(cfg, PipelineParams())
+    packets = _frame_packets(cfg, n, varied)
 
     def decode() -> RecordArrays:
-        dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[preset], reference=reference)
-        got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
-        return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
+        return _decoded(packets, cfg, dcfg, reference)
 
     def cloud(arr: RecordArrays) -> PointCloud:
         return process_records(arr, cfg, params, reference=reference, compiled=compiled)
@@ -312,6 +327,57 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
     t_pc = _best_ms(lambda: cloud(arr), repeat)
     t_all = _best_ms(lambda: cloud(decode()), repeat)
     return t_dec, t_pc, t_all, len(cloud(arr))
+
+
+STAGES = ("select_records", "record_offsets", "hypothesis_classes", "class_peaks",
+          "choose_folds", "first_components", "screened_components", "relax_rows", "_cloud")
+"""The steps of ``host.record_points.process_records`` timed by :func:`stage_rows`, by the
+names under which ``host.record_points`` calls them (``relax_rows`` runs inside
+``screened_components``)."""
+
+
+@contextmanager
+def _stage_clock(spent: dict[str, float]) -> Iterator[None]:
+    """While active, the CPU seconds of each of :data:`STAGES` add up in ``spent`` (the
+    functions are wrapped where ``host.record_points`` looks them up, and restored)."""
+    saved = {name: getattr(record_points, name) for name in STAGES}
+
+    def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        def run(*a: Any, **k: Any) -> Any:
+            t0 = time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                spent[name] = spent.get(name, 0.0) + time.process_time() - t0
+        return run
+
+    try:
+        for name, fn in saved.items():
+            setattr(record_points, name, timed(name, fn))
+        yield
+    finally:
+        for name, fn in saved.items():
+            setattr(record_points, name, fn)
+
+
+def stage_rows(preset: str, n: int, repeat: int, varied: bool) -> dict[str, float]:
+    """CPU ms per step of records -> point cloud (:data:`STAGES`, and ``total``) for one
+    frame of ``n`` synthetic records, from the fastest of ``repeat`` runs."""
+    cfg = get_preset(preset)
+    params = DetectionParams()
+    arr = _decoded(_frame_packets(cfg, n, varied), cfg,
+                   fpga_detect_config(cfg, params.cfar, max_detections=n))
+    process_records(arr, cfg, params)             # compile / load the kernels
+    best: dict[str, float] = {"total": math.inf}
+    for _ in range(repeat):
+        spent: dict[str, float] = {}
+        with _stage_clock(spent):
+            t0 = time.process_time()
+            process_records(arr, cfg, params)
+            spent["total"] = time.process_time() - t0
+        if spent["total"] < best["total"]:
+            best = spent
+    return {k: v * 1e3 for k, v in best.items()}
 
 
 def calibration_ms(repeat: int) -> float:
@@ -416,6 +482,18 @@ def host_table(args: argparse.Namespace) -> None:
                                   ("DMA bytes -> point cloud", oa, pa, na)):
                 print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {p[0]:.2f} | {w[0]:.2f} | "
                       f"{o[1]:.2f} | {w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
+    rows = {kind: stage_rows("full", 1000, args.repeat, kind == "mixed")
+            for kind in ("strong", "mixed")}
+    print("\n## Where records -> point cloud spends its time, 1000 detections, `full`, one "
+          f"core (CPU ms, the fastest of {args.repeat} runs)")
+    print("| step (`host.record_points`) | strong | mixed |")
+    print("|---|---|---|")
+    for name in (*STAGES, "other"):
+        got = [r.get(name, 0.0) if name != "other" else r["total"] - sum(
+            r.get(k, 0.0) for k in STAGES if k != "relax_rows") for r in rows.values()]
+        label = "of which RELAX (`relax_rows`)" if name == "relax_rows" else f"`{name}`"
+        print(f"| {label} | {got[0]:.2f} | {got[1]:.2f} |")
+    print(f"| total | {rows['strong']['total']:.2f} | {rows['mixed']['total']:.2f} |")
     print(f"\nCPU calibration after the runs: {calibration_ms(args.repeat):.2f} ms per 10^6 "
           f"complex multiplications")
 
