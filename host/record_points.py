@@ -155,7 +155,7 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
         return PointCloud.empty()
     nd, nv, ntx = cfg.n_doppler, cfg.n_virtual, cfg.num_tx
     r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
-    x = np.asarray(snapshots)
+    x = np.ascontiguousarray(snapshots, dtype=np.complex128)   # once for every kernel
     noise = np.asarray(noise, dtype=float)
     sb = signed_bins(nd)[d].astype(np.int64)
     cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
@@ -168,8 +168,7 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
             pw, sn = class_peaks(x, ci, _tdm_tx_phasors(cfg, sb[ci] + cc * nd),
                                  params.angle.n_fft)
         else:
-            # complex128 before the gather: the same products as x * phasor
-            xc = _tdm_compensate(cfg, x.astype(np.complex128)[ci], sb[ci] + cc * nd)
+            xc = _tdm_compensate(cfg, x[ci], sb[ci] + cc * nd)
             pw, sn = peak_power_lean(xc, params.angle.n_fft)
         class_power = np.zeros((n, ntx))         # absent classes: masked by choose_folds
         class_power[ci, cc] = pw
