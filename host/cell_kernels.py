@@ -44,8 +44,9 @@ from host.angle import (
 if ZOOM_HALF != 2:
     raise ImportError("host.cell_kernels: _fine_search sums a 5-bin window (ZOOM_HALF = 2)")
 
-_BLOCK = 16
-"""(cell, class) pairs per coarse-FFT block: 2 x 128 x 16 float32, 16 KiB, stays in L1."""
+_BLOCK = 32
+"""(cell, class) pairs per coarse-FFT block: 2 x 128 x 32 float32, 32 KiB, the L1 data cache
+of this machine's cores (measured: 16 pairs 19 % slower, 64 5 %, 8 29 %)."""
 
 
 @numba.njit(cache=True, fastmath=True)
