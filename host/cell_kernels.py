@@ -278,10 +278,12 @@ def _argmax_bits(bits: np.ndarray) -> int:
     for k in range(n):
         v = bits[k]
         mx = v if v > mx else mx
-    first = n
+    n32 = np.int32(n)                   # 32-bit indices: twice as many per vector
+    first = n32
     for k in range(n):
-        first = min(first, k if bits[k] == mx else n)
-    return first
+        k32 = np.int32(k)
+        first = min(first, k32 if bits[k] == mx else n32)
+    return int(first)
 
 
 @numba.njit(cache=True, fastmath=True)
