@@ -291,13 +291,13 @@ def _frame_packets(cfg: RadarConfig, n: int, varied: bool) -> list[bytes]:
     return [words_to_bytes(p) for p in packetize(frame, UDP_PACKET_WORDS[cfg.name])]
 
 
-def _decoded(packets: list[bytes], cfg: RadarConfig, dcfg: DetectConfig,
+def _decoded(packets: list[bytes], cfg: RadarConfig, dcfg: DetectConfig, gain: float,
              reference: bool = False) -> RecordArrays:
-    """The record arrays the host decoder makes of a frame's payloads (DMA bytes)."""
+    """The record arrays the host decoder makes of a frame's payloads (DMA bytes); gain:
+    the chain's (``model.radar_pipeline.chain_gain``)."""
     dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[cfg.name], reference=reference)
     got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
-    return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual,
-                         chain_gain(cfg, PipelineParams()))
+    return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
 
 
 def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
@@ -314,9 +314,10 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
     packets = _frame_packets(cfg, n, varied)
+    gain = chain_gain(cfg, PipelineParams())
 
     def decode() -> RecordArrays:
-        return _decoded(packets, cfg, dcfg, reference)
+        return _decoded(packets, cfg, dcfg, gain, reference)
 
     def cloud(arr: RecordArrays) -> PointCloud:
         return process_records(arr, cfg, params, reference=reference, compiled=compiled)
@@ -366,7 +367,8 @@ def stage_rows(preset: str, n: int, repeat: int, varied: bool) -> dict[str, floa
     cfg = get_preset(preset)
     params = DetectionParams()
     arr = _decoded(_frame_packets(cfg, n, varied), cfg,
-                   fpga_detect_config(cfg, params.cfar, max_detections=n))
+                   fpga_detect_config(cfg, params.cfar, max_detections=n),
+                   chain_gain(cfg, PipelineParams()))
     process_records(arr, cfg, params)             # compile / load the kernels
     best: dict[str, float] = {"total": math.inf}
     for _ in range(repeat):

@@ -455,7 +455,7 @@ def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.n
         _steer_row(s1[i], str_, sti, lor, loi)
         sr = 0.0
         si = 0.0
-        for v in range(nv):                    # conj(st) . x
+        for v in range(nv):     # conj(st) . x, as _project but on the split row (25 % faster)
             sr += str_[v] * outr[v] + sti[v] * outi[v]
             si += str_[v] * outi[v] - sti[v] * outr[v]
         ar = sr / nv
@@ -710,24 +710,21 @@ def _beats(p: np.ndarray, best: int, margin: float) -> bool:
 
 
 @numba.njit(cache=True)
-def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, ms: np.ndarray,
-                    vmax: float, max_speed: float, test: bool, margin: float,
+def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, lo: np.ndarray,
+                    hi: np.ndarray, ms: np.ndarray, vmax: float, test: bool, margin: float,
                     min_snr: float, fold: np.ndarray, ambiguous: np.ndarray) -> None:
     """:func:`fold_decisions` into fold, ambiguous (int64, bool (n,))."""
     ntx = cp.shape[1]
     h = ms.shape[0]
-    period = 2.0 * vmax
     hyp = np.empty(h, np.bool_)
     p = np.empty(ntx)
     present = np.empty(ntx, np.bool_)
     for i in range(v.shape[0]):
-        lo = math.ceil((-max_speed - v[i]) / period)
-        hi = math.floor((max_speed - v[i]) / period)
         count = 0
         for k in range(h):
-            hyp[k] = lo <= ms[k] <= hi
+            hyp[k] = lo[i] <= ms[k] <= hi[i]
             count += hyp[k]
-        if count == 0:                     # no hypothesis within max_speed: m = 0
+        if count == 0:                     # no order within max_speed: m = 0
             for k in range(h):
                 hyp[k] = ms[k] == 0
             count = 1
@@ -766,17 +763,18 @@ def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, ms: np.ndarr
 
 
 def fold_decisions(class_power: np.ndarray, velocity_mps: np.ndarray, snr_db: np.ndarray,
-                   orders: np.ndarray, max_velocity_mps: float, max_speed_mps: float,
-                   test: bool, margin: float, min_snr_db: float
+                   lo: np.ndarray, hi: np.ndarray, orders: np.ndarray,
+                   max_velocity_mps: float, test: bool, margin: float, min_snr_db: float
                    ) -> tuple[np.ndarray, np.ndarray]:
     """The velocity-unfolding decision of ``host.pipeline._choose_fold`` for every cell:
     (alias order int (n,), ambiguous bool (n,)). Hypotheses: the alias orders m in
-    ``orders`` (int (h,), sorted, 0 among them) with |v + 2 m max_velocity| <=
-    max_speed_mps (m = 0 when none is). With ``test`` and more than one hypothesis the TDM
-    test keeps those of the alias class (m mod num_tx) whose power in class_power (float
-    (n, num_tx)) beats every other present class's by ``margin`` (a power ratio), falling
-    back to class 0 below min_snr_db (snr_db float (n,)); the order nearest zero velocity
-    wins. velocity_mps: float (n,) measured (aliased)."""
+    ``orders`` (int (h,), sorted, 0 among them) within lo..hi (int (n,) each, the cell's
+    orders from ``host.pipeline.alias_orders``; m = 0 when the range is empty). With
+    ``test`` and more than one hypothesis the TDM test keeps those of the alias class
+    (m mod num_tx) whose power in class_power (float (n, num_tx)) beats every other present
+    class's by ``margin`` (a power ratio), falling back to class 0 below min_snr_db (snr_db
+    float (n,)); the order nearest zero velocity (|v + 2 m max_velocity_mps|) wins.
+    velocity_mps: float (n,) measured (aliased)."""
     n = len(velocity_mps)
     fold = np.zeros(n, np.int64)
     ambiguous = np.zeros(n, bool)
@@ -784,9 +782,10 @@ def fold_decisions(class_power: np.ndarray, velocity_mps: np.ndarray, snr_db: np
         _fold_decisions(np.ascontiguousarray(class_power, dtype=float),
                         np.ascontiguousarray(velocity_mps, dtype=float),
                         np.ascontiguousarray(snr_db, dtype=float),
+                        np.ascontiguousarray(lo, dtype=np.int64),
+                        np.ascontiguousarray(hi, dtype=np.int64),
                         np.ascontiguousarray(orders, dtype=np.int64), float(max_velocity_mps),
-                        float(max_speed_mps), bool(test), float(margin), float(min_snr_db),
-                        fold, ambiguous)
+                        bool(test), float(margin), float(min_snr_db), fold, ambiguous)
     return fold, ambiguous
 
 

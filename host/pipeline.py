@@ -402,12 +402,11 @@ def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.nda
     class_power: float (n, num_tx) (``_class_powers``; (n, 0) when the TDM test does not
     run); velocity_mps, snr_db: float (n,)."""
     v = np.asarray(velocity_mps, dtype=float)
-    _, _, ms = alias_orders(cfg, v, params)
+    lo, hi, ms = alias_orders(cfg, v, params)
     test = cfg.num_tx > 1 and params.unfold_velocity and class_power.shape[1] == cfg.num_tx
     return fold_decisions(class_power if test else np.zeros((len(v), cfg.num_tx)), v,
-                          np.asarray(snr_db, dtype=float), ms, cfg.max_velocity_mps,
-                          params.max_speed_mps, test, 10 ** (params.unfold_margin_db / 10),
-                          params.unfold_min_snr_db)
+                          np.asarray(snr_db, dtype=float), lo, hi, ms, cfg.max_velocity_mps,
+                          test, 10 ** (params.unfold_margin_db / 10), params.unfold_min_snr_db)
 
 
 def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
