@@ -22,10 +22,11 @@ cost on the link and on the host. Prints four tables:
    the process is pinned to one CPU and the BLAS / OpenMP pools get one thread (set before
    numpy loads). Table 1 also gives the azimuth errors of both, and in how many scenes old
    and new clouds agree. Then where the 1000-detection frames spend their time, per step of
-   ``process_records``.
+   ``process_records``, and the spread of records -> point cloud over ``--spread-runs``
+   runs (best, median, 90th percentile; velocity unfolding on and off).
 
     python -m host.bench_detect [--scenes 100] [--full-scenes 20] [--noise-frames 40]
-                                [--repeat 5] [--host-only]
+                                [--repeat 5] [--spread-runs 100] [--host-only]
 
 Uses the bit-accurate model of the chain (mode 0 cube, mode 1 records). Reported, never
 asserted in tests.
@@ -382,6 +383,26 @@ def stage_rows(preset: str, n: int, repeat: int, varied: bool) -> dict[str, floa
     return {k: v * 1e3 for k, v in best.items()}
 
 
+def spread_ms(preset: str, n: int, runs: int, varied: bool, unfold: bool
+              ) -> tuple[float, float, float]:
+    """(best, median, 90th percentile) CPU ms of records -> point cloud over ``runs`` runs
+    of one frame of ``n`` synthetic records; ``unfold``: ``DetectionParams.
+    unfold_velocity``. The spread a frame loop sees on this machine, not just its best."""
+    cfg = get_preset(preset)
+    params = DetectionParams(unfold_velocity=unfold)
+    arr = _decoded(_frame_packets(cfg, n, varied), cfg,
+                   fpga_detect_config(cfg, params.cfar, max_detections=n),
+                   chain_gain(cfg, PipelineParams()))
+    process_records(arr, cfg, params)             # compile / load the kernels
+    spent = []
+    for _ in range(runs):
+        t0 = time.process_time()
+        process_records(arr, cfg, params)
+        spent.append(time.process_time() - t0)
+    best, median, p90 = np.percentile(spent, (0, 50, 90)) * 1e3
+    return float(best), float(median), float(p90)
+
+
 def calibration_ms(repeat: int) -> float:
     """CPU ms of 10^6 complex128 multiplications: this machine's speed and load at the time
     (to compare runs on differently loaded machines)."""
@@ -398,6 +419,8 @@ def main() -> None:
     ap.add_argument("--table1-seeds", type=int, default=30,
                     help="noise seeds of the Table I error table (about 2 s each)")
     ap.add_argument("--repeat", type=int, default=5, help="timing runs; best is reported")
+    ap.add_argument("--spread-runs", type=int, default=100,
+                    help="runs of the best / median / 90th percentile table")
     ap.add_argument("--host-only", action="store_true",
                     help="only table 4 (host time per frame), a minute instead of ~15")
     args = ap.parse_args()
@@ -496,6 +519,14 @@ def host_table(args: argparse.Namespace) -> None:
         label = "of which RELAX (`relax_rows`)" if name == "relax_rows" else f"`{name}`"
         print(f"| {label} | {got[0]:.2f} | {got[1]:.2f} |")
     print(f"| total | {rows['strong']['total']:.2f} | {rows['mixed']['total']:.2f} |")
+    print(f"\n## Records -> point cloud, 1000 detections, `full`, one core: CPU ms over "
+          f"{args.spread_runs} runs")
+    print("| frame | velocity unfolding | best | median | 90th percentile |")
+    print("|---|---|---|---|---|")
+    for kind in ("strong", "mixed"):
+        for unfold in (True, False):
+            b, m, p = spread_ms("full", 1000, args.spread_runs, kind == "mixed", unfold)
+            print(f"| {kind} | {'on' if unfold else 'off'} | {b:.2f} | {m:.2f} | {p:.2f} |")
     print(f"\nCPU calibration after the runs: {calibration_ms(args.repeat):.2f} ms per 10^6 "
           f"complex multiplications")
 
