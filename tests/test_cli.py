@@ -1,6 +1,7 @@
 """The `radar` command line: simulate writes the DESIGN.md array; bad input exits 2."""
 
 import json
+import re
 import subprocess
 import sys
 
@@ -48,6 +49,9 @@ def test_demo_prints_table3_and_writes_figures(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "paper" in text and "MISSED" not in text
     assert "unfolded by TDM phase test" in text  # vehicle 3 reported honestly
+    # a frame's time apart from the first call's one-time kernel loading
+    assert re.search(r"host processing \d+ ms per frame \(the process's first frame \d+ ms",
+                     text)
     for name in ("fig6_range_doppler_ch0.png", "fig5_range_azimuth_bf_vs_nobf.png",
                  "range_doppler_nci.png", "point_cloud.png"):
         assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
