@@ -303,7 +303,7 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     noise = np.asarray(noise, dtype=float)
     dd = offsets[:, 1]
     sb = signed_bins(nd)[d].astype(np.int64)
-    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    snr_db = cell_snr_db(power, noise, nv)
     measured = (sb + dd) * cfg.velocity_bin_mps
     # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
     class_power = (_class_powers(x, cfg, sb, params.angle.n_fft)
@@ -313,7 +313,7 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     for i in range(n):
         powers = {c: float(p) for c, p in enumerate(class_power[i])}
         fold[i], ambiguous[i] = _choose_fold(powers, cfg, float(measured[i]),
-                                             float(cell_snr_db[i]), params)
+                                             float(snr_db[i]), params)
     k = sb + fold * nd
     # step 4: angles of the TDM-compensated channel vectors
     comps = estimate_angles_batch(x * _tdm_comp(cfg, k), noise / nv, params.angle)
@@ -324,6 +324,15 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
                   np.array([c.azimuth_deg for c in flat]),
                   np.array([c.amplitude for c in flat], dtype=complex),
                   np.array([c.snr_db for c in flat]), frame)
+
+
+def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndarray:
+    """SNR of detected cells over the coherent sum of their channels, dB, float (n,):
+    (power - noise) / noise of the non-coherent map (power, noise float (n,)) plus the
+    coherent gain 10 log10(n_virtual); a zero noise estimate (noiseless input: every
+    training cell 0) counts as 1e-30, as the angle estimator's noise floor."""
+    noise = np.maximum(noise, 1e-30)
+    return 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(n_virtual)
 
 
 def _cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.ndarray,
@@ -434,7 +443,7 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
     noise = np.asarray(noise, dtype=float)
     dd = offsets[:, 1]
     sb = signed_bins(nd)[d].astype(np.int64)
-    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    snr_db = cell_snr_db(power, noise, nv)
     measured = (sb + dd) * cfg.velocity_bin_mps
     # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
     if cfg.num_tx > 1 and params.unfold_velocity:
@@ -443,7 +452,7 @@ def points_from_cells(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarra
         class_power, class_sin = peak_power_fast(xc, params.angle.n_fft)
     else:
         class_power = np.zeros((n, 0))
-    fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
+    fold, ambiguous = choose_folds(class_power, cfg, measured, snr_db, params)
     k = sb + fold * nd
     # step 4: angles of the TDM-compensated channel vectors (the phasors of k are those of
     # its class k mod num_tx n_doppler: the class's vector and peak serve)

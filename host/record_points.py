@@ -51,12 +51,13 @@ from host.pipeline import (
     _tdm_compensate,
     _tdm_tx_phasors,
     alias_orders,
+    cell_snr_db,
     choose_folds,
     neighbour_offsets,
     points_from_cells,
 )
 from host.pointcloud import PointCloud
-from host.records import RecordArrays
+from host.records import RecordArrays, outside_map
 from model.config import RadarConfig
 from model.reference import signed_bins
 
@@ -158,7 +159,7 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
     x = np.ascontiguousarray(snapshots, dtype=np.complex128)   # once for every kernel
     noise = np.asarray(noise, dtype=float)
     sb = signed_bins(nd)[d].astype(np.int64)
-    cell_snr_db = 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(nv)
+    snr_db = cell_snr_db(power, noise, nv)
     measured = (sb + offsets[:, 1]) * cfg.velocity_bin_mps
     fold = np.zeros(n, np.int64)
     sn_sel = None
@@ -174,14 +175,14 @@ def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.nd
         class_power[ci, cc] = pw
         pair = np.full((n, ntx), -1, np.int64)
         pair[ci, cc] = np.arange(len(ci))
-        fold, ambiguous = choose_folds(class_power, cfg, measured, cell_snr_db, params)
+        fold, ambiguous = choose_folds(class_power, cfg, measured, snr_db, params)
         # the fold's class always holds a hypothesis: its peak was computed
         sel = pair[np.arange(n), fold % ntx]
         sn_sel = sn[sel]
         if not compiled:
             ang = estimate_angles_screened(xc[sel], noise / nv, params.angle, first_sin=sn_sel)
     else:
-        fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, cell_snr_db, params)
+        fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, snr_db, params)
         if not compiled:
             ang = estimate_angles_screened(_tdm_compensate(cfg, x, sb + fold * nd), noise / nv,
                                            params.angle)
@@ -206,10 +207,18 @@ def _neighbours(arr: RecordArrays) -> np.ndarray:
     return arr.neighbours
 
 
-def _check_channels(arr: RecordArrays, cfg: RadarConfig) -> None:
+def _check_records(arr: RecordArrays, cfg: RadarConfig) -> None:
+    """ValueError naming the problem when the records do not fit ``cfg``: their channel
+    count, or bins outside its map (``host.records.inside_map`` drops those first)."""
     if arr.snapshot.shape[1:] != (cfg.n_virtual,):
         raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
                          f"{cfg.n_virtual} virtual channels")
+    out = np.flatnonzero(outside_map(arr, cfg))
+    if len(out):
+        i = out[0]
+        raise ValueError(f"{len(out)} record(s) outside {cfg.name}'s {cfg.n_range} x "
+                         f"{cfg.n_doppler} map (first: range bin {arr.range_bin[i]}, Doppler "
+                         f"bin {arr.doppler_bin[i]}); host.records.inside_map drops them")
 
 
 def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
@@ -222,7 +231,7 @@ def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     replaced implementation (:func:`process_records_reference`; benchmark, tests);
     ``compiled`` False: the angle work of :func:`points_from_snapshots` in numpy (benchmark)."""
     params = params or DetectionParams()
-    _check_channels(arr, cfg)
+    _check_records(arr, cfg)
     if reference:
         return process_records_reference(arr, cfg, params, frame)
     idx = select_records(arr, cfg, params)
@@ -240,7 +249,7 @@ def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
     search); same points (tests). The map-based selection and 1024-point FFTs before it are
     ``select_records_reference`` and ``host.pipeline.points_from_cells_reference``."""
     params = params or DetectionParams()
-    _check_channels(arr, cfg)
+    _check_records(arr, cfg)
     idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)

@@ -274,6 +274,34 @@ class RecordArrays:
         return int(len(self.range_bin))
 
 
+def outside_map(arr: RecordArrays, cfg: RadarConfig) -> np.ndarray:
+    """bool (n,): the records whose (range_bin, doppler_bin) lie outside ``cfg``'s
+    n_range x n_doppler map (the header fields are 12 bits wide: corrupt words that still
+    look like records, or records of another configuration)."""
+    r, d = np.asarray(arr.range_bin), np.asarray(arr.doppler_bin)
+    return (r < 0) | (r >= cfg.n_range) | (d < 0) | (d >= cfg.n_doppler)
+
+
+def inside_map(arr: RecordArrays, cfg: RadarConfig) -> tuple[RecordArrays, int]:
+    """(the records inside ``cfg``'s map, how many were dropped) (:func:`outside_map`):
+    what the receivers hand to ``host.record_points.process_records``, which refuses
+    records outside the map; the count goes into the frame's problems."""
+    out = outside_map(arr, cfg)
+    if not out.any():
+        return arr, 0
+    keep = ~out
+    return RecordArrays(arr.range_bin[keep], arr.doppler_bin[keep], arr.power[keep],
+                        arr.noise[keep], arr.snapshot[keep],
+                        None if arr.neighbours is None else arr.neighbours[keep]
+                        ), int(out.sum())
+
+
+def outside_problem(frame_id: int, dropped: int, cfg: RadarConfig) -> str:
+    """The frame problem a receiver reports for records :func:`inside_map` dropped."""
+    return (f"frame {frame_id}: {dropped} record(s) outside the {cfg.n_range} x "
+            f"{cfg.n_doppler} map dropped")
+
+
 def record_arrays(records: Sequence[Record], n_virtual: int, gain: float = 1.0
                   ) -> RecordArrays:
     """Arrays of ``records`` (see :class:`RecordArrays`); ``gain``: the chain's gain over

@@ -6,7 +6,8 @@ Tolerance of "same cloud": integer and flag fields exactly, float fields within 
 
 from __future__ import annotations
 
-from dataclasses import fields
+import warnings
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -48,6 +49,8 @@ from host.records import (
     RecordList,
     decode_record_fields,
     fpga_detect_config,
+    inside_map,
+    outside_map,
     record_arrays,
     record_arrays_reference,
 )
@@ -403,3 +406,50 @@ def test_estimate_angles_rows_is_estimate_angles_per_row() -> None:
         np.testing.assert_allclose(got.amplitude, [c.amplitude for _, c in want], rtol=1e-9,
                                    atol=1e-9)
         np.testing.assert_allclose(got.snr_db, [c.snr_db for _, c in want], atol=1e-9)
+
+
+@pytest.mark.parametrize("field,value", [("range_bin", 64), ("range_bin", -1),
+                                         ("doppler_bin", 256), ("doppler_bin", 4095)])
+def test_records_outside_the_map_are_refused_or_dropped(field: str, value: int) -> None:
+    """Bins outside the map (12-bit header fields: corrupt words, another configuration's
+    records) get a ValueError naming them from process_records (both paths; the compiled
+    kernels would index out of bounds); inside_map drops them and counts them."""
+    cfg = get_preset("paper-fpga")
+    arr = record_arrays(synthetic_records(cfg, 40, seed=5), cfg.n_virtual, 37.0)
+    assert not outside_map(arr, cfg).any() and inside_map(arr, cfg) == (arr, 0)
+    bins = getattr(arr, field).copy()
+    bins[[3, 17]] = value
+    bad = replace(arr, **{field: bins})
+    for reference in (False, True):
+        with pytest.raises(ValueError, match=r"2 record\(s\) outside paper-fpga's 64 x 256 "
+                                             rf"map \(first: .*{value}"):
+            process_records(bad, cfg, reference=reference)
+    kept, dropped = inside_map(bad, cfg)
+    assert dropped == 2 and len(kept) == 38
+    keep = np.setdiff1d(np.arange(40), [3, 17])
+    for f in fields(arr):
+        np.testing.assert_array_equal(getattr(kept, f.name), getattr(arr, f.name)[keep])
+    assert len(process_records(kept, cfg)) > 0
+    no_nb = inside_map(replace(bad, neighbours=None), cfg)[0]
+    assert no_nb.neighbours is None and len(no_nb) == 38
+
+
+def test_zero_noise_estimates_give_finite_points() -> None:
+    """A CFAR noise estimate of 0 (noiseless input: every training cell 0) is the noise
+    floor 1e-30 (host.pipeline.cell_snr_db, the angle estimator): no divide warning, the
+    same points as that floor, every value finite; on both paths."""
+    cfg = get_preset("full")
+    arr = record_arrays(synthetic_records(cfg, 60, seed=9, varied=True), cfg.n_virtual, 37.0)
+    zero = replace(arr, noise=np.zeros_like(arr.noise))
+    floor = replace(arr, noise=np.full_like(arr.noise, 1e-30))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for reference in (False, True):
+            got = process_records(zero, cfg, reference=reference)
+            want = process_records(floor, cfg, reference=reference)
+            assert len(got) == len(want) > 0
+            for f in fields(got):
+                a = getattr(got, f.name)
+                np.testing.assert_array_equal(a, getattr(want, f.name), err_msg=f.name)
+                if a.dtype.kind == "f":
+                    assert np.isfinite(a).all(), f.name

@@ -8,8 +8,8 @@ import socket
 import threading
 import time
 
-from host.capture import read_capture
-from model.detect_records import frame_words
+from host.capture import read_capture, write_capture
+from model.detect_records import TAG_RECORD, frame_words
 from radar.cli import main
 
 
@@ -61,3 +61,26 @@ def test_record_capture_replay_receive(tmp_path, capsys):
     assert rc == 1
     doc = json.loads(out.read_text())
     assert any("--detect fpga" in u for u in doc["stream_problems"]), doc["stream_problems"]
+
+
+def test_receive_drops_records_outside_the_map(tmp_path):
+    """A record whose bins lie outside the map (corrupt words that still carry the record
+    tag: the packets have no checksum) is dropped and named in the frame's problems; the
+    other records still become points (process_records refuses such records: tests in
+    test_records_fast.py)."""
+    cap = tmp_path / "r.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "1",
+                 "--packet-words", "64", "--detect", "fpga", "--out", str(cap)]) == 0
+    info, packets = read_capture(cap)
+    packets = [bytearray(p) for p in packets]
+    wb = 4 * info.num_rx                  # the packet header word, then record 0's header
+    first = int.from_bytes(packets[0][wb:wb + 4], "little")
+    assert first >> 24 == TAG_RECORD
+    packets[0][wb:wb + 4] = (first | 0xFFF << 12).to_bytes(4, "little")   # range bin 4095
+    bad = tmp_path / "bad.dmacap"
+    write_capture(bad, info, (bytes(p) for p in packets))
+    rc, out = _round_trip(tmp_path, bad, ["--detect", "fpga"])
+    assert rc == 0
+    f0 = json.loads(out.read_text())["frame_info"][0]
+    assert f0["complete"] and f0["points"] >= 3
+    assert any("1 record(s) outside the 64 x 256 map dropped" in p for p in f0["problems"])

@@ -21,7 +21,7 @@ from host.capture import CaptureInfo, read_capture, write_capture
 from host.pipeline import process_cube
 from host.pointcloud import PointCloud
 from host.record_points import process_records
-from host.records import RecordDecoder, record_arrays
+from host.records import RecordDecoder, inside_map, outside_problem, record_arrays
 from model.axis_packetizer import words_to_bytes
 from model.config import PRESETS, RadarConfig, get_preset
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
@@ -193,7 +193,11 @@ def cmd_receive(args: argparse.Namespace) -> int:
             if decoder and cfg and (f.complete or args.use_damaged):
                 gain = chain_gain(cfg, PipelineParams(packet_words=decoder.packet_words))
                 if records:
-                    arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
+                    arr, dropped = inside_map(
+                        record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain), cfg)
+                    if dropped:          # corrupt words that still looked like records
+                        entry["problems"] = [*f.problems, outside_problem(
+                            f.frame_id, dropped, cfg)]
                     note_compile("receive")
                     cloud = process_records(arr, cfg, params, frame=f.frame_id)
                     entry.update({"records": len(f.records), "detections": f.detections,

@@ -29,7 +29,13 @@ import numpy as np
 from host.capture import CaptureInfo, read_capture
 from host.pipeline import DetectionParams, process_cube_nci
 from host.record_points import process_records
-from host.records import DetectionFrame, RecordDecoder, record_arrays
+from host.records import (
+    DetectionFrame,
+    RecordDecoder,
+    inside_map,
+    outside_problem,
+    record_arrays,
+)
 from host.stream import (
     PacketDecoder,
     cube_frame_words,
@@ -205,14 +211,11 @@ class Processor:
 
     def _process_records(self, job: _RecordJob, skipped: int) -> None:
         cfg, f = job.cfg, job.frame
-        records = f.records[:f.usable_records]
-        inside = [r for r in records if r.range_bin < cfg.n_range and r.doppler_bin < cfg.n_doppler]
-        if len(inside) < len(records):  # corrupt words that still looked like records
+        arr, dropped = inside_map(
+            record_arrays(f.records[:f.usable_records], cfg.n_virtual, job.gain), cfg)
+        if dropped:                     # corrupt words that still looked like records
             with self.health.lock:
-                self.health.problems.append(
-                    f"frame {job.frame_id}: {len(records) - len(inside)} record(s) outside "
-                    f"the {cfg.n_range} x {cfg.n_doppler} map dropped")
-        arr = record_arrays(inside, cfg.n_virtual, job.gain)
+                self.health.problems.append(outside_problem(job.frame_id, dropped, cfg))
         note_compile("view")                # the kernels may compile now (once per checkout)
         cloud = process_records(arr, cfg, self.params, frame=job.frame_id)
         objects = self._objects(cloud)
