@@ -99,7 +99,7 @@ def load_frames(path: Path) -> tuple[list[Frame], dict[str, str]]:
         pc = {fl.name: z[f"pc_{fl.name}"] for fl in fields(PointCloud)}
         pcls, pobj, boxes, bcls, ego = (z[k] for k in ("point_class", "point_object", "boxes",
                                                        "box_class", "ego_speed"))
-    except (KeyError, OSError, ValueError) as exc:
+    except (KeyError, OSError, ValueError, EOFError) as exc:
         raise ValueError(f"dataset: {path} is not a gnn dataset file ({exc})") from None
     frames = []
     for i in range(len(ego)):

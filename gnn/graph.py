@@ -9,6 +9,7 @@ need compiled extensions that are not installed, hence cKDTree.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,8 +45,8 @@ class GraphConfig:
             raise ValueError(f"graph kind: must be 'knn' or 'radius', got {self.kind!r}")
         if self.k < 1:
             raise ValueError(f"k: must be >= 1, got {self.k}")
-        if self.radius_m <= 0:
-            raise ValueError(f"radius_m: must be positive, got {self.radius_m}")
+        if not 0 < self.radius_m < math.inf:
+            raise ValueError(f"radius_m: must be positive and finite, got {self.radius_m}")
 
 
 def neighbour_edges(xy: np.ndarray, cfg: GraphConfig) -> np.ndarray:

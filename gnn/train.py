@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import dataclass
 
@@ -29,8 +30,11 @@ class TrainConfig:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.epochs < 1 or self.batch_size < 1 or self.lr <= 0:
-            raise ValueError("train: epochs and batch_size must be >= 1 and lr > 0")
+        if self.epochs < 1 or self.batch_size < 1 or not 0 < self.lr < math.inf:
+            raise ValueError("train: epochs and batch_size must be >= 1 and lr finite > 0")
+        if not 0 <= self.box_weight < math.inf:
+            raise ValueError(f"train: box_weight must be finite and >= 0, got "
+                             f"{self.box_weight!r}")
 
 
 def seed_everything(seed: int) -> None:

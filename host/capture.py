@@ -117,6 +117,11 @@ def read_capture(path: Path) -> tuple[CaptureInfo, Iterator[bytes]]:
             f.close()
             raise ValueError(f"{path}: record capture header truncated or MAX_DETECTIONS 0")
         (max_det,) = _MAX_DET.unpack(more)
+    if not 2 <= packet_words <= 65535 or not num_rx or not num_tx:
+        f.close()
+        raise ValueError(f"{path}: capture header says {packet_words} payload words per "
+                         f"packet, {num_rx} lanes, {num_tx} TX (packets carry 2..65535 words, "
+                         f"lanes and TX >= 1): not a capture this tool wrote")
     info = CaptureInfo(num_rx, packet_words, num_tx, n_range, n_doppler, max_det)
 
     def packets() -> Iterator[bytes]:

@@ -480,7 +480,12 @@ def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     (n_range, n_doppler), LSB^2 (a display needs it; computing it again costs a cube pass)."""
     params = params or DetectionParams()
     cfg.check_cube(cube)
+    if np.asarray(cube).dtype.kind != "c":
+        raise ValueError(f"cube: must be complex (Doppler FFT values), got dtype "
+                         f"{np.asarray(cube).dtype}")
     cells, noise, nci = detect_cells(cube, cfg, params)
+    if not np.isfinite(nci).all():         # NaN / inf anywhere in the cube reach the map
+        raise ValueError("cube: contains NaN or infinite values")
     offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
     r, d = cells[:, 0], cells[:, 1]
     fn = points_from_cells_reference if reference else points_from_cells

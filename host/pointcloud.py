@@ -127,7 +127,18 @@ class PointCloud:
             db = [int(p.get("doppler_bin", 0)) for p in pts]
             frame = np.array([int(p.get("frame", 0)) for p in pts], dtype=int)
             amb = [bool(p.get("ambiguous", False)) for p in pts]
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"not a point cloud JSON object ({exc!r})") from None
+        for key, values in (*get.items(), ("rcs_dbsm", rcs)):
+            bad = [i for i, v in enumerate(values) if not np.isfinite(v)]
+            if bad:
+                raise ValueError(f"point {bad[0]}: {key} is {values[bad[0]]!r}, not a finite "
+                                 f"number")
+        bad = [i for i, (r, az) in enumerate(zip(get["range_m"], get["azimuth_deg"],
+                                                 strict=True)) if r < 0 or abs(az) > 90]
+        if bad:
+            raise ValueError(f"point {bad[0]}: range_m {get['range_m'][bad[0]]!r}, azimuth_deg "
+                             f"{get['azimuth_deg'][bad[0]]!r}: a point needs range >= 0 and "
+                             f"|azimuth| <= 90 deg")
         return cls.from_polar(rcs_dbsm=rcs, range_bin=rb, doppler_bin=db, ambiguous=amb,
                               frame=frame, **get)

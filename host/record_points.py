@@ -210,9 +210,25 @@ def _neighbours(arr: RecordArrays) -> np.ndarray:
 def _check_records(arr: RecordArrays, cfg: RadarConfig) -> None:
     """ValueError naming the problem when the records do not fit ``cfg``: their channel
     count, or bins outside its map (``host.records.inside_map`` drops those first)."""
-    if arr.snapshot.shape[1:] != (cfg.n_virtual,):
-        raise ValueError(f"records carry {arr.snapshot.shape[1:]} channels, {cfg.name} has "
-                         f"{cfg.n_virtual} virtual channels")
+    n = len(np.asarray(arr.range_bin))
+    shapes = {"range_bin": (n,), "doppler_bin": (n,), "power": (n,), "noise": (n,),
+              "snapshot": (n, cfg.n_virtual)}
+    if arr.neighbours is not None:
+        shapes["neighbours"] = (n, 4)
+    for name, shape in shapes.items():
+        value = np.asarray(getattr(arr, name))
+        if name == "snapshot" and value.shape[1:] != shape[1:]:
+            raise ValueError(f"records carry {value.shape[1:]} channels, {cfg.name} has "
+                             f"{cfg.n_virtual} virtual channels")
+        if value.shape != shape:
+            raise ValueError(f"records: {name} has shape {value.shape}, expected {shape} "
+                             f"({n} records)")
+        kinds = {"range_bin": "iu", "doppler_bin": "iu", "snapshot": "c"}.get(name, "fiu")
+        if value.dtype.kind not in kinds:
+            want = {"iu": "integer", "c": "complex"}.get(kinds, "real")
+            raise ValueError(f"records: {name} has dtype {value.dtype}, expected {want}")
+        if kinds == "fiu" and not (np.isfinite(value).all() and (value >= 0).all()):
+            raise ValueError(f"records: {name} must be finite and >= 0 (powers)")
     out = np.flatnonzero(outside_map(arr, cfg))
     if len(out):
         i = out[0]

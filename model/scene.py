@@ -43,6 +43,8 @@ MAX_RCS_M2 = 1.0e6
 """Largest RCS, m^2 (a large ship)."""
 MAX_SIZE_M = 1000.0
 """Largest object length or width, m."""
+MIN_SIZE_M = 0.01
+"""Smallest length / width of an extended object, m (a box of edges that can be sampled)."""
 MAX_SCATTERERS_PER_OBJECT = 256
 """Scatterers per extended object (memory and time of the simulator grow with it)."""
 MAX_SCATTERERS = 2048
@@ -63,8 +65,15 @@ def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = 
             raise ValueError(f"{where}: missing required field {key!r}")
         return default
     value = d[key]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, int | float):
         raise ValueError(f"{where}.{key}: must be a finite number, got {value!r}")
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:                   # an integer beyond float range
+        finite = False
+    if not finite:
+        raise ValueError(f"{where}.{key}: must be a finite number, got {str(value)[:20]}"
+                         f"{'...' if len(str(value)) > 20 else ''}")
     lo, hi = _BOUNDS.get(key, (-math.inf, math.inf))
     if not lo <= value <= hi:
         raise ValueError(f"{where}.{key}: {value!r} is outside what the simulator accepts "
@@ -171,8 +180,13 @@ class ExtendedObject:
     def __post_init__(self) -> None:
         if self.x_m <= 0:
             raise ValueError(f"x_m: object must be in front of the radar (x > 0), got {self.x_m}")
-        if self.length_m <= 0 or self.width_m <= 0:
-            raise ValueError("length_m/width_m: must be positive")
+        if self.length_m < MIN_SIZE_M or self.width_m < MIN_SIZE_M:
+            raise ValueError(f"length_m/width_m: must be at least {MIN_SIZE_M:g} m, got "
+                             f"{self.length_m!r} x {self.width_m!r}")
+        if (self.corners()[:, 0] <= 0).any():
+            raise ValueError(f"object at x {self.x_m:g} m, y {self.y_m:g} m: its "
+                             f"{self.length_m:g} x {self.width_m:g} m box reaches x <= 0 "
+                             f"(beside or behind the radar); the whole box must be in front")
         if self.rcs_m2 <= 0:
             raise ValueError(f"rcs_m2: must be positive, got {self.rcs_m2}")
         if not isinstance(self.n_scatterers, int) or not \
@@ -295,7 +309,7 @@ class Scene:
         if "scene" in d:
             _check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise"}, "scene")
             builtin = d["scene"]
-            if builtin not in BUILTIN_SCENES:
+            if not isinstance(builtin, str) or builtin not in BUILTIN_SCENES:
                 raise ValueError(f"scene: unknown built-in scene {builtin!r}; choose one of "
                                  f"{', '.join(BUILTIN_SCENES)}")
             base = BUILTIN_SCENES[builtin](preset)
@@ -413,6 +427,8 @@ def load_scene(spec: str | Path, preset: str | None = None) -> Scene:
         data = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"scene: {spec_s} is not valid JSON: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"scene: {spec_s} is not a scene: JSON nested too deeply") from None
     if preset is not None and isinstance(data, dict):
         data = {**data, "preset": preset}
     return Scene.from_dict(data)

@@ -96,7 +96,12 @@ def out_file(path: str, suffix: str, option: str) -> Path:
     p = Path(path)
     if p.suffix != suffix:
         raise CliError(f"{option}: {p} must end in {suffix}")
-    p.parent.mkdir(parents=True, exist_ok=True)
+    if p.is_dir():
+        raise CliError(f"{option}: {p} is a folder, not a file")
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise CliError(f"{option}: {p.parent} is a file, not a folder") from None
     return p
 
 

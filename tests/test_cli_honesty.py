@@ -127,6 +127,11 @@ BAD = [
     ["replay", "--rate-mbps", "nan"], ["replay", "--loss", "2"], ["replay", "--seed", "-1"],
     ["capture", "--packet-words", "5000"], ["capture", "--packet-words", "1"],
     ["capture", "--frames", "0"], ["capture", "--frames", "100000"],
+    ["replay", "--rate-mbps", "1e-9"], ["replay", "--rate-mbps", "1e-300"],
+    ["receive", "--packet-words", "-3"], ["receive", "--packet-words", "0"],
+    ["view", "--fps", "nan"], ["view", "--fps", "1e-300"], ["view", "--duration", "0"],
+    ["view", "--duration", "nan"], ["view", "--duration", "-1"], ["view", "--seed", "-1"],
+    ["view", "--ego-speed", "nan"], ["view", "--packet-words", "0"],
 ]
 
 
@@ -139,7 +144,8 @@ def test_bad_option_values_one_line_exit_2(tmp_path, capsys, argv):
              "simulate": ["--scene", scene, "--out", str(tmp_path / "o.npy")],
              "receive": ["--json", str(tmp_path / "o.json"), "--timeout", "0.2"],
              "replay": ["--capture", str(tmp_path / "missing.dmacap")],
-             "capture": ["--scene", scene, "--out", str(tmp_path / "o.dmacap")]}[cmd]
+             "capture": ["--scene", scene, "--out", str(tmp_path / "o.dmacap")],
+             "view": ["--scene", scene, "--port", "0", "--duration", "0.1"]}[cmd]
     if cmd == "replay" and "--port" not in rest:
         extra += ["--port", "9"]
     t0 = time.monotonic()
@@ -185,3 +191,54 @@ def test_demo_paper_fpga_says_aliased(tmp_path, capsys):
     row = [line for line in out.splitlines() if line.strip().startswith("3 |")][0]
     assert "ALIASED" in row and "*" in row
     assert (tmp_path / "point_cloud.png").stat().st_size > 10_000
+
+
+def _bad_files(tmp_path):
+    """(argv, what the one-line error must say) of bad files given to the CLI."""
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    pts = {"range_m": 10.0, "azimuth_deg": 0.0, "radial_velocity_mps": 0.0, "power_db": 1.0,
+           "snr_db": 20.0}
+
+    def points(name, **bad):
+        p = tmp_path / name
+        p.write_text(json.dumps({"points": [{**pts, **bad}]}))
+        return str(p)
+
+    cap = tmp_path / "c.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "1",
+                 "--out", str(cap)]) == 0
+    raw = bytearray(cap.read_bytes())
+    raw[12:16] = (0).to_bytes(4, "little")          # header: payload words per packet 0
+    pw0 = tmp_path / "pw0.dmacap"
+    pw0.write_bytes(bytes(raw))
+    empty = tmp_path / "empty.npz"
+    empty.write_bytes(b"")
+    (tmp_path / "adir.json").mkdir()
+    return [
+        (["simulate", "--scene", str(deep), "--out", str(tmp_path / "o.npy")], "nested"),
+        (["gnn", "detect", "--points", str(deep)], "nested"),
+        (["gnn", "detect", "--points", points("inf.json", frame=float("inf"))], "infinity"),
+        (["gnn", "detect", "--points", points("neg.json", range_m=-42.0)], "range >= 0"),
+        (["gnn", "detect", "--points", points("az.json", azimuth_deg=1000.0)], "azimuth"),
+        (["gnn", "detect", "--points", points("nan.json", snr_db=float("nan"))], "snr_db"),
+        (["replay", "--capture", str(pw0), "--port", "9"], "0 payload words"),
+        (["view", "--replay", str(pw0), "--port", "0", "--duration", "0.1"],
+         "0 payload words"),
+        (["gnn", "eval", "--data", str(empty)], "not a gnn dataset"),
+        (["gnn", "train", "--data", str(empty), "--threads", "0"], "--threads"),
+        (["gnn", "train", "--data", str(empty), "--out", "/proc/x.pt"], "--out"),
+        (["receive", "--json", str(tmp_path / "adir.json"), "--timeout", "0.2"], "folder"),
+    ]
+
+
+def test_bad_files_one_line_exit_2(tmp_path, capsys):
+    """Files that are not what the option needs (nested too deeply, non-finite or impossible
+    points, a capture header with 0 words per packet, an empty dataset, an unwritable or
+    folder output): exit 2 with one line naming the problem, before any long work."""
+    for argv, word in _bad_files(tmp_path):
+        capsys.readouterr()
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and err.startswith(f"radar {argv[0]}: error:"), err
+        assert word.lower() in err.lower() and "Traceback" not in err, (argv, err)

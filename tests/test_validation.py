@@ -115,10 +115,23 @@ def test_scene_target_fields(target, word):
     ({**_O, "n_scatterers": 1_000_000}, "n_scatterers"),
     ({**_O, "n_scatterers": 1e6}, "n_scatterers"), ({**_O, "n_scatterers": 0}, "n_scatterers"),
     ({**_O, "length_m": 1e7}, "length_m"), ({**_O, "vx_mps": NAN}, "vx_mps"),
-    ({**_O, "x_m": -5}, "x_m"), ({**_O, "heading_deg": 1e300}, "heading")])
+    ({**_O, "x_m": -5}, "x_m"), ({**_O, "heading_deg": 1e300}, "heading"),
+    ({**_O, "x_m": 1}, "box reaches x <= 0"), ({**_O, "x_m": 1, "length_m": 4}, "behind"),
+    ({**_O, "length_m": 1e-300}, "at least"), ({**_O, "width_m": 0.001}, "at least"),
+    ({**_O, "y_m": 10**400}, "y_m")])
 def test_scene_object_fields(obj, word):
     with pytest.raises(ValueError, match=word) as exc:
         Scene.from_dict({"preset": "full", "objects": [obj]})
+    _one_line(exc)
+
+
+@pytest.mark.parametrize("doc, word", [
+    ({"scene": ["table1"]}, "built-in"), ({"scene": {"a": 1}}, "built-in"),
+    ({"targets": [{**_T, "range_m": 10**400}]}, "range_m")])
+def test_scene_documents(doc, word):
+    """A non-string built-in scene name, an integer beyond float range: named, one line."""
+    with pytest.raises(ValueError, match=word) as exc:
+        Scene.from_dict({"preset": "full", **doc})
     _one_line(exc)
 
 

@@ -19,7 +19,7 @@ def _guarded(cmd: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Nam
         try:
             return int(cmd(args))
         except ValueError as exc:
-            print(f"gnn: error: {exc}", file=sys.stderr)
+            print(f"radar gnn: error: {exc}", file=sys.stderr)
             return 2
     return run
 

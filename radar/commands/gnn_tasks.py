@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +41,8 @@ def cmd_train(args: argparse.Namespace) -> int:
     from gnn.model import ModelConfig
     from gnn.train import TrainConfig, train
 
-    torch.set_num_threads(args.threads)
+    _threads(torch, args.threads)
+    _writable(Path(args.out))           # before training, not after
     paths = [Path(d) for d in args.data] if args.data else [_data_path(args, "train")]
     frames, meta = [], {}
     for path in paths:
@@ -63,6 +65,31 @@ def cmd_train(args: argparse.Namespace) -> int:
     return 0
 
 
+def _threads(torch: Any, threads: int) -> None:
+    """``--threads`` checked, then torch's intra-op pool set to it."""
+    if threads < 1:
+        raise ValueError(f"--threads: must be >= 1, got {threads}")
+    torch.set_num_threads(threads)
+
+
+def _writable(path: Path) -> None:
+    """ValueError unless a file can be written at ``path`` (its folder exists or can be
+    made, the path is not a folder)."""
+    if path.is_dir():
+        raise ValueError(f"--out: {path} is a folder, not a file")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"--out: cannot make the folder of {path}: "
+                         f"{exc.strerror or exc}") from None
+    try:
+        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise ValueError(f"--out: cannot write in {path.parent}: "
+                         f"{exc.strerror or exc}") from None
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     import torch
 
@@ -70,7 +97,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from gnn.evaluate import evaluate_all
     from gnn.infer import GnnDetector
 
-    torch.set_num_threads(args.threads)
+    _threads(torch, args.threads)
     frames, _ = load_frames(_data_path(args, "test"))
     res = evaluate_all(GnnDetector.from_checkpoint(args.checkpoint), frames,
                        progress=not args.quiet)
@@ -123,11 +150,14 @@ def read_points(path: Path) -> PointCloud:
         raise ValueError(f"points: no such file {str(path)!r}")
     try:
         doc = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"points: {path} is not a point cloud JSON ({exc!r})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"points: {path} is not a point cloud JSON ({exc})") from None
+    except RecursionError:
+        raise ValueError(f"points: {path} is not a point cloud JSON (nested too "
+                         f"deeply)") from None
     try:
         return PointCloud.from_json_dict(doc)
-    except ValueError as exc:
+    except (ValueError, OverflowError) as exc:
         raise ValueError(f"points: {path}: {exc}") from None
 
 

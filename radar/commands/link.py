@@ -92,8 +92,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
     check(args.seed, "--seed", 0 <= args.seed < 2**63, "an integer in 0..2**63-1")
     rate = args.rate_mbps
-    check(rate, "--rate-mbps", rate == 0 or 0 < rate <= 1e6,
-          "0 (unpaced) or a rate in (0, 1e6] Mbit/s")
+    check(rate, "--rate-mbps", rate == 0 or 1e-3 <= rate <= 1e6,
+          "0 (unpaced) or a rate in [0.001, 1e6] Mbit/s")
     try:
         info, packets = read_capture(Path(args.capture))
         cfg = info.config(PRESETS.values())
@@ -129,6 +129,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
 
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_RECEIVE_FRAMES)
+    count(args.packet_words, "--packet-words", 65535, lo=2)   # before listening
     try:
         check_seconds(args.idle_timeout, "--idle-timeout")
         check_seconds(args.timeout, "--timeout")
@@ -230,7 +231,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
         return 130
     if not clouds:
         why = ("no datagram arrived" if not rx.datagrams else
-               "no datagram was a DMA packet of a known preset" if not decoder else
+               "no datagram was a DMA packet of a known preset" + (
+                   f" ({rx.unusable[0][:300]})" if rx.unusable else "") if not decoder else
                "every frame was damaged (see --use-damaged)")
         print(f"radar receive: error: no usable frame: {why} within {args.timeout:g} s",
               file=sys.stderr)

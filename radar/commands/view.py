@@ -32,10 +32,10 @@ from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
 from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain
-from model.scene import EGO_SPEED_KMH, load_scene
+from model.scene import EGO_SPEED_KMH, check_ego_speed, load_scene
 from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, fpga_config
-from radar.common import CliError, add_detection_options, detection_params
+from radar.common import CliError, add_detection_options, check, count, detection_params
 from radar.sources import get_source
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
@@ -120,10 +120,21 @@ def build(args: argparse.Namespace, stop: threading.Event
     """Feed, health, the (not yet started) producer threads and a description of the
     source, from parsed ``radar view`` options. Raises CliError on bad input."""
     feed, health = Feed(), LinkHealth()
-    if args.fps < 0:
-        raise CliError("--fps: must be >= 0")
+    check(args.fps, "--fps", args.fps == 0 or 1e-3 <= args.fps <= 1e4,
+          "0 (as fast as possible) or a rate in [0.001, 1e4] frames/s")
     if not 0.0 <= args.loss <= 1.0:
         raise CliError("--loss: probability must be in [0, 1]")
+    check(args.seed, "--seed", 0 <= args.seed < 2**63, "an integer in 0..2**63-1")
+    if args.duration is not None:
+        check(args.duration, "--duration", 0 < args.duration <= 1e7,
+              "a number of seconds in (0, 1e7]")
+    if args.packet_words is not None:
+        count(args.packet_words, "--packet-words", 65535, lo=2)
+    if args.ego_speed is not None:
+        try:
+            check_ego_speed(args.ego_speed)
+        except ValueError as exc:
+            raise CliError(f"--ego-speed: {exc}") from None
     kind: str | None = {"host": CUBE, "fpga": RECORDS, None: None}[args.detect]
     detect_config = detect_config_of(args)
     try:
