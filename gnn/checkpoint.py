@@ -18,7 +18,12 @@ DEFAULT_CHECKPOINT = Path(__file__).resolve().parent / "checkpoints" / "radargnn
 
 def save_checkpoint(path: Path, model: RadarGnn, graph_cfg: GraphConfig,
                     meta: dict[str, Any]) -> None:
-    """Write ``{"state_dict", "model", "graph", "meta"}`` (tensors, numbers, strings)."""
+    """Write ``{"state_dict", "model", "graph", "meta"}`` (tensors, numbers, strings);
+    ValueError when a weight is not finite (a diverged training: nothing is written)."""
+    bad = _non_finite(model.state_dict())
+    if bad:
+        raise ValueError(f"checkpoint: {bad} holds NaN or infinite weights (training "
+                         f"diverged: lower --lr); nothing written to {path}")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     torch.save({"state_dict": model.state_dict(), "model": model.cfg.to_dict(),
@@ -42,5 +47,18 @@ def load_checkpoint(path: Path | None = None) -> tuple[RadarGnn, GraphConfig, di
         raise ValueError(f"checkpoint: {path} is not a readable gnn checkpoint "
                          f"({type(exc).__name__}); use a file written by `radar gnn train` "
                          f"(loaded with weights_only=True only)") from None
+    bad = _non_finite(model.state_dict())
+    if bad:
+        raise ValueError(f"checkpoint: {path}: {bad} holds NaN or infinite weights (a "
+                         f"diverged training)")
     model.eval()
     return model, graph, dict(ck.get("meta", {}))
+
+
+def _non_finite(state: dict[str, torch.Tensor]) -> str | None:
+    """The name of the first floating-point tensor of ``state`` with a NaN or infinite
+    element, else None."""
+    for name, t in state.items():
+        if t.is_floating_point() and not bool(torch.isfinite(t).all()):
+            return name
+    return None

@@ -194,7 +194,8 @@ def test_demo_paper_fpga_says_aliased(tmp_path, capsys):
 
 
 def _bad_files(tmp_path):
-    """(argv, what the one-line error must say) of bad files given to the CLI."""
+    """(argv, what the one-line error must say) of bad files given to the CLI, and
+    addresses this machine cannot bind."""
     deep = tmp_path / "deep.json"
     deep.write_text("[" * 100_000 + "]" * 100_000)
     pts = {"range_m": 10.0, "azimuth_deg": 0.0, "radial_velocity_mps": 0.0, "power_db": 1.0,
@@ -229,6 +230,10 @@ def _bad_files(tmp_path):
         (["gnn", "train", "--data", str(empty), "--threads", "0"], "--threads"),
         (["gnn", "train", "--data", str(empty), "--out", "/proc/x.pt"], "--out"),
         (["receive", "--json", str(tmp_path / "adir.json"), "--timeout", "0.2"], "folder"),
+        (["receive", "--json", str(tmp_path / "r.json"), "--host", "8.8.8.8", "--timeout",
+          "0.2"], "--host 8.8.8.8"),
+        (["view", "--udp-host", "8.8.8.8", "--port", "0", "--duration", "0.1"],
+         "--udp-host 8.8.8.8"),
     ]
 
 

@@ -182,3 +182,28 @@ def test_pickled_code_checkpoint_is_refused(tmp_path):
     with pytest.raises(ValueError, match="not a readable"):
         load_checkpoint(path)
     assert np.isfinite(1.0)
+
+
+def test_non_finite_weights_neither_saved_nor_loaded(tmp_path):
+    """A diverged training (NaN weights) writes no checkpoint; a checkpoint holding them
+    (written by other means) is refused on load, naming the tensor."""
+    import torch
+
+    from gnn.checkpoint import DEFAULT_CHECKPOINT, load_checkpoint, save_checkpoint
+
+    model, graph, meta = load_checkpoint(DEFAULT_CHECKPOINT)
+    name, weights = next((k, v) for k, v in model.state_dict().items()
+                         if v.is_floating_point())
+    with torch.no_grad():
+        weights.view(-1)[0] = float("nan")
+    path = tmp_path / "nan.pt"
+    with pytest.raises(ValueError, match=f"{name} holds NaN") as exc:
+        save_checkpoint(path, model, graph, meta)
+    _one_line(exc)
+    assert not path.exists()
+    ck = torch.load(DEFAULT_CHECKPOINT, weights_only=True)
+    ck["state_dict"][name].view(-1)[0] = float("inf")
+    torch.save(ck, path)
+    with pytest.raises(ValueError, match=f"{name} holds NaN or infinite") as exc:
+        load_checkpoint(path)
+    _one_line(exc)

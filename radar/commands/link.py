@@ -101,7 +101,11 @@ def cmd_replay(args: argparse.Namespace) -> int:
                           seed=args.seed)
         with UdpSender(args.host, args.port, rate * 1e6 if rate else None, imp) as tx:
             log = tx.send(packets)
-    except (ValueError, OSError) as exc:
+    except OSError as exc:
+        if exc.filename:                # the capture file
+            raise CliError(str(exc)) from None
+        raise CliError(f"--host {args.host} --port {args.port}: {exc}") from None
+    except ValueError as exc:
         raise CliError(str(exc)) from None
     kind = f"records, MAX_DETECTIONS {info.max_detections}" if info.records else "cube"
     print(f"sent {log.sent} datagrams ({cfg.name} {kind}, {info.packet_words} payload words "
@@ -176,8 +180,10 @@ def cmd_receive(args: argparse.Namespace) -> int:
             else:
                 StreamDecoder(fixed, args.packet_words)
         rx = UdpReceiver(args.host, args.port)
-    except (ValueError, OSError) as exc:
+    except ValueError as exc:
         raise CliError(str(exc)) from None
+    except OSError as exc:
+        raise CliError(f"--host {args.host} --port {args.port}: {exc}") from None
     print(f"listening on {args.host}:{rx.port}", flush=True)
     with rx:
         frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,

@@ -209,8 +209,11 @@ def build(args: argparse.Namespace, stop: threading.Event
     else:
         try:
             rx = UdpReceiver(args.udp_host, args.udp_port)
-        except (OSError, ValueError) as exc:  # ValueError: port outside 0..65535
+        except ValueError as exc:  # port outside 0..65535
             raise CliError(f"--udp-port: {exc}") from None
+        except OSError as exc:     # an unknown or foreign --udp-host, a port in use
+            raise CliError(f"--udp-host {args.udp_host} --udp-port {args.udp_port}: "
+                           f"{exc}") from None
         desc = f"UDP {args.udp_host}:{rx.port}"
         processor.source = desc
         threads.append(threading.Thread(target=udp_loop, name="view-udp", daemon=True,
