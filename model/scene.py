@@ -420,6 +420,8 @@ def load_scene(spec: str | Path, preset: str | None = None) -> Scene:
     if spec_s in BUILTIN_SCENES:
         return Scene.from_dict({"scene": spec_s, "preset": preset or "full"})
     path = Path(spec_s)
+    if path.is_dir():
+        raise ValueError(f"scene: {spec_s} is a folder, not a scene JSON file")
     if not path.is_file():
         raise ValueError(f"scene: no such file {spec_s!r} and not a built-in scene "
                          f"({', '.join(BUILTIN_SCENES)})")

@@ -135,6 +135,14 @@ def test_scene_documents(doc, word):
     _one_line(exc)
 
 
+def test_scene_folder_named(tmp_path):
+    from model.scene import load_scene
+
+    with pytest.raises(ValueError, match="is a folder") as exc:
+        load_scene(str(tmp_path))
+    _one_line(exc)
+
+
 def test_scene_total_scatterers_and_seed():
     with pytest.raises(ValueError, match="scatterers"):
         Scene.from_dict({"preset": "full", "objects": [{**_O, "n_scatterers": 256}] * 9})
