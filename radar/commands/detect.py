@@ -72,6 +72,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     scene = scene_of(args)
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
+    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
+        raise CliError(f"--plots: {args.plots} is a file, not a folder")
     cfg = scene.config
     params = detection_params(args, scene.tx_beamforming, cfg)
     clouds, per_frame, objects = [], [], []
