@@ -84,3 +84,20 @@ def test_receive_drops_records_outside_the_map(tmp_path):
     f0 = json.loads(out.read_text())["frame_info"][0]
     assert f0["complete"] and f0["points"] >= 3
     assert any("1 record(s) outside the 64 x 256 map dropped" in p for p in f0["problems"])
+
+
+def test_cube_stream_received_as_records_names_the_flag(tmp_path, capsys):
+    """A radar-cube stream sent to `receive --detect fpga`: its last packet can fit a
+    record stream's geometry too, so such a packet is skipped rather than taken (it was,
+    and the frames were then reported as damaged, missing packets); the one-line error
+    says it is a cube stream."""
+    cap = tmp_path / "c.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "2",
+                 "--out", str(cap)]) == 0
+    capsys.readouterr()
+    rc, out = _round_trip(tmp_path, cap, ["--detect", "fpga"])
+    assert rc == 1
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "radar-cube stream packet of paper-fpga (leave out --detect fpga)" in err, err
+    doc = json.loads(out.read_text())
+    assert doc["frame_info"] == [] and doc["packet_words"] is None

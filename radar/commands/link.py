@@ -148,14 +148,24 @@ def cmd_receive(args: argparse.Namespace) -> int:
     def make_decoder(first: bytes) -> PacketDecoder[Any]:
         """Geometry from the options if given, else learnt from the first datagram."""
         if records:
+            try:   # a radar-cube packet: its stream's last packet may fit records too
+                cube_of = geometry_from_packet(first, configs)[0].name
+            except ValueError:
+                cube_of = None
+            cube = (f"it is a radar-cube stream packet of {cube_of} (leave out --detect "
+                    f"fpga)") if cube_of else None
             errors = []
             for cfg in configs:
                 try:
-                    return _record_decoder(args, cfg, args.packet_words, first)
+                    dec = _record_decoder(args, cfg, args.packet_words, first)
                 except (ValueError, CliError) as exc:
                     errors.append(f"{cfg.name}: {exc}")
-            raise ValueError("not a record-stream packet of "
-                             + "; ".join(errors) + " (check --max-detections)")
+                    continue
+                if cube:      # both fit: wait for a packet that says which
+                    raise ValueError(f"a packet that fits records of {cfg.name} but {cube}")
+                return dec
+            raise ValueError(cube or ("not a record-stream packet of " + "; ".join(errors)
+                                      + " (check --max-detections)"))
         try:
             cfg, pw = geometry_from_packet(first, configs)
         except ValueError as exc:
