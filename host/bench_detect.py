@@ -301,6 +301,15 @@ def _decoded(packets: list[bytes], cfg: RadarConfig, dcfg: DetectConfig, gain: f
     return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
 
 
+def _frame_arrays(cfg: RadarConfig, n: int, varied: bool, params: DetectionParams
+                  ) -> RecordArrays:
+    """The record arrays of one decoded frame of ``n`` synthetic records (what
+    :func:`stage_rows` and :func:`spread_ms` time ``process_records`` on)."""
+    return _decoded(_frame_packets(cfg, n, varied), cfg,
+                    fpga_detect_config(cfg, params.cfar, max_detections=n),
+                    chain_gain(cfg, PipelineParams()))
+
+
 def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
                    varied: bool = False, compiled: bool = True
                    ) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float],
@@ -367,9 +376,7 @@ def stage_rows(preset: str, n: int, repeat: int, varied: bool) -> dict[str, floa
     frame of ``n`` synthetic records, from the fastest of ``repeat`` runs."""
     cfg = get_preset(preset)
     params = DetectionParams()
-    arr = _decoded(_frame_packets(cfg, n, varied), cfg,
-                   fpga_detect_config(cfg, params.cfar, max_detections=n),
-                   chain_gain(cfg, PipelineParams()))
+    arr = _frame_arrays(cfg, n, varied, params)
     process_records(arr, cfg, params)             # compile / load the kernels
     best: dict[str, float] = {"total": math.inf}
     for _ in range(repeat):
@@ -390,9 +397,7 @@ def spread_ms(preset: str, n: int, runs: int, varied: bool, unfold: bool
     unfold_velocity``. The spread a frame loop sees on this machine, not just its best."""
     cfg = get_preset(preset)
     params = DetectionParams(unfold_velocity=unfold)
-    arr = _decoded(_frame_packets(cfg, n, varied), cfg,
-                   fpga_detect_config(cfg, params.cfar, max_detections=n),
-                   chain_gain(cfg, PipelineParams()))
+    arr = _frame_arrays(cfg, n, varied, params)
     process_records(arr, cfg, params)             # compile / load the kernels
     spent = []
     for _ in range(runs):

@@ -480,9 +480,9 @@ def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     (n_range, n_doppler), LSB^2 (a display needs it; computing it again costs a cube pass)."""
     params = params or DetectionParams()
     cfg.check_cube(cube)
-    if np.asarray(cube).dtype.kind != "c":
-        raise ValueError(f"cube: must be complex (Doppler FFT values), got dtype "
-                         f"{np.asarray(cube).dtype}")
+    dtype = np.asarray(cube).dtype
+    if dtype.kind != "c":
+        raise ValueError(f"cube: must be complex (Doppler FFT values), got dtype {dtype}")
     cells, noise, nci = detect_cells(cube, cfg, params)
     if not np.isfinite(nci).all():         # NaN / inf anywhere in the cube reach the map
         raise ValueError("cube: contains NaN or infinite values")

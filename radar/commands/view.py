@@ -32,10 +32,17 @@ from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
 from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain
-from model.scene import EGO_SPEED_KMH, check_ego_speed, load_scene
+from model.scene import load_scene
 from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, fpga_config
-from radar.common import CliError, add_detection_options, check, count, detection_params
+from radar.common import (
+    CliError,
+    add_detection_options,
+    check,
+    count,
+    detection_params,
+    ego_speed_mps,
+)
 from radar.sources import get_source
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
@@ -130,11 +137,6 @@ def build(args: argparse.Namespace, stop: threading.Event
               "a number of seconds in (0, 1e7]")
     if args.packet_words is not None:
         count(args.packet_words, "--packet-words", 65535, lo=2)
-    if args.ego_speed is not None:
-        try:
-            check_ego_speed(args.ego_speed)
-        except ValueError as exc:
-            raise CliError(f"--ego-speed: {exc}") from None
     kind: str | None = {"host": CUBE, "fpga": RECORDS, None: None}[args.detect]
     detect_config = detect_config_of(args)
     try:
@@ -161,9 +163,8 @@ def build(args: argparse.Namespace, stop: threading.Event
                     detect_config(c)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
-    # the Table I scene's ego speed for its simulation; a capture or a link does not say
-    ego = args.ego_speed if args.ego_speed is not None else (
-        EGO_SPEED_KMH / 3.6 if args.scene and scene.name == "table1" else 0.0)
+    # --ego-speed (checked), else the scene's (Table I: 100 km/h); a capture or a link: 0
+    ego = ego_speed_mps(args, scene if args.scene else None)
     processor = Processor(cfg, feed, health, detection_params(args), _gnn(args), ego, source=desc)
     threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
                                 daemon=True)]
