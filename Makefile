@@ -68,7 +68,7 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(RUN) tools/lint.sh
-	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth
+	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth benchmarks
 
 # Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
 gen: $(STAMP)
@@ -76,11 +76,11 @@ gen: $(STAMP)
 	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py -k up_to_date
 
 bench: $(STAMP)
-	$(RUN) python -m model.bench_simulate
-	$(RUN) python -m model.bench_model
-	$(RUN) python -m host.bench_host
-	$(RUN) python -m host.bench_detect
-	$(RUN) python -m host.bench_unfold
+	$(RUN) python -m benchmarks.bench_simulate
+	$(RUN) python -m benchmarks.bench_model
+	$(RUN) python -m benchmarks.bench_host
+	$(RUN) python -m benchmarks.bench_detect
+	$(RUN) python -m benchmarks.bench_unfold
 
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py
@@ -133,7 +133,7 @@ gnn-train: $(STAMP)
 gnn-eval: $(STAMP)
 	mkdir -p $(OUT)
 	$(RUN) radar gnn eval --json $(OUT)/gnn_eval.json
-	$(RUN) python -m gnn.bench_infer
+	$(RUN) python -m benchmarks.bench_infer
 
 clean:
 	rm -rf sim_build $(OUT) .pytest_cache .ruff_cache
@@ -161,7 +161,7 @@ view-records: $(STAMP) $(VIEW_RECORDS)
 	$(RUN) radar view --replay $(VIEW_RECORDS) --gnn --ego-speed 27.78
 
 bench-view: $(STAMP)
-	$(RUN) python -m radar.view.bench_view
+	$(RUN) python -m benchmarks.bench_view
 
 # On-chip detection blocks at every parameter set (make test runs a quick subset)
 .PHONY: test-detect-long

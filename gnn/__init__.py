@@ -5,6 +5,6 @@ Modules, one job each: ``classes`` (class list), ``boxes`` (rotated boxes, IoU, 
 radar), ``labelling`` (points -> objects), ``frame`` / ``dataset`` (labelled frames, cache),
 ``radarscenes`` (RadarScenes loader), ``graph`` (graph + features), ``model`` (network),
 ``losses``, ``train``, ``checkpoint``, ``detection`` (decoder), ``infer``
-(``detect_objects``), ``metrics``, ``baseline`` (DBSCAN + rules), ``evaluate``, ``cli``,
-``bench_infer``.
+(``detect_objects``), ``metrics``, ``baseline`` (DBSCAN + rules), ``evaluate``, ``cli``.
+The latency benchmark is ``benchmarks/bench_infer.py`` (outside the package).
 """

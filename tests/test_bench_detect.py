@@ -1,11 +1,11 @@
-"""Smoke tests of the detection benchmark's host-time tables (``host.bench_detect``): each
+"""Smoke tests of the detection benchmark's host-time tables (``benchmarks.bench_detect``): each
 runs on a small frame and gives consistent numbers (the timings themselves are reported by
 the benchmark, never asserted)."""
 
 from __future__ import annotations
 
+from benchmarks.bench_detect import STAGES, host_time_rows, link_rows, spread_ms, stage_rows
 from host import cell_kernels, record_points
-from host.bench_detect import STAGES, host_time_rows, link_rows, spread_ms, stage_rows
 
 
 def test_host_time_rows_times_each_step() -> None:

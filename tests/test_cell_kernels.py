@@ -24,7 +24,6 @@ from host.angle import (
     peak_sin_fast,
     screened_components,
 )
-from host.bench_detect import synthetic_records
 from host.cell_kernels import (
     class_peaks,
     first_components,
@@ -37,6 +36,7 @@ from host.record_points import points_from_snapshots, record_offsets, select_rec
 from host.records import record_arrays
 from model.config import get_preset
 from radar.common import note_compile
+from tests.scenes import synthetic_records
 
 
 def _rows(rng: np.random.Generator, m: int, n: int, targets: int = 3) -> np.ndarray:

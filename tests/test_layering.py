@@ -1,18 +1,20 @@
 """The package layering of DESIGN.md section 1: every import (top level, lazy, or under
 ``TYPE_CHECKING``) of every Python file of each package goes only to the packages its row of
 the table allows; ``model`` imports nothing outside numpy, scipy and the standard library;
-nothing but ``tests`` and ``tb`` themselves imports ``tb`` or ``tests``."""
+no installed (product) package imports ``tests``, ``tb`` or ``benchmarks`` (the benchmark
+scripts, which may use the tests' scenes)."""
 
 from __future__ import annotations
 
 import ast
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-PROJECT = ("model", "rtlsim", "tb", "host", "gnn", "radar", "synth", "tests")
+PROJECT = ("model", "rtlsim", "tb", "host", "gnn", "radar", "synth", "tests", "benchmarks")
 """The project's Python packages (folders) whose imports are checked."""
 MAY_IMPORT: dict[str, frozenset[str]] = {
     "model": frozenset({"model"}),
@@ -22,9 +24,16 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "gnn": frozenset({"gnn", "model", "host"}),
     "radar": frozenset({"radar", "model", "rtlsim", "host", "gnn", "synth"}),
     "synth": frozenset({"synth", "model"}),
-    "tests": frozenset({"tests", "model", "rtlsim", "host", "gnn", "radar", "synth"}),
+    "tests": frozenset({"tests", "model", "rtlsim", "host", "gnn", "radar", "synth",
+                        "benchmarks"}),
+    "benchmarks": frozenset({"benchmarks", "model", "rtlsim", "host", "gnn", "radar", "synth",
+                             "tests"}),
 }
-"""Project packages each package may import (DESIGN.md section 1, last column)."""
+"""Project packages each package may import (DESIGN.md section 1, last column; ``benchmarks``
+is the top-level folder of benchmark scripts, not an installed package)."""
+PRODUCT = tuple(p.rstrip("*") for p in tomllib.loads((REPO / "pyproject.toml").read_text())
+                ["tool"]["setuptools"]["packages"]["find"]["include"])
+"""The packages pyproject.toml installs."""
 MODEL_THIRD_PARTY = frozenset({"numpy", "scipy"})
 """The only non-standard-library modules ``model`` may import."""
 
@@ -73,6 +82,8 @@ def test_imports_follow_the_layering(package: str) -> None:
     ("rtlsim", "from host.capture import write_capture"),
     ("tb", "from radar.sources import SOURCES"),
     ("radar", "import tests.test_cli"),
+    ("host", "from benchmarks.bench_detect import host_time_rows"),
+    ("radar", "def f():\n    import benchmarks.bench_view\n"),
     ("model", "import torch"),
     ("synth", "from host import plots"),
 ])
@@ -85,3 +96,14 @@ def test_checker_allows_the_table() -> None:
                                    "from gnn.infer import detect_objects\nimport torch")
     assert not violations("model", "import numpy as np\nfrom scipy import signal\nimport math")
     assert not violations("tb", "from host.stream import StreamDecoder\nimport cocotb")
+    assert not violations("benchmarks", "from tests.scenes import synthetic_records\n"
+                                        "from radar.view.browser import launch")
+    assert not violations("tests", "from benchmarks.bench_detect import host_time_rows")
+
+
+def test_no_product_package_imports_test_or_benchmark_code() -> None:
+    """The table keeps ``tests``, ``tb`` and ``benchmarks`` out of every installed package,
+    and pyproject.toml installs none of them."""
+    assert set(PRODUCT) == {"model", "rtlsim", "host", "gnn", "radar", "synth"}
+    for package in PRODUCT:
+        assert not MAY_IMPORT[package] & {"tests", "tb", "benchmarks"}, package

@@ -20,7 +20,7 @@ def test_rtl_lint_clean():
 def test_python_lint_clean():
     ruff = str(Path(sys.executable).parent / "ruff")  # pinned in the dev extras
     folders = [f for f in ("model", "rtlsim", "host", "gnn", "radar", "tb", "tests", "tools",
-                           "synth")
+                           "synth", "benchmarks")
                if (REPO / f).is_dir()]
     r = subprocess.run([ruff, "check", *folders], cwd=REPO, capture_output=True, text=True)
     assert r.returncode == 0, r.stdout[-3000:]

@@ -23,7 +23,6 @@ from host.angle import (
     peak_sin_batch,
     peak_sin_fast,
 )
-from host.bench_detect import random_scene, synthetic_records
 from host.pipeline import (
     DetectionParams,
     _choose_fold,
@@ -68,6 +67,7 @@ from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
+from tests.scenes import random_scene, synthetic_records
 
 
 def _same_records(a: list, b: list) -> None:

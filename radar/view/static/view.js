@@ -7,10 +7,10 @@ const state = window.radarView = {
   draws: 0, frames: 0, lastSeq: null, drawFps: 0, connected: false, reconnects: 0,
   drawTimes: [], lastHealth: null, drawMs: {},
   // benchmark hooks: hold = true stops drawing live messages; lastFrame is the newest frame
-  // message drawn; drawFrame(msg) draws one message (radar.view.bench_view times it)
+  // message drawn; drawFrame(msg) draws one message (benchmarks.bench_view times it)
   hold: false, lastFrame: null, drawFrame: null,
   // benchmark hook: serial = true draws the plots one after another, as before 2026-11-23
-  // (radar.view.bench_view compares the display rates in the same run)
+  // (benchmarks.bench_view compares the display rates in the same run)
   serial: false,
 };
 const CONFIG = { displaylogo: false, responsive: true, showSendToCloud: false };

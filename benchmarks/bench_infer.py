@@ -1,7 +1,7 @@
 """CPU inference latency per frame of the shipped GNN (graph + network + decoding), and of
 the DBSCAN baseline, on held-out synthetic frames. Prints a table.
 
-Usage: ``python -m gnn.bench_infer [--data TEST.npz] [--checkpoint CK.pt] [--threads 1]``
+Usage: ``python -m benchmarks.bench_infer [--data TEST.npz] [--checkpoint CK.pt] [--threads 1]``
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ matters), for the peak test and two variants of the cheap one (sub-array angle f
 phase, or from the peak of the non-coherent sub-array spectrum), and the CPU time of each
 statistic for 1000 cells (all classes):
 
-    python -m host.bench_unfold [--cells 4000]
+    python -m benchmarks.bench_unfold [--cells 4000]
 
 Reported, never asserted in tests. ``full`` preset, default ``DetectionParams``.
 """

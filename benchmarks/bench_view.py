@@ -18,7 +18,7 @@ frame), the message's size, and the page's main thread drawing one update: the p
 draw and, for comparison in the same browser on the same message, the reference draw of main
 ea510a1 (one full Plotly.react per plot, ``bench_reference.js``).
 
-    python -m radar.view.bench_view [--duration 20 | --minutes 10]
+    python -m benchmarks.bench_view [--duration 20 | --minutes 10]
                                     [--presets paper-fpga full records]
                                     [--screenshot docs/img/view_table1.png] [--gnn]
                                     [--capture out/table1_paper-fpga.dmacap]

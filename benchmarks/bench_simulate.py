@@ -1,6 +1,6 @@
 """Benchmark: wall time to simulate one frame (and to run the float reference chain).
 
-    python -m model.bench_simulate [--repeat 5]
+    python -m benchmarks.bench_simulate [--repeat 5]
 
 Prints a table; the goal (issue 2) is one ``full``-preset frame with 200 scatterers in at
 most 2 s on a 2-core machine. Timing is reported, never asserted in tests.

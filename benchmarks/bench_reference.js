@@ -1,4 +1,4 @@
-// Reference for radar.view.bench_view (not served to the page): how the page drew a frame
+// Reference for benchmarks.bench_view (not served to the page): how the page drew a frame
 // before the canvas heat maps (main ea510a1): one full Plotly.react per plot per update, heat
 // maps as plotly heatmap traces. The benchmark times it on the same message as the page's own
 // draw, in the same browser, so the old and new figures are measured side by side.

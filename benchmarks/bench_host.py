@@ -1,7 +1,7 @@
 """Benchmark: host processing time per frame (decode DMA packets -> cube -> CFAR -> angles ->
 point cloud), Table I scene, both presets.
 
-    python -m host.bench_host [--repeat 5]
+    python -m benchmarks.bench_host [--repeat 5]
 
 Goal (issue 5): <= 100 ms per ``full`` frame on this 2-core machine (the paper's host
 managed 3.79 frames/s). Reported, never asserted in tests.

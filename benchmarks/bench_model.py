@@ -1,7 +1,7 @@
 """Benchmark: the bit-accurate chain model, fast path against the stage-by-stage reference,
 measured in the same run.
 
-    python -m model.bench_model [--repeat 3]
+    python -m benchmarks.bench_model [--repeat 3]
 
 Prints a table per preset: seconds per frame of ``run_chain`` (reference, fast), the ratio,
 ``dma_packets`` (fast chain + packing) and the float reference ``radar_cube``; the fast path's

@@ -1,0 +1,1 @@
+"""The Python tests: a package, so tests share support modules (``tests.scenes``)."""
