@@ -14,9 +14,9 @@ cost on the link and on the host. Prints four tables:
    10, 100, 1000 detections (measured on encoded, packetized frames) vs the radar cube
    (goal: fits the paper's measured 766 Mbit/s);
 4. host time per frame for 10, 100, 1000 detections on one core, CPU and wall, the replaced
-   code ("old": ``Record`` objects, ``process_records_reference``) beside the current one
-   (arrays, ``process_records``, and the same with the angle work of
-   ``points_from_snapshots`` in numpy, ``compiled=False``) in the same run: DMA bytes ->
+   code ("old": ``Record`` objects, the numpy records path kept as the oracle
+   ``tests.oracles.points.process_records_reference``) beside the current one (arrays,
+   ``process_records``) in the same run: DMA bytes ->
    records (decoder), records -> point cloud, and both (goal <= 5 ms for 1000), on strong
    isolated targets and on a mixed frame (``synthetic_records(varied=True)``). One core:
    the process is pinned to one CPU and the BLAS / OpenMP pools get one thread (set before
@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from host import record_points
+from host import angle, points, record_points
 from host.cfar import CfarParams
 from host.evaluate import match_targets
 from host.pipeline import DetectionParams, process_cube
@@ -64,6 +64,7 @@ from model.detect_records import encode_frame
 from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.scene import Scene, table1_scene
 from model.simulate import simulate_scene, thermal_noise
+from tests.oracles.points import process_cube_reference, process_records_reference
 from tests.scenes import random_scene, synthetic_records
 
 FRAME_RATE_HZ = 111.0
@@ -93,10 +94,8 @@ def _both_paths(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
     fpga = process_records(arr, cfg, params)
     if not reference:
         return host, fpga, f.detections
-    host_ref = process_cube(out.cube().astype(np.complex64) / gain, cfg, params,
-                            reference=True)
-    return host, fpga, f.detections, host_ref, process_records(arr, cfg, params,
-                                                               reference=True)
+    host_ref = process_cube_reference(out.cube().astype(np.complex64) / gain, cfg, params)
+    return host, fpga, f.detections, host_ref, process_records_reference(arr, cfg, params)
 
 
 def detection_rows(scenes: list[Scene]) -> dict[str, float]:
@@ -257,15 +256,14 @@ def _frame_arrays(cfg: RadarConfig, n: int, varied: bool, params: DetectionParam
 
 
 def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
-                   varied: bool = False, compiled: bool = True
+                   varied: bool = False
                    ) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float],
                               int]:
     """((CPU, wall) ms of DMA bytes -> record arrays, of records -> point cloud, of both
     in one go, points) for one frame of ``n`` synthetic records (``varied``: see
     :func:`synthetic_records`); ``reference``: through the replaced code (``Record``
-    objects from ``model.detect_records.decode_frame``, ``record_arrays_reference``,
-    ``process_records_reference``); ``compiled`` False: the current code with the angle
-    work of ``points_from_snapshots`` in numpy."""
+    objects from ``model.detect_records.decode_frame``, ``record_arrays_reference``, the
+    oracle ``process_records_reference``)."""
     cfg = get_preset(preset)
     params = DetectionParams()
     dcfg = fpga_detect_config(cfg, params.cfar, max_detections=n)
@@ -276,7 +274,8 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
         return _decoded(packets, cfg, dcfg, gain, reference)
 
     def cloud(arr: RecordArrays) -> PointCloud:
-        return process_records(arr, cfg, params, reference=reference, compiled=compiled)
+        process = process_records_reference if reference else process_records
+        return process(arr, cfg, params)
 
     arr = decode()
     cloud(arr)                          # the kernels compile (or load) on their first call
@@ -286,18 +285,21 @@ def host_time_rows(preset: str, n: int, repeat: int, reference: bool = False,
     return t_dec, t_pc, t_all, len(cloud(arr))
 
 
-STAGES = ("select_records", "record_offsets", "hypothesis_classes", "class_peaks",
-          "choose_folds", "first_components", "screened_components", "relax_rows", "_cloud")
-"""The steps of ``host.record_points.process_records`` timed by :func:`stage_rows`, by the
-names under which ``host.record_points`` calls them (``relax_rows`` runs inside
-``screened_components``)."""
+STAGES = {"select_records": record_points, "record_offsets": record_points,
+          "hypothesis_classes": points, "peak_powers": points, "choose_folds": points,
+          "estimate_angles": points, "first_components": angle, "_relax": angle,
+          "cloud": points}
+"""The steps of ``host.record_points.process_records`` timed by :func:`stage_rows`, each
+with the module that calls it (it is wrapped there); ``first_components`` and ``_relax``
+(RELAX) run inside ``estimate_angles``: :data:`NESTED`."""
+NESTED = ("first_components", "_relax")
 
 
 @contextmanager
 def _stage_clock(spent: dict[str, float]) -> Iterator[None]:
     """While active, the CPU seconds of each of :data:`STAGES` add up in ``spent`` (the
-    functions are wrapped where ``host.record_points`` looks them up, and restored)."""
-    saved = {name: getattr(record_points, name) for name in STAGES}
+    functions are wrapped where their callers look them up, and restored)."""
+    saved = {name: getattr(module, name) for name, module in STAGES.items()}
 
     def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
         def run(*a: Any, **k: Any) -> Any:
@@ -310,11 +312,11 @@ def _stage_clock(spent: dict[str, float]) -> Iterator[None]:
 
     try:
         for name, fn in saved.items():
-            setattr(record_points, name, timed(name, fn))
+            setattr(STAGES[name], name, timed(name, fn))
         yield
     finally:
         for name, fn in saved.items():
-            setattr(record_points, name, fn)
+            setattr(STAGES[name], name, fn)
 
 
 def stage_rows(preset: str, n: int, repeat: int, varied: bool) -> dict[str, float]:
@@ -441,33 +443,30 @@ def host_table(args: argparse.Namespace) -> None:
     print(f"\n## Host time per full frame, one core (best of {args.repeat}; CPU = "
           f"process_time, wall = perf_counter; old = the replaced code, same run; "
           f"10^6 complex multiplications take {calibration_ms(args.repeat):.2f} ms CPU here)")
-    print("| detections | frame | step | old CPU ms | new, angle work in numpy, CPU ms | "
-          "new CPU ms | "
-          "old wall ms | new wall ms | CPU speed-up |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| detections | frame | step | old CPU ms | new CPU ms | old wall ms | new wall ms | "
+          "CPU speed-up |")
+    print("|---|---|---|---|---|---|---|---|")
     for varied in (False, True):
         for n in (10, 100, 1000):
             od, op, oa, _ = host_time_rows("full", n, args.repeat, reference=True,
                                            varied=varied)
-            _, pp, pa, _ = host_time_rows("full", n, args.repeat, varied=varied,
-                                          compiled=False)
             nd_, np_, na, pts = host_time_rows("full", n, args.repeat, varied=varied)
             kind = "mixed" if varied else "strong"
-            for step, o, p, w in (("DMA bytes -> records", od, nd_, nd_),
-                                  (f"records -> point cloud ({pts} points)", op, pp, np_),
-                                  ("DMA bytes -> point cloud", oa, pa, na)):
-                print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {p[0]:.2f} | {w[0]:.2f} | "
-                      f"{o[1]:.2f} | {w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
+            for step, o, w in (("DMA bytes -> records", od, nd_),
+                               (f"records -> point cloud ({pts} points)", op, np_),
+                               ("DMA bytes -> point cloud", oa, na)):
+                print(f"| {n} | {kind} | {step} | {o[0]:.2f} | {w[0]:.2f} | {o[1]:.2f} | "
+                      f"{w[1]:.2f} | {o[0] / max(w[0], 1e-9):.1f}x |")
     rows = {kind: stage_rows("full", 1000, args.repeat, kind == "mixed")
             for kind in ("strong", "mixed")}
     print("\n## Where records -> point cloud spends its time, 1000 detections, `full`, one "
           f"core (CPU ms, the fastest of {args.repeat} runs)")
-    print("| step (`host.record_points`) | strong | mixed |")
+    print("| step (`host.record_points`, `host.points`, `host.angle`) | strong | mixed |")
     print("|---|---|---|")
     for name in (*STAGES, "other"):
         got = [r.get(name, 0.0) if name != "other" else r["total"] - sum(
-            r.get(k, 0.0) for k in STAGES if k != "relax_rows") for r in rows.values()]
-        label = "of which RELAX (`relax_rows`)" if name == "relax_rows" else f"`{name}`"
+            r.get(k, 0.0) for k in STAGES if k not in NESTED) for r in rows.values()]
+        label = f"of which `{name}`" if name in NESTED else f"`{name}`"
         print(f"| {label} | {got[0]:.2f} | {got[1]:.2f} |")
     print(f"| total | {rows['strong']['total']:.2f} | {rows['mixed']['total']:.2f} |")
     print(f"\n## Records -> point cloud, 1000 detections, `full`, one core: CPU ms over "

@@ -1,8 +1,8 @@
 """Monte Carlo of the TDM velocity-unfolding test (issue 14: why the host keeps the angle-peak
 test although it is most of the records -> point cloud time).
 
-``host.pipeline.choose_folds`` compares, per detected cell, the peak of the angle spectrum of
-the channel vector compensated for each TDM alias class (``host.angle.peak_power_fast``: a
+``host.tdm.choose_folds`` compares, per detected cell, the peak of the angle spectrum of
+the channel vector compensated for each TDM alias class (``host.angle.peak_powers``: a
 128-point FFT and the exact 1024-grid peak, for ~3.4 classes per cell on ``full``). A
 cheaper test needs no angle FFT per class: estimate the angle on the 16-element TX
 sub-arrays (where the TDM phase does not enter), beamform each sub-array there, and take the
@@ -31,9 +31,11 @@ from collections.abc import Callable
 import numpy as np
 import scipy.fft
 
-from host.angle import peak_power_fast
-from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors, choose_folds
+from host.angle import peak_powers
+from host.params import DetectionParams
+from host.tdm import choose_folds, tx_phasors
 from model.config import RadarConfig, get_preset
+from tests.oracles.points import tdm_compensate
 
 Stat = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -41,9 +43,9 @@ Stat = Callable[[np.ndarray, np.ndarray], np.ndarray]
 def peak_test(cfg: RadarConfig, n_fft: int) -> Stat:
     """The pipeline's statistic: angle-spectrum peak power per class, float (n, num_tx)."""
     def stat(x: np.ndarray, sb: np.ndarray) -> np.ndarray:
-        c = np.arange(cfg.num_tx)
-        xc = _tdm_compensate(cfg, x, sb[:, None] + c[None, :] * cfg.n_doppler)
-        return peak_power_fast(xc, n_fft)[0]
+        rows = np.arange(len(x))
+        return np.stack([peak_powers(x, n_fft, tx_phasors(cfg, sb + c * cfg.n_doppler), rows)[0]
+                         for c in range(cfg.num_tx)], axis=1)
     return stat
 
 
@@ -71,7 +73,7 @@ def tx_coherent_test(cfg: RadarConfig, angle: str) -> Stat:
             ps = 2 * np.pi * f
         ph = np.exp(1j * ps[:, None] * np.arange(ntx * nrx)[None, :]).reshape(n, ntx, nrx)
         z = (xb * ph).sum(axis=2)                                         # (n, num_tx)
-        p0 = _tdm_tx_phasors(cfg, sb[:, None] + np.arange(ntx)[None, :] * cfg.n_doppler)
+        p0 = tx_phasors(cfg, sb[:, None] + np.arange(ntx)[None, :] * cfg.n_doppler)
         return np.abs(np.einsum("nct,nt->nc", p0, z)) ** 2
     return stat
 
@@ -96,7 +98,7 @@ def outcome(stats: dict[str, Stat], cfg: RadarConfig, params: DetectionParams, n
         sep, below = second
         x = x + amp * 10 ** (-below / 20) * np.exp(
             -1j * np.pi * np.outer(s + sep, v) + 1j * rng.uniform(0, 2 * np.pi, (n, 1)))
-    x = x * np.conj(_tdm_compensate(cfg, np.ones((n, nv)), k))      # the TDM phase of k
+    x = x * np.conj(tdm_compensate(cfg, np.ones((n, nv)), k))      # the TDM phase of k
     x = x + (rng.normal(size=(n, nv)) + 1j * rng.normal(size=(n, nv))) / np.sqrt(2)
     power = np.sum(np.abs(x) ** 2, axis=1)
     noise = np.full(n, float(nv))

@@ -15,18 +15,17 @@ own CFAR (``host.pipeline`` module docstring), on the records alone:
    (``host.cfar.sidelobe_masked``; a cell strong enough to throw sidelobes above the
    threshold is always detected itself);
 4. peak offsets: Gaussian interpolation over the 3 log powers along each axis, from the
-   four neighbour powers every record carries (``host.pipeline.neighbour_offsets``, the
+   four neighbour powers every record carries (``host.cells.neighbour_offsets``, the
    cube path's interpolation on the same values: detected or not, the neighbours' powers
    come from the FPGA's map);
-5. TDM compensation, velocity unfolding, angle estimation and the point cloud: the same
-   points as :func:`host.pipeline.points_from_cells` (the cube path's code), computed by
-   :func:`points_from_snapshots` with less work: the TDM test runs only the alias classes
-   that hold a velocity hypothesis of the cell (what ``host.pipeline.choose_folds`` looks
-   at), and the search for a second angle component only where a Cauchy-Schwarz bound
-   leaves room for one (``host.angle.estimate_angles_screened``).
+5. TDM compensation, velocity unfolding, angle estimation and the point cloud: the cube
+   path's code, ``host.points.points_from_cells``, on the selected records as
+   ``host.cells.Cells``.
 
 :func:`process_records` is the public entry (records -> point cloud; the live view, the
-CLI); :func:`process_records_reference` is the path it replaced (benchmark, tests).
+CLI). The selection works on the records alone (:func:`select_records`, compiled); its
+definition on the whole map (``host.cfar.local_peaks``, ``host.cfar.sidelobe_masked``) is
+the oracle in ``tests/oracles/points.py``.
 """
 
 from __future__ import annotations
@@ -35,31 +34,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from host.angle import estimate_angles_screened, peak_power_lean, screened_components
-from host.cell_kernels import (
-    class_peaks,
-    first_components,
-    peak_sins,
-    relax_rows,
-    select_cells,
-    steering_rows,
-)
-from host.cfar import detection_mask, local_peaks, sidelobe_envelope, sidelobe_masked
-from host.pipeline import (
-    DetectionParams,
-    _cloud,
-    _tdm_compensate,
-    _tdm_tx_phasors,
-    alias_orders,
-    cell_snr_db,
-    choose_folds,
-    neighbour_offsets,
-    points_from_cells,
-)
+from host.cells import Cells, neighbour_offsets
+from host.cfar import sidelobe_envelope
+from host.kernels import njit
+from host.params import DetectionParams
 from host.pointcloud import PointCloud
+from host.points import points_from_cells
 from host.records import RecordArrays, outside_map
 from model.config import RadarConfig
-from model.reference import signed_bins
 
 
 def record_offsets(power: np.ndarray, neighbours: np.ndarray, range_bin: np.ndarray,
@@ -67,7 +49,7 @@ def record_offsets(power: np.ndarray, neighbours: np.ndarray, range_bin: np.ndar
     """Fractional (range, Doppler) peak offsets, float (n, 2) bins, of records (step 4 of
     the module docstring): power float (n,), neighbours float (n, 4)
     (``host.records.RecordArrays``), range_bin int (n,); the cube path's interpolation
-    (``host.pipeline.peak_offsets``) on the same powers."""
+    (``host.cells.peak_offsets``) on the same powers."""
     logc = np.log(np.maximum(power, 1e-30))
     lognb = np.log(np.maximum(neighbours, 1e-30))
     r = np.asarray(range_bin)
@@ -86,10 +68,9 @@ def _envelope(n: int, windowed: bool, margin_db: float) -> np.ndarray:
 def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
                    ) -> np.ndarray:
     """Indices (int (m,)) of the records that become points (steps 1 to 3), in (range,
-    Doppler) order. Works on the records
-    alone (compiled, ``host.cell_kernels.select_cells``: a 3x3 gather per record, pairs
-    of detected cells in a row or column), with the result of ``host.cfar.local_peaks`` and
-    ``host.cfar.sidelobe_masked`` on the map (:func:`select_records_reference`)."""
+    Doppler) order. Works on the records alone (compiled, :func:`select_cells`: a 3x3
+    gather per record, pairs of detected cells in a row or column), with the result of
+    ``host.cfar.local_peaks`` and ``host.cfar.sidelobe_masked`` on the map."""
     nr, nd = cfg.n_range, cfg.n_doppler
     envelopes = None
     if params.sidelobe_margin_db is not None:
@@ -98,105 +79,6 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     nbmax = None if arr.neighbours is None else arr.neighbours.max(axis=1, initial=0.0)
     return select_cells(arr.range_bin, arr.doppler_bin, arr.power, nbmax, (nr, nd),
                         cfg.detection_bins, envelopes)
-
-
-def select_records_reference(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
-                             ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`select_records` on the whole map (``host.cfar.local_peaks``,
-    ``host.cfar.sidelobe_masked``): the specification, and the benchmark's old path; also
-    returns that map of detected powers, float (n_range, n_doppler)."""
-    nr, nd = cfg.n_range, cfg.n_doppler
-    pmap = np.zeros((nr, nd))
-    index = np.full((nr, nd), -1, np.int64)
-    pmap[arr.range_bin, arr.doppler_bin] = arr.power
-    index[arr.range_bin, arr.doppler_bin] = np.arange(len(arr))
-    mask = (pmap > 0) & detection_mask(nr, nd, cfg.detection_bins)
-    if arr.neighbours is not None:           # a direct neighbour, detected or not, is stronger
-        nbmax = np.zeros((nr, nd))
-        nbmax[arr.range_bin, arr.doppler_bin] = arr.neighbours.max(axis=1, initial=0.0)
-        mask &= pmap >= nbmax
-    cells = local_peaks(pmap, mask)
-    windowed = (params.range_window, params.doppler_window)
-    if params.sidelobe_margin_db is not None and len(cells):
-        cells = cells[~sidelobe_masked(pmap, cells, windowed, params.sidelobe_margin_db)]
-    return index[cells[:, 0], cells[:, 1]], pmap
-
-
-def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, params: DetectionParams
-                       ) -> np.ndarray:
-    """Alias classes c = m mod num_tx that hold a velocity hypothesis m of each cell (the
-    hypotheses of ``host.pipeline.choose_folds``: |v + 2 m vmax| <= max_speed, m = 0 when
-    none is), bool (n, num_tx); velocity_mps: float (n,) measured (aliased). Only these
-    classes' powers enter the unfolding decision."""
-    lo, hi, _ = alias_orders(cfg, velocity_mps, params)
-    count = hi - lo + 1                        # consecutive orders lo..hi (none: m = 0)
-    first = np.where(count > 0, lo, 0)
-    count = np.maximum(count, 1)
-    c = np.arange(cfg.num_tx)
-    # class c holds an order of lo..hi when the first one at or after lo is within it
-    return (c[None, :] - first[:, None]) % cfg.num_tx < count[:, None]
-
-
-def points_from_snapshots(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
-                          noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
-                          params: DetectionParams, frame: int = 0, compiled: bool = True
-                          ) -> PointCloud:
-    """``host.pipeline.points_from_cells`` (steps 3 to 5 there; same arguments, same
-    points) with less work: angle peaks (``host.angle.fine_peaks``) only of the TDM alias
-    classes in :func:`hypothesis_classes` (the others do not enter ``choose_folds``), and
-    the second-component search screened (``host.angle.estimate_angles_screened``).
-    ``compiled``: the class peaks, first angle components, steering vectors and RELAX peak
-    searches by the compiled kernels of ``host.cell_kernels`` (default); False: by numpy
-    (the same values to rounding).
-
-    cells: int (n, 2) (range_bin, doppler_bin natural order); snapshots: complex
-    (n, n_virtual); power, noise: float (n,); offsets: float (n, 2) bins."""
-    n = len(cells)
-    if not n:
-        return PointCloud.empty()
-    nd, nv, ntx = cfg.n_doppler, cfg.n_virtual, cfg.num_tx
-    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
-    x = np.ascontiguousarray(snapshots, dtype=np.complex128)   # once for every kernel
-    noise = np.asarray(noise, dtype=float)
-    sb = signed_bins(nd)[d].astype(np.int64)
-    snr_db = cell_snr_db(power, noise, nv)
-    measured = (sb + offsets[:, 1]) * cfg.velocity_bin_mps
-    fold = np.zeros(n, np.int64)
-    sn_sel = None
-    if ntx > 1 and params.unfold_velocity:
-        ci, cc = np.nonzero(hypothesis_classes(cfg, measured, params))   # (cell, class) pairs
-        if compiled:
-            pw, sn = class_peaks(x, ci, _tdm_tx_phasors(cfg, sb[ci] + cc * nd),
-                                 params.angle.n_fft)
-        else:
-            xc = _tdm_compensate(cfg, x[ci], sb[ci] + cc * nd)
-            pw, sn = peak_power_lean(xc, params.angle.n_fft)
-        class_power = np.zeros((n, ntx))         # absent classes: masked by choose_folds
-        class_power[ci, cc] = pw
-        pair = np.full((n, ntx), -1, np.int64)
-        pair[ci, cc] = np.arange(len(ci))
-        fold, ambiguous = choose_folds(class_power, cfg, measured, snr_db, params)
-        # the fold's class always holds a hypothesis: its peak was computed
-        sel = pair[np.arange(n), fold % ntx]
-        sn_sel = sn[sel]
-        if not compiled:
-            ang = estimate_angles_screened(xc[sel], noise / nv, params.angle, first_sin=sn_sel)
-    else:
-        fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, snr_db, params)
-        if not compiled:
-            ang = estimate_angles_screened(_tdm_compensate(cfg, x, sb + fold * nd), noise / nv,
-                                           params.angle)
-    if compiled:
-        ph = _tdm_tx_phasors(cfg, sb + fold * nd)
-        if sn_sel is None:                       # no TDM test: the peaks of the fold's class
-            sn_sel = class_peaks(x, np.arange(n), ph, params.angle.n_fft)[1]
-        a = params.angle
-        xs, a1, p1, maybe = first_components(x, ph, sn_sel, noise / nv, a.min_snr_db,
-                                             a.dynamic_range_db, a.max_targets > 1)
-        ang = screened_components(xs, np.maximum(noise / nv, 1e-30), a, sn_sel, a1, p1, maybe,
-                                  peaks=peak_sins, steer=steering_rows, relax=relax_rows)
-    return _cloud(cfg, params, r, offsets, sb + fold * nd, ambiguous, ang.cell,
-                  ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
 
 
 def _neighbours(arr: RecordArrays) -> np.ndarray:
@@ -238,36 +120,117 @@ def _check_records(arr: RecordArrays, cfg: RadarConfig) -> None:
 
 
 def process_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams | None = None,
-                    frame: int = 0, reference: bool = False, compiled: bool = True
-                    ) -> PointCloud:
+                    frame: int = 0) -> PointCloud:
     """Point cloud of one frame's records (``host.records.record_arrays``, host float units)
     -> the same :class:`host.pointcloud.PointCloud` as ``host.pipeline.process_cube``:
-    record selection (steps 1 to 3), peak offsets (step 4), :func:`points_from_snapshots`.
-    The public records -> point cloud function (CLI, live view). ``reference``: run the
-    replaced implementation (:func:`process_records_reference`; benchmark, tests);
-    ``compiled`` False: the angle work of :func:`points_from_snapshots` in numpy (benchmark)."""
+    record selection (steps 1 to 3), peak offsets (step 4), ``host.points.
+    points_from_cells``. The public records -> point cloud function (CLI, live view)."""
     params = params or DetectionParams()
-    _check_records(arr, cfg)
-    if reference:
-        return process_records_reference(arr, cfg, params, frame)
-    idx = select_records(arr, cfg, params)
-    cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
-    return points_from_snapshots(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
-                                 offsets, cfg, params, frame, compiled)
+    return points_from_cells(record_cells(arr, cfg, params), cfg, params, frame)
 
 
-def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
-                              params: DetectionParams | None = None, frame: int = 0
-                              ) -> PointCloud:
-    """The implementation :func:`process_records` replaced (``host.pipeline.
-    points_from_cells``: every TDM alias class's angle peaks, every cell's second-component
-    search); same points (tests). The map-based selection and 1024-point FFTs before it are
-    ``select_records_reference`` and ``host.pipeline.points_from_cells_reference``."""
-    params = params or DetectionParams()
+def record_cells(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams) -> Cells:
+    """The records that become points (steps 1 to 4) as :class:`host.cells.Cells`;
+    ValueError naming the problem when the records do not fit ``cfg``."""
     _check_records(arr, cfg)
     idx = select_records(arr, cfg, params)
-    cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
-    return points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
-                             offsets, cfg, params, frame)
+    r = arr.range_bin[idx]
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg.n_range)
+    return Cells(r, arr.doppler_bin[idx], arr.power[idx], arr.noise[idx], offsets,
+                 arr.snapshot[idx])
+
+
+@njit()
+def _select(r: np.ndarray, d: np.ndarray, power: np.ndarray, nbmax: np.ndarray, nr: int,
+            nd: int, lo: int, hi: int, sidelobes: bool, env_r: np.ndarray,
+            env_d: np.ndarray) -> np.ndarray:
+    """:func:`select_cells` (nbmax: float (n,) the largest neighbour power, 0 when not
+    known; env_*: the sidelobe envelopes times the margin)."""
+    n = r.shape[0]
+    pmap = np.zeros((nr, nd))
+    idx1 = np.zeros((nr, nd), np.int64)         # record index + 1 (the last one wins)
+    for i in range(n):
+        pmap[r[i], d[i]] = power[i]
+        idx1[r[i], d[i]] = i + 1
+    own = np.zeros(n, np.bool_)                  # the records that are the map's non-zeros
+    for i in range(n):
+        own[i] = idx1[r[i], d[i]] == i + 1 and pmap[r[i], d[i]] > 0
+    cand = np.empty(n, np.int64)
+    nc = 0
+    for i in range(n):
+        if not own[i] or r[i] < lo or r[i] >= hi:
+            continue
+        p = pmap[r[i], d[i]]
+        mx = max(p, nbmax[i])
+        for a in range(-1, 2):
+            for b in range(-1, 2):
+                if a or b:
+                    mx = max(mx, pmap[(r[i] + a) % nr, (d[i] + b) % nd])
+        if p >= mx:
+            cand[nc] = i
+            nc += 1
+    cand = cand[:nc]
+    cand = cand[np.argsort(r[cand] * nd + d[cand], kind="mergesort")]
+    if not sidelobes or nc == 0:
+        return cand
+    # the non-zero cells grouped by column and by row (counting sort)
+    col_start = np.zeros(nd + 1, np.int64)
+    row_start = np.zeros(nr + 1, np.int64)
+    for i in range(n):
+        if own[i]:
+            col_start[d[i] + 1] += 1
+            row_start[r[i] + 1] += 1
+    for k in range(nd):
+        col_start[k + 1] += col_start[k]
+    for k in range(nr):
+        row_start[k + 1] += row_start[k]
+    col_rows = np.empty(col_start[nd], np.int64)
+    row_cols = np.empty(row_start[nr], np.int64)
+    col_fill = col_start[:nd].copy()
+    row_fill = row_start[:nr].copy()
+    for i in range(n):
+        if own[i]:
+            col_rows[col_fill[d[i]]] = r[i]
+            col_fill[d[i]] += 1
+            row_cols[row_fill[r[i]]] = d[i]
+            row_fill[r[i]] += 1
+    keep = np.empty(nc, np.bool_)
+    for c in range(nc):
+        i = cand[c]
+        p = pmap[r[i], d[i]]
+        masked = False
+        for k in range(col_start[d[i]], col_start[d[i] + 1]):
+            rr = col_rows[k]
+            if pmap[rr, d[i]] * env_r[(r[i] - rr) % nr] > p:
+                masked = True
+        for k in range(row_start[r[i]], row_start[r[i] + 1]):
+            dd = row_cols[k]
+            if pmap[r[i], dd] * env_d[(d[i] - dd) % nd] > p:
+                masked = True
+        keep[c] = not masked
+    return cand[keep]
+
+
+def select_cells(range_bin: np.ndarray, doppler_bin: np.ndarray, power: np.ndarray,
+                 neighbour_max: np.ndarray | None, shape: tuple[int, int],
+                 bins: tuple[int, int], envelopes: tuple[np.ndarray, np.ndarray] | None
+                 ) -> np.ndarray:
+    """The records that become points (:func:`select_records`): indices int
+    (m,) in (range, Doppler) order of the records that hold their cell (the last record of a
+    cell wins, power > 0), lie in range bins ``bins`` = [lo, hi), are no weaker than any
+    of the 8 cells around them on the map of detected powers (both axes circular) nor than
+    ``neighbour_max`` (float (n,), their largest neighbour power, detected or not), and,
+    with ``envelopes`` (range, Doppler sidelobe envelopes times the margin, float
+    (n_range,), (n_doppler,)), are not below the sidelobes of a detected cell in their
+    column or row. range_bin, doppler_bin: int (n,); power: float (n,); shape: (n_range,
+    n_doppler)."""
+    n = len(range_bin)
+    nbmax = np.zeros(n) if neighbour_max is None else np.asarray(neighbour_max, dtype=float)
+    z = np.zeros(1)
+    env_r, env_d = envelopes if envelopes is not None else (z, z)
+    return _select(np.ascontiguousarray(range_bin, dtype=np.int64),
+                   np.ascontiguousarray(doppler_bin, dtype=np.int64),
+                   np.ascontiguousarray(power, dtype=float), np.ascontiguousarray(nbmax),
+                   int(shape[0]), int(shape[1]), int(bins[0]), int(bins[1]),
+                   envelopes is not None, np.ascontiguousarray(env_r, dtype=float),
+                   np.ascontiguousarray(env_d, dtype=float))

@@ -12,7 +12,7 @@ from typing import TypeVar
 from tqdm import tqdm
 
 from host.cfar import CfarParams
-from host.pipeline import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams
+from host.params import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams
 from model.config import RadarConfig
 from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
 
@@ -79,15 +79,15 @@ _compile_noted = False
 def note_compile(command: str) -> None:
     """Once per process, right before the first records -> point cloud call: one
     ``radar <command>: ...`` line on stderr when the host's compiled kernels
-    (``host.cell_kernels``) are not cached yet (that call then takes 20-30 s longer, once
+    (``host.kernels``) are not cached yet (that call then takes 20-30 s longer, once
     per checkout)."""
     global _compile_noted
     if _compile_noted:
         return
     _compile_noted = True
-    from host.cell_kernels import uncompiled_kernels  # numba: only where records are
+    from host.kernels import uncompiled_kernels  # numba: only where records are
     if uncompiled_kernels():
-        print(f"radar {command}: compiling the host kernels (host/cell_kernels.py, numba; "
+        print(f"radar {command}: compiling the host kernels (numba; "
               "first run in this checkout, 20-30 s)", file=sys.stderr)
 
 

@@ -8,12 +8,12 @@ import math
 
 import numpy as np
 
-from host.pipeline import _tdm_comp
 from model.axis_packetizer import pack_iq
 from model.config import RadarConfig, get_preset
 from model.detect_records import Record
 from model.reference import signed_bins
 from model.scene import PointTarget, Scene
+from tests.oracles.points import tdm_comp
 
 MAX_SCENE_RANGE_M = 150.0
 """Farthest random target, m (full reports up to 435 m, where 5..100 m^2 targets are below
@@ -58,7 +58,7 @@ def synthetic_records(cfg: RadarConfig, n: int, seed: int = 0, varied: bool = Fa
             amp = sigma * 10 ** (rng.uniform(0, 45) / 20)
             fold = int(rng.integers(-2, 2))
         kk = int(signed_bins(cfg.n_doppler)[d]) + fold * cfg.n_doppler
-        tdm = np.conj(_tdm_comp(cfg, kk))
+        tdm = np.conj(tdm_comp(cfg, kk))
         x = amp * np.exp(-1j * np.pi * v * s) * tdm
         if varied and k % 8 == 7:
             x = x + 0.5 * amp * np.exp(-1j * np.pi * v * rng.uniform(-0.9, 0.9)) * tdm

@@ -5,7 +5,8 @@ raised), truncation flagged, and records -> point cloud equal to the cube path's
 import numpy as np
 import pytest
 
-from host.pipeline import DetectionParams, peak_offsets, process_cube
+from host.cells import peak_offsets
+from host.pipeline import DetectionParams, process_cube
 from host.record_points import process_records, record_offsets
 from host.records import RecordDecoder, fpga_detect_config, record_arrays
 from model import cfar_2d as cm
@@ -122,7 +123,7 @@ def test_wrong_max_detections_is_reported():
 
 def test_offsets_from_neighbour_powers():
     """The records' neighbour powers give the cube path's interpolation
-    (``host.pipeline.peak_offsets`` on the map), detected or not; 0 in range at the ends."""
+    (``host.cells.peak_offsets`` on the map), detected or not; 0 in range at the ends."""
     def hann(x):
         return abs(np.sinc(x) / (1 - x * x))
     pmap = np.full((32, 32), 1e-3)
@@ -173,7 +174,7 @@ def test_records_need_the_configs_channels():
 
 
 def test_window_response_closed_form_is_the_windows_dft():
-    from host.pipeline import _window_response
+    from host.points import _window_response
     from model.reference import hann_periodic
 
     off = np.linspace(-0.5, 0.5, 41)

@@ -1,5 +1,6 @@
-"""The vectorised host record path against the implementations it replaced (issue 14, host
-time; kept as ``*_reference``): same records, same selection, same peaks, same clouds.
+"""The host's records path and its one cells -> points path against the implementations
+they replaced (issue 14, host time; issue 28, one path: the oracles in ``tests/oracles``):
+same records, same selection, same peaks, same clouds.
 
 Tolerance of "same cloud": integer and flag fields exactly, float fields within 1e-9
 (relative and absolute): the fast path evaluates the same sums, partly in another order."""
@@ -12,36 +13,12 @@ from dataclasses import fields, replace
 import numpy as np
 import pytest
 
-from host.angle import (
-    AngleParams,
-    estimate_angles,
-    estimate_angles_fast,
-    estimate_angles_rows,
-    estimate_angles_screened,
-    fine_peaks,
-    fine_peaks_lean,
-    peak_sin_batch,
-    peak_sin_fast,
-)
-from host.pipeline import (
-    DetectionParams,
-    _choose_fold,
-    choose_folds,
-    detect_cells,
-    peak_offsets,
-    points_from_cells,
-    points_from_cells_reference,
-    velocity_hypotheses,
-)
+from host.angle import AngleParams, estimate_angles
+from host.cells import Cells, peak_offsets
+from host.pipeline import DetectionParams, detect_cells
 from host.pointcloud import PointCloud
-from host.record_points import (
-    hypothesis_classes,
-    points_from_snapshots,
-    process_records,
-    process_records_reference,
-    select_records,
-    select_records_reference,
-)
+from host.points import points_from_cells
+from host.record_points import process_records, record_cells, select_records
 from host.records import (
     RecordArrays,
     RecordDecoder,
@@ -53,6 +30,7 @@ from host.records import (
     record_arrays,
     record_arrays_reference,
 )
+from host.tdm import choose_folds, hypothesis_classes
 from model import cfar_2d as cm
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import get_preset
@@ -67,6 +45,23 @@ from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
+from tests.oracles.angle import estimate_angles as estimate_angles_row
+from tests.oracles.angle import (
+    estimate_angles_rows,
+    fine_peaks,
+    first_component_screen,
+    peak_sin_batch,
+    peak_sin_fast,
+    screened_components,
+)
+from tests.oracles.points import (
+    choose_fold,
+    points_from_cells_numpy,
+    points_from_cells_reference,
+    process_records_reference,
+    select_records_reference,
+    velocity_hypotheses,
+)
 from tests.scenes import random_scene, synthetic_records
 
 
@@ -206,8 +201,8 @@ def test_choose_folds_matches_per_cell_decision() -> None:
             m, amb = choose_folds(use, cfg, v, snr, params)
             for i in range(n):
                 powers = {c: float(p) for c, p in enumerate(use[i])}
-                assert (m[i], amb[i]) == _choose_fold(powers, cfg, float(v[i]), float(snr[i]),
-                                                      params)
+                assert (m[i], amb[i]) == choose_fold(powers, cfg, float(v[i]), float(snr[i]),
+                                                     params)
 
 
 def test_hypothesis_classes_are_the_per_cell_hypotheses() -> None:
@@ -218,8 +213,7 @@ def test_hypothesis_classes_are_the_per_cell_hypotheses() -> None:
         cfg = get_preset(preset)
         v = np.concatenate([rng.uniform(-1, 1, 300), [-1.0, 1.0, 0.0]]) * cfg.max_velocity_mps
         for speed in (100.0, 30.0, 1.0, 0.01, 400.0):
-            params = DetectionParams(max_speed_mps=speed)
-            got = hypothesis_classes(cfg, v, params)
+            got = hypothesis_classes(cfg, v, speed)
             for i in range(len(v)):
                 classes = {m % cfg.num_tx for m in velocity_hypotheses(cfg, float(v[i]), speed)}
                 assert set(np.flatnonzero(got[i])) == classes, (preset, speed, v[i])
@@ -232,7 +226,7 @@ def test_points_match_reference(preset: str) -> None:
     arr = record_arrays(recs, cfg.n_virtual, 37.0)
     params = DetectionParams()
     new = process_records(arr, cfg, params)
-    old = process_records(arr, cfg, params, reference=True)
+    old = process_records_reference(arr, cfg, params)
     assert len(new) == len(old) > 0
     for f in fields(new):
         a, b = getattr(new, f.name), getattr(old, f.name)
@@ -243,8 +237,8 @@ def test_points_match_reference(preset: str) -> None:
     idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     off = np.zeros((len(idx), 2))
-    a = points_from_cells(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx], off, cfg,
-                          params)
+    a = points_from_cells(Cells(cells[:, 0], cells[:, 1], arr.power[idx], arr.noise[idx], off,
+                                arr.snapshot[idx]), cfg, params)
     b = points_from_cells_reference(cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx],
                                     off, cfg, params)
     np.testing.assert_allclose(a.azimuth_deg, b.azimuth_deg, atol=1e-9)
@@ -290,18 +284,10 @@ def test_decoder_frames_are_arrays_with_the_reference_records() -> None:
     assert [f.usable_records for f in out[0]] == [0, 5, 20, 3]
 
 
-def test_fine_peaks_lean_is_fine_peaks() -> None:
-    rng = np.random.default_rng(11)
-    for n, n_fft in ((64, 1024), (4, 1024), (64, 64), (16, 16)):
-        x = rng.normal(size=(300, n)) + 1j * rng.normal(size=(300, n))
-        x[:100] += 5 * np.exp(-1j * np.pi * np.arange(n) * rng.uniform(-1, 1, (100, 1)))
-        for got, want in zip(fine_peaks_lean(x, n_fft), fine_peaks(x, n_fft), strict=True):
-            np.testing.assert_array_equal(got, want)
-
-
-def test_screened_angles_are_the_fast_ones() -> None:
-    """One, two and three targets per row over a wide SNR range: the screened second-
-    component search gives the same components (and skips most strong single targets)."""
+def test_angles_are_the_numpy_screened_ones() -> None:
+    """One, two and three targets per row over a wide SNR range: ``host.angle`` gives the
+    components of the numpy screened estimator with the same (fine-grid) peak search, and
+    the screen skips most strong single targets."""
     rng = np.random.default_rng(12)
     rows, v = 300, np.arange(64)
     x = np.zeros((rows, 64), complex)
@@ -311,12 +297,14 @@ def test_screened_angles_are_the_fast_ones() -> None:
     x += (rng.normal(size=x.shape) + 1j * rng.normal(size=x.shape)) / np.sqrt(2)
     noise = np.ones(rows)
     for p in (AngleParams(), AngleParams(max_targets=1), AngleParams(min_snr_db=3.0)):
-        a = estimate_angles_screened(x, noise, p)
-        b = estimate_angles_fast(x, noise, p)
+        a = estimate_angles(x, noise, p)
+        s1 = peak_sin_fast(x, p.n_fft)[0]
+        b = screened_components(x, noise, p, s1, *first_component_screen(x, noise, p, s1),
+                                peaks=peak_sin_fast)
         np.testing.assert_array_equal(a.cell, b.cell)
         for name in ("sin_az", "amplitude", "snr_db"):
-            np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-12,
-                                       atol=1e-12)
+            np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-9,
+                                       atol=1e-9)
         assert len(a.cell) > rows or p.max_targets == 1
 
 
@@ -334,22 +322,24 @@ def test_process_records_is_the_reference_on_synthetic_frames(preset: str) -> No
                        DetectionParams(max_speed_mps=5.0),     # cells with no hypothesis
                        DetectionParams(unfold_velocity=False, sidelobe_margin_db=None)):
             new = process_records(arr, cfg, params, frame=3)
-            _same_cloud(new, process_records(arr, cfg, params, frame=3, reference=True))
+            _same_cloud(new, process_records_reference(arr, cfg, params, frame=3))
         assert len(new) > 0.8 * big
     empty = record_arrays([], cfg.n_virtual)
     assert len(process_records(empty, cfg)) == 0 == len(process_records_reference(empty, cfg))
     recs = [r for r in synthetic_records(cfg, 200, seed=3) if r.range_bin == 0]
     arr = record_arrays(recs, cfg.n_virtual)
     assert len(process_records(arr, cfg)) == 0 == len(process_records_reference(arr, cfg))
-    none = points_from_snapshots(np.zeros((0, 2), np.int64), np.zeros((0, cfg.n_virtual)),
-                                 np.zeros(0), np.zeros(0), np.zeros((0, 2)), cfg,
-                                 DetectionParams())
-    assert len(none) == 0
+    z = np.zeros(0)
+    none = Cells(z.astype(int), z.astype(int), z, z, np.zeros((0, 2)),
+                 np.zeros((0, cfg.n_virtual), complex))
+    assert len(points_from_cells(none, cfg, DetectionParams())) == 0
+    assert len(record_cells(empty, cfg, DetectionParams())) == 0
 
 
 def test_table1_full_cells_as_records() -> None:
     """Table I on ``full``: every CFAR cell of the float cube as a record (its snapshot,
-    NCI power and noise): the fast path's cloud is the reference's, and the cube path's."""
+    NCI power and noise): the records path's cloud is the reference's, and the cube path's
+    (one path, ``host.points``) is the numpy path the cube took before."""
     scene = table1_scene("full")
     cfg = scene.config
     params = DetectionParams()
@@ -362,8 +352,10 @@ def test_table1_full_cells_as_records() -> None:
     assert len(new) >= 4
     _same_cloud(new, process_records_reference(arr, cfg, params))
     off = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
-    _same_cloud(points_from_snapshots(cells, arr.snapshot, arr.power, noise, off, cfg, params),
-                points_from_cells(cells, arr.snapshot, arr.power, noise, off, cfg, params))
+    cube_cells = Cells(cells[:, 0], cells[:, 1], arr.power, noise, off, arr.snapshot)
+    _same_cloud(points_from_cells(cube_cells, cfg, params),
+                points_from_cells_numpy(cells, arr.snapshot, arr.power, noise, off, cfg,
+                                        params))
 
 
 def test_random_scenes_through_the_chain() -> None:
@@ -379,8 +371,8 @@ def test_random_scenes_through_the_chain() -> None:
         f = [f for p in packetize_stream([out.records], chain.packet_words)
              for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
         arr = record_arrays(f[0].records, cfg.n_virtual, chain_gain(cfg, chain))
-        _same_cloud(process_records(arr, cfg, params), process_records_reference(arr, cfg,
-                                                                                 params))
+        _same_cloud(process_records(arr, cfg, params),
+                    process_records_reference(arr, cfg, params))
 
 
 def test_estimate_angles_rows_is_estimate_angles_per_row() -> None:
@@ -399,7 +391,8 @@ def test_estimate_angles_rows_is_estimate_angles_per_row() -> None:
     for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256),
               AngleParams(min_snr_db=0.0, dynamic_range_db=40.0)):
         got = estimate_angles_rows(x, noise, p)
-        want = [(i, c) for i in range(rows) for c in estimate_angles(x[i], float(noise[i]), p)]
+        want = [(i, c) for i in range(rows)
+                for c in estimate_angles_row(x[i], float(noise[i]), p)]
         assert len(want) > rows
         np.testing.assert_array_equal(got.cell, [i for i, _ in want])
         np.testing.assert_allclose(got.sin_az, [c.sin_az for _, c in want], atol=1e-9)
@@ -420,10 +413,10 @@ def test_records_outside_the_map_are_refused_or_dropped(field: str, value: int) 
     bins = getattr(arr, field).copy()
     bins[[3, 17]] = value
     bad = replace(arr, **{field: bins})
-    for reference in (False, True):
+    for process in (process_records, process_records_reference):
         with pytest.raises(ValueError, match=r"2 record\(s\) outside paper-fpga's 64 x 256 "
                                              rf"map \(first: .*{value}"):
-            process_records(bad, cfg, reference=reference)
+            process(bad, cfg)
     kept, dropped = inside_map(bad, cfg)
     assert dropped == 2 and len(kept) == 38
     keep = np.setdiff1d(np.arange(40), [3, 17])
@@ -436,7 +429,7 @@ def test_records_outside_the_map_are_refused_or_dropped(field: str, value: int) 
 
 def test_zero_noise_estimates_give_finite_points() -> None:
     """A CFAR noise estimate of 0 (noiseless input: every training cell 0) is the noise
-    floor 1e-30 (host.pipeline.cell_snr_db, the angle estimator): no divide warning, the
+    floor 1e-30 (host.points.cell_snr_db, the angle estimator): no divide warning, the
     same points as that floor, every value finite; on both paths."""
     cfg = get_preset("full")
     arr = record_arrays(synthetic_records(cfg, 60, seed=9, varied=True), cfg.n_virtual, 37.0)
@@ -444,9 +437,9 @@ def test_zero_noise_estimates_give_finite_points() -> None:
     floor = replace(arr, noise=np.full_like(arr.noise, 1e-30))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        for reference in (False, True):
-            got = process_records(zero, cfg, reference=reference)
-            want = process_records(floor, cfg, reference=reference)
+        for process in (process_records, process_records_reference):
+            got = process(zero, cfg)
+            want = process(floor, cfg)
             assert len(got) == len(want) > 0
             for f in fields(got):
                 a = getattr(got, f.name)

@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 from host.evaluate import match_targets, table3
-from host.pipeline import DetectionParams, process_frame, velocity_hypotheses
+from host.pipeline import DetectionParams, process_frame
 from model.config import get_preset
 from model.scene import Scene, table1_scene
 from model.simulate import simulate_scene
+from tests.oracles.points import velocity_hypotheses
 
 
 def _cloud(preset, targets, params=None, seed=2):

@@ -6,7 +6,7 @@ import argparse
 
 import numpy as np
 
-from host.pipeline import MAX_RADIAL_SPEED_MPS
+from host.params import MAX_RADIAL_SPEED_MPS
 from model.observability import scene_report
 from model.simulate import MAX_FRAME_INDEX, check_frame_index, simulate_scene
 from radar.common import CliError, out_file, scene_of, warn

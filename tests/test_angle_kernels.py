@@ -1,7 +1,8 @@
-"""The compiled kernels of ``host.cell_kernels`` against the numpy functions they replace
-(``host.angle.peak_power_lean``, ``peak_sin_fast``, the first half of
-``estimate_angles_screened``, ``estimate_angles_rows``, RELAX itself), and the compiled record path
-against the numpy one: the same peaks and decisions, floats equal to rounding."""
+"""The compiled kernels of ``host.angle`` (``host._angle_peaks``, ``host._angle_relax``)
+against the numpy implementations they replaced (``tests.oracles.angle``: the fast peak
+search, the screened estimator, RELAX in step over rows): the same peaks and decisions,
+floats equal to rounding; and the same results with numba absent (the uncompiled fallback
+of ``host.kernels``)."""
 
 from __future__ import annotations
 
@@ -14,29 +15,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from host.angle import (
-    AngleParams,
+from host._angle_peaks import class_peaks, peak_sins
+from host._angle_relax import first_components, relax_rows, steering_rows
+from host.angle import AngleParams, _relax, estimate_angles, peak_powers
+from host.tdm import tx_phasors
+from model.config import get_preset
+from radar.common import note_compile
+from tests.oracles.angle import (
     _steering_rows,
     estimate_angles_rows,
     estimate_angles_screened,
     first_component_screen,
-    peak_power_lean,
+    peak_power_fast,
     peak_sin_fast,
-    screened_components,
 )
-from host.cell_kernels import (
-    class_peaks,
-    first_components,
-    peak_sins,
-    relax_rows,
-    steering_rows,
-)
-from host.pipeline import DetectionParams, _tdm_compensate, _tdm_tx_phasors
-from host.record_points import points_from_snapshots, record_offsets, select_records
-from host.records import record_arrays
-from model.config import get_preset
-from radar.common import note_compile
-from tests.scenes import synthetic_records
+from tests.oracles.points import tdm_compensate
 
 
 def _rows(rng: np.random.Generator, m: int, n: int, targets: int = 3) -> np.ndarray:
@@ -53,7 +46,7 @@ def _rows(rng: np.random.Generator, m: int, n: int, targets: int = 3) -> np.ndar
 
 
 @pytest.mark.parametrize("n_fft", [1024, 256, 64])
-def test_class_peaks_are_peak_power_lean(n_fft: int) -> None:
+def test_class_peaks_are_the_numpy_peaks(n_fft: int) -> None:
     """Every (cell, class) pair of 4-TX snapshots, random phasors and cell order; rows that
     are 0 (every bin ties) and constant; blocks not filled to the end."""
     cfg = get_preset("full")
@@ -66,9 +59,9 @@ def test_class_peaks_are_peak_power_lean(n_fft: int) -> None:
     cell[:2] = (7, 8)
     k = rng.integers(-cfg.n_doppler // 2, cfg.n_doppler // 2, len(cell)) + \
         rng.integers(0, cfg.num_tx, len(cell)) * cfg.n_doppler
-    ph = _tdm_tx_phasors(cfg, k)
+    ph = tx_phasors(cfg, k)
     got_p, got_s = class_peaks(x, cell, ph, n_fft)
-    want_p, want_s = peak_power_lean(_tdm_compensate(cfg, x.astype(complex)[cell], k), n_fft)
+    want_p, want_s = peak_power_fast(tdm_compensate(cfg, x.astype(complex)[cell], k), n_fft)
     np.testing.assert_allclose(got_p, want_p, rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(got_s, want_s, rtol=0, atol=1e-12)
     assert got_p[0] == 0 and np.isfinite(got_s).all()
@@ -99,15 +92,17 @@ def test_uncompiled_kernels_are_named(tmp_path: Path, monkeypatch: pytest.Monkey
                                       capsys: pytest.CaptureFixture[str]) -> None:
     """With an empty numba cache every kernel is named (the CLI then says it compiles);
     after a call, its kernels are cached."""
-    code = ("import host.cell_kernels as K, numpy as np; print(sorted(K.uncompiled_kernels()));"
-            "K.steering_rows(np.zeros(2), 4); print(sorted(K.uncompiled_kernels()))")
+    code = ("import host.kernels as K, host._angle_relax as R, numpy as np;"
+            "print(sorted(K.uncompiled_kernels()));"
+            "R.steering_rows(np.zeros(2), 4); print(sorted(K.uncompiled_kernels()))")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, check=True, cwd=Path(__file__).parents[1]).stdout.split("\n")
     before, after = ast.literal_eval(out[0]), ast.literal_eval(out[1])
-    assert {"_class_peaks", "_relax", "_steering", "_steer_row"} <= set(before)
+    assert {"_class_peaks", "_relax", "_steering", "_steer_row", "_select",
+            "_fold_decisions"} <= set(before)
     assert "_steering" in before and "_steering" not in after and "_relax" in after
-    import host.cell_kernels as kernels
+    import host.kernels as kernels
     import radar.common
     for missing, said in ((["_relax"], True), ([], False)):
         monkeypatch.setattr(radar.common, "_compile_noted", False)
@@ -130,7 +125,18 @@ def test_kernel_inputs_are_checked() -> None:
         first_components(np.zeros((2, 64), complex), np.ones((2, 3)), np.zeros(2),
                          np.ones(2), 12.0, 20.0)
     with pytest.raises(ValueError, match="exceed the coarse FFT"):
-        relax_rows(np.zeros((2, 64), complex), np.ones(2), AngleParams(n_fft=32))
+        relax_rows(np.zeros((2, 64), complex), np.ones(2), 32, 3, 2, 12.0, 20.0)
+    with pytest.raises(ValueError, match="at most 128"):
+        estimate_angles(np.zeros((2, 256), complex), np.ones(2), AngleParams())
+    with pytest.raises(ValueError, match="at most 128"):
+        peak_powers(np.zeros((2, 256), complex), 1024)
+    with pytest.raises(ValueError, match=r"noise \(3,\) for 2 rows"):
+        estimate_angles(np.zeros((2, 64), complex), np.ones(3), AngleParams())
+    with pytest.raises(ValueError, match="TX phasors"):
+        estimate_angles(np.zeros((2, 64), complex), np.ones(2), AngleParams(),
+                        tx_phasors=np.ones((2, 3)))
+    with pytest.raises(ValueError, match=r"\(n, n_channels\)"):
+        estimate_angles(np.zeros(64, complex), np.ones(1), AngleParams())
 
 
 def test_first_components_are_the_screened_ones() -> None:
@@ -141,8 +147,8 @@ def test_first_components_are_the_screened_ones() -> None:
     n = 300
     x = _rows(rng, n, cfg.n_virtual)
     k = rng.integers(-cfg.n_doppler, cfg.n_doppler, n)
-    ph = _tdm_tx_phasors(cfg, k)
-    xc = _tdm_compensate(cfg, x.astype(complex), k)
+    ph = tx_phasors(cfg, k)
+    xc = tdm_compensate(cfg, x.astype(complex), k)
     s1, _ = peak_sin_fast(xc, 1024)
     noise = rng.uniform(0.5, 2, n)
     p = AngleParams()
@@ -156,7 +162,7 @@ def test_first_components_are_the_screened_ones() -> None:
     none = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db, screen=False)
     assert not none[3].any()
     # and the components that follow: the numpy screened estimator's
-    got = screened_components(xs, noise, p, s1, a1, p1, maybe)
+    got = estimate_angles(x, noise, p, tx_phasors=ph, first_sin=s1)
     want = estimate_angles_screened(xc, noise, p, first_sin=s1)
     np.testing.assert_array_equal(got.cell, want.cell)
     np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
@@ -189,41 +195,53 @@ def test_relax_rows_is_estimate_angles_rows(n: int) -> None:
     for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256),
               AngleParams(max_targets=4, refine_iterations=0, min_snr_db=6.0)):
         for rows in (slice(None), slice(5, 6)):
-            got = relax_rows(x[rows], noise[rows], p)
+            got = _relax(x[rows], noise[rows], p)
             want = estimate_angles_rows(x[rows], noise[rows], p, peaks=peak_sins,
                                         steer=steering_rows)
             np.testing.assert_array_equal(got.cell, want.cell)
             np.testing.assert_allclose(got.sin_az, want.sin_az, atol=1e-9)
             np.testing.assert_allclose(got.amplitude, want.amplitude, rtol=1e-9, atol=1e-9)
             np.testing.assert_allclose(got.snr_db, want.snr_db, atol=1e-9)
-    counts = np.bincount(relax_rows(x, noise, AngleParams()).cell, minlength=200)
+    counts = np.bincount(_relax(x, noise, AngleParams()).cell, minlength=200)
     assert (counts[13:] >= 1).all() and (counts >= 2).sum() > 40 and (counts == 3).any()
-    assert len(relax_rows(np.zeros((0, n)), np.zeros(0), AngleParams()).cell) == 0
+    assert len(_relax(np.zeros((0, n)), np.zeros(0), AngleParams()).cell) == 0
     with pytest.raises(ValueError, match="noise"):
-        relax_rows(x, noise[:3], AngleParams())
+        _relax(x, noise[:3], AngleParams())
 
 
-@pytest.mark.parametrize("preset", ["full", "paper-fpga"])
-def test_compiled_record_path_is_the_numpy_one(preset: str) -> None:
-    """Strong and mixed synthetic frames (aliased velocities, two targets in every 8th
-    cell), several settings: the same points through the kernels as through numpy."""
-    cfg = get_preset(preset)
-    for recs in (synthetic_records(cfg, 400, seed=4),
-                 synthetic_records(cfg, 400, seed=5, varied=True)):
-        arr = record_arrays(recs, cfg.n_virtual, 37.0)
-        for params in (DetectionParams(), DetectionParams(max_speed_mps=30.0),
-                       DetectionParams(unfold_velocity=False)):
-            idx = select_records(arr, cfg, params)
-            cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-            off = record_offsets(arr.power[idx], arr.neighbours[idx], cells[:, 0],
-                                 cfg.n_range)
-            args = (cells, arr.snapshot[idx], arr.power[idx], arr.noise[idx], off, cfg,
-                    params)
-            a = points_from_snapshots(*args, compiled=True)
-            b = points_from_snapshots(*args, compiled=False)
-            assert len(a) == len(b) > 300
-            for f in ("range_bin", "doppler_bin", "ambiguous"):
-                np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
-            for f in ("range_m", "azimuth_deg", "radial_velocity_mps", "snr_db", "rcs_dbsm"):
-                np.testing.assert_allclose(getattr(a, f), getattr(b, f), rtol=1e-9,
-                                           atol=1e-9)
+def test_without_numba_the_same_python_runs() -> None:
+    """numba absent (blocked in a subprocess): the kernels run as plain Python
+    (``host.kernels.COMPILED`` False, nothing to compile) and give the compiled results:
+    the peaks, the components and a point cloud."""
+    code = (
+        "import sys; sys.modules['numba'] = None\n"
+        "import numpy as np, host.kernels as K\n"
+        "from tests.test_angle_kernels import uncompiled_case\n"
+        "print(K.COMPILED, K.uncompiled_kernels()); np.save(sys.argv[1], uncompiled_case())\n")
+    out = Path(os.environ.get("TMPDIR", "/tmp")) / f"nonumba_{os.getpid()}.npy"
+    run = subprocess.run([sys.executable, "-c", code, str(out)], capture_output=True,
+                         text=True, timeout=600, cwd=Path(__file__).parents[1])
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split("\n")[0] == "False []"
+    try:
+        np.testing.assert_allclose(np.load(out), uncompiled_case(), rtol=1e-9, atol=1e-9)
+    finally:
+        out.unlink(missing_ok=True)
+
+
+def uncompiled_case() -> np.ndarray:
+    """A few rows through every kernel: the class peaks, the angle components and the
+    points of a small cube scene, as one float array."""
+    from host.pipeline import process_frame
+    from model.scene import table1_scene
+    from model.simulate import simulate_scene
+    cfg = get_preset("full")
+    rng = np.random.default_rng(3)
+    x = _rows(rng, 6, cfg.n_virtual).astype(complex)
+    ph = tx_phasors(cfg, np.arange(6) * 40 - 100)
+    p, s = class_peaks(x, np.arange(6), ph, 1024)
+    ang = estimate_angles(x, np.ones(6), AngleParams(min_snr_db=3.0), tx_phasors=ph)
+    scene = table1_scene("paper-fpga")
+    cloud = process_frame(simulate_scene(scene).samples, scene.config)
+    return np.concatenate([p, s, ang.cell, ang.sin_az, np.abs(ang.amplitude),
+                           cloud.range_m, cloud.azimuth_deg, cloud.radial_velocity_mps])

@@ -1,0 +1,278 @@
+"""Private backend of ``host.angle``: compiled steering vectors, first angle components with
+the screen for a second one, and RELAX on the rows that hold several.
+
+- :func:`first_components`: each row's TDM-compensated vector, the amplitude and power of
+  its first component at a given sin(az), and the Cauchy-Schwarz screen: the residual r
+  after the first component can hold a second one only if |s^H r / n|^2 <= ||r||^2 / n
+  (|s_v| = 1) passes both gates of ``host.angle.AngleParams``.
+- :func:`steering_rows`: exp(-j pi v s) per row, from two sines and cosines per row.
+- :func:`relax_rows`: RELAX-style sequential estimation (``host.angle`` module docstring),
+  every pass's batch of rows through the peak search of ``host._angle_peaks``.
+
+The numpy implementations these replaced are the oracles in ``tests/oracles/angle.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from host._angle_peaks import COARSE_FFT, SECOND_LOBE, _c128, _class_peaks, _tables
+from host.kernels import njit
+
+
+@njit(fastmath=True)
+def _steer_row(s: float, str_: np.ndarray, sti: np.ndarray, lor: np.ndarray,
+               loi: np.ndarray) -> None:
+    """exp(-j pi v s) for v = 0..n-1 into str_, sti (float (n,)), as
+    v = q b0 + p with b0 = len(lor) = ceil(sqrt(n)), the
+    products of powers of exp(-j pi s) and of exp(-j pi b0 s) (two sines and cosines; the
+    powers are a few ulp off the exponentials). lor, loi (b0,): scratch."""
+    nv = str_.shape[0]
+    b0 = lor.shape[0]
+    c1 = math.cos(math.pi * s)
+    d1 = -math.sin(math.pi * s)
+    cb = math.cos(math.pi * b0 * s)
+    db = -math.sin(math.pi * b0 * s)
+    lor[0] = 1.0
+    loi[0] = 0.0
+    for p in range(1, b0):
+        lor[p] = lor[p - 1] * c1 - loi[p - 1] * d1
+        loi[p] = lor[p - 1] * d1 + loi[p - 1] * c1
+    hr = 1.0
+    hi = 0.0
+    for q in range(-(-nv // b0)):
+        if q:
+            hr, hi = hr * cb - hi * db, hr * db + hi * cb
+        for p in range(b0):
+            v = q * b0 + p
+            if v < nv:
+                str_[v] = hr * lor[p] - hi * loi[p]
+                sti[v] = hr * loi[p] + hi * lor[p]
+
+
+@njit(fastmath=True)
+def _steering(s: np.ndarray, out: np.ndarray) -> None:
+    """:func:`steering_rows` into out (complex128 (m, n))."""
+    m, n = out.shape
+    b0 = int(math.ceil(math.sqrt(n)))
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(n)
+    sti = np.empty(n)
+    for i in range(m):
+        _steer_row(s[i], str_, sti, lor, loi)
+        for v in range(n):
+            out[i, v] = complex(str_[v], sti[v])
+
+
+def steering_rows(s: np.ndarray, n: int) -> np.ndarray:
+    """exp(-j pi v s) for v = 0..n-1 of every s (float (m,)), complex (m, n) (equal to
+    the exponentials to rounding)."""
+    s = np.ascontiguousarray(s, dtype=float)
+    out = np.empty((len(s), n), np.complex128)
+    if len(s):
+        _steering(s, out)
+    return out
+
+
+@njit(fastmath=True)
+def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.ndarray,
+                      snr_lin: float, dyn_lin: float, screen: bool, out: np.ndarray,
+                      a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray) -> None:
+    """:func:`first_components` (x, ph, out complex128; snr_lin, dyn_lin: the gates as
+    power ratios)."""
+    n_rows, nv = x.shape
+    ntx = ph.shape[1]
+    nrx = nv // ntx
+    b0 = int(math.ceil(math.sqrt(nv)))
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(nv)
+    sti = np.empty(nv)
+    outr = np.empty(nv)
+    outi = np.empty(nv)
+    for i in range(n_rows):
+        for t in range(ntx):
+            pr = ph[i, t].real
+            pi = ph[i, t].imag
+            for r in range(nrx):
+                v = t * nrx + r
+                xr = x[i, v].real
+                xi = x[i, v].imag
+                outr[v] = xr * pr - xi * pi
+                outi[v] = xr * pi + xi * pr
+                out[i, v] = complex(outr[v], outi[v])
+        _steer_row(s1[i], str_, sti, lor, loi)
+        sr = 0.0
+        si = 0.0
+        for v in range(nv):     # conj(st) . x, as _project but on the split row (25 % faster)
+            sr += str_[v] * outr[v] + sti[v] * outi[v]
+            si += str_[v] * outi[v] - sti[v] * outr[v]
+        ar = sr / nv
+        ai = si / nv
+        a1[i] = complex(ar, ai)
+        p1[i] = ar * ar + ai * ai
+        if screen:
+            e = 0.0
+            for v in range(nv):
+                rr = outr[v] - (ar * str_[v] - ai * sti[v])
+                ri = outi[v] - (ar * sti[v] + ai * str_[v])
+                e += rr * rr + ri * ri
+            bound = e * (1.0 + 1e-9) / nv
+            maybe[i] = (bound * nv >= snr_lin * noise[i]) and (
+                p1[i] <= dyn_lin * max(bound, 1e-300))
+
+
+
+def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
+                     noise_per_channel: np.ndarray, min_snr_db: float,
+                     dynamic_range_db: float, screen: bool = True
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The first angle component of each TDM-compensated snapshot and the screen for a
+    second (module docstring):
+    (compensated rows complex128 (n, n_v), amplitude a1 complex (n,), power |a1|^2 float
+    (n,), ``maybe`` bool (n,): the row may hold a second component).
+
+    x: complex (n, num_tx * num_rx); phasors: complex (n, num_tx) per TX
+    (``host.tdm.tx_phasors``); first_sin: float (n,) sin(az) of the row's peak;
+    noise_per_channel: float (n,) (clamped to >= 1e-30 as there); ``screen`` False: no
+    second-component screen (``maybe`` all False)."""
+    n = len(x)
+    if x.ndim != 2 or phasors.shape[0] != n or x.shape[1] % max(phasors.shape[1], 1):
+        raise ValueError(f"first_components: snapshots {x.shape}, phasors {phasors.shape}")
+    out = np.empty(x.shape, np.complex128)
+    a1, p1, maybe = np.zeros(n, complex), np.zeros(n), np.zeros(n, bool)
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if n:
+        _first_components(_c128(x), _c128(phasors),
+                          np.ascontiguousarray(first_sin, dtype=float),
+                          noise, 10 ** (min_snr_db / 10), 10 ** (dynamic_range_db / 10),
+                          screen, out, a1, p1, maybe)
+    return out, a1, p1, maybe
+
+
+
+@njit(fastmath=True)
+def _project(s: float, row: np.ndarray, str_: np.ndarray, sti: np.ndarray, lor: np.ndarray,
+             loi: np.ndarray) -> complex:
+    """The amplitude conj(st) . row / n of the component at sin(az) s in row (complex (n,)),
+    its steering vector st left in str_, sti (:func:`_steer_row`; lor, loi: scratch)."""
+    n = row.shape[0]
+    _steer_row(s, str_, sti, lor, loi)
+    ar = 0.0
+    ai = 0.0
+    for v in range(n):
+        xr = row[v].real
+        xi = row[v].imag
+        ar += str_[v] * xr + sti[v] * xi
+        ai += str_[v] * xi - sti[v] * xr
+    return complex(ar / n, ai / n)
+
+
+@njit(fastmath=True, error_model="numpy")
+def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
+           dyn_db: float, n_fft: int, second_lobe: float, wr: np.ndarray, wi: np.ndarray,
+           rank: np.ndarray, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
+           os_: np.ndarray, s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray) -> None:
+    """:func:`relax_rows` into s_c, a_c, count (float, complex (m, k), int (m,); zeros
+    in): RELAX's passes, the peak search of each batch of
+    live rows by :func:`_class_peaks` (unit phasors), steering by :func:`_steer_row`."""
+    m, n = xs.shape
+    kmax = s_c.shape[1]
+    b0 = int(math.ceil(math.sqrt(n)))
+    lor = np.empty(b0)
+    loi = np.empty(b0)
+    str_ = np.empty(n)
+    sti = np.empty(n)
+    st_c = np.zeros((m, kmax, n), np.complex128)    # steering of s_c, once per estimate
+    first = np.zeros(m)
+    residual = xs.copy()
+    batch = np.empty((m, n), np.complex128)
+    rows = np.arange(m)
+    ones = np.ones((m, 1), np.complex128)
+    out_pow = np.empty(m)
+    out_sin = np.empty(m)
+    live = np.arange(m)                  # rows still adding components, all with t comps
+    nl = m
+    for t in range(kmax):
+        if nl == 0:
+            break
+        for p in range(nl):
+            batch[p] = residual[live[p]]
+        _class_peaks(batch[:nl], rows[:nl], ones[:nl], n_fft, second_lobe, wr, wi, rank,
+                     dmr, dmi, oc, os_, out_pow[:nl], out_sin[:nl])
+        kept = 0
+        for p in range(nl):
+            i = live[p]
+            s = out_sin[p]
+            a = _project(s, residual[i], str_, sti, lor, loi)
+            power = a.real * a.real + a.imag * a.imag
+            if t:
+                snr_db = 10 * np.log10(power * n / noise[i])
+                if snr_db < min_snr_db or 10 * np.log10(first[i] / power) > dyn_db:
+                    continue
+            s_c[i, t] = s
+            a_c[i, t] = a
+            for v in range(n):
+                st_c[i, t, v] = complex(str_[v], sti[v])
+            count[i] = t + 1
+            if first[i] == 0:
+                first[i] = power
+            live[kept] = i
+            kept += 1
+        nl = kept
+        if t:
+            for _ in range(refine):
+                for j in range(t + 1):
+                    for p in range(nl):      # the row without the other components
+                        i = live[p]
+                        for v in range(n):
+                            o = 0j
+                            for q in range(t + 1):
+                                if q != j:
+                                    o += a_c[i, q] * st_c[i, q, v]
+                            batch[p, v] = xs[i, v] - o
+                    _class_peaks(batch[:nl], rows[:nl], ones[:nl], n_fft, second_lobe, wr,
+                                 wi, rank, dmr, dmi, oc, os_, out_pow[:nl], out_sin[:nl])
+                    for p in range(nl):
+                        i = live[p]
+                        s_c[i, j] = out_sin[p]
+                        a_c[i, j] = _project(out_sin[p], batch[p], str_, sti, lor, loi)
+                        for v in range(n):
+                            st_c[i, j, v] = complex(str_[v], sti[v])
+        for p in range(nl):
+            i = live[p]
+            for v in range(n):
+                tot = 0j
+                for q in range(t + 1):
+                    tot += a_c[i, q] * st_c[i, q, v]
+                residual[i, v] = xs[i, v] - tot
+
+
+def relax_rows(x: np.ndarray, noise: np.ndarray, n_fft: int, max_targets: int,
+               refine_iterations: int, min_snr_db: float, dynamic_range_db: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """RELAX on the rows of x, complex (m, n) (TDM-compensated), noise float (m,) per
+    channel (>= 1e-30): components found strongest first, each further one while its
+    coherent SNR reaches ``min_snr_db`` and it is within ``dynamic_range_db`` of the first,
+    every component re-estimated ``refine_iterations`` times with the others removed
+    (``host.angle.AngleParams``). Returns (sin(az) float (m, max_targets), amplitude complex
+    (m, max_targets), count int (m,): the first count slots of each row are valid)."""
+    xs = _c128(x)
+    m, n = xs.shape
+    if noise.shape != (m,):
+        raise ValueError(f"relax_rows: {m} rows, noise {noise.shape}")
+    if n > min(COARSE_FFT, n_fft):
+        raise ValueError(f"relax_rows: {n} channels exceed the coarse FFT "
+                         f"({min(COARSE_FFT, n_fft)})")
+    s_c = np.zeros((m, max_targets))
+    a_c = np.zeros((m, max_targets), np.complex128)
+    count = np.zeros(m, np.int64)
+    if m:
+        wr, wi, rank, dmr, dmi, oc, os_ = _tables(n, n_fft)
+        _relax(xs, np.ascontiguousarray(noise, dtype=float), refine_iterations, min_snr_db,
+               dynamic_range_db, n_fft, SECOND_LOBE, wr, wi, rank, dmr, dmi, oc, os_, s_c,
+               a_c, count)
+    return s_c, a_c, count

@@ -1,0 +1,67 @@
+"""Host processing settings (``host.pipeline``, ``host.record_points``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from host.angle import AngleParams
+from host.cfar import CfarParams, check_window
+from model.config import RadarConfig
+
+DETECTORS = ("ca", "os", "paper")
+MAX_RADIAL_SPEED_MPS = 100.0
+"""Default fastest radial speed the application expects, m/s (360 km/h: two cars at
+180 km/h head-on). Velocities are unfolded and flagged ``ambiguous`` against it."""
+
+
+@dataclass(frozen=True)
+class DetectionParams:
+    """Host processing settings.
+
+    ``detector``: ``ca`` / ``os`` CFAR on the non-coherent map, or ``paper`` (threshold
+    ``paper_threshold_db`` above the median of channel 0's map). ``cfar``: window and Pfa.
+    ``range_window``/``doppler_window``: whether the FPGA chain applied Hann windows (for the
+    CFAR cell correlation, scalloping and RCS corrections). ``tx_beamforming``: TX gain
+    model used for the RCS estimate. ``unfold_velocity``: TDM Doppler hypothesis test.
+    ``unfold_min_snr_db`` / ``unfold_margin_db``: a hypothesis other than the aliased one
+    wins only in cells at least this strong and by at least this margin; the aliased one
+    excludes the others when it beats them by the margin. ``max_speed_mps``: fastest radial
+    speed considered when unfolding and flagging ``ambiguous`` (``host.pipeline`` module
+    docstring, step 3; ``host.tdm``).
+    Reported range bins are ``RadarConfig.detection_bins`` (DC and negative-beat guards).
+    ``sidelobe_margin_db``: a detected cell must exceed the window sidelobes of every
+    stronger cell in its Doppler column and range row by this much (``host.cfar.
+    sidelobe_masked``; beyond the +-2-bin main lobe); None turns the masking off.
+    """
+
+    detector: str = "ca"
+    cfar: CfarParams = field(default_factory=CfarParams)
+    paper_threshold_db: float = 15.0
+    angle: AngleParams = field(default_factory=AngleParams)
+    range_window: bool = True
+    doppler_window: bool = True
+    tx_beamforming: bool = True
+    unfold_velocity: bool = True
+    unfold_min_snr_db: float = 30.0
+    unfold_margin_db: float = 0.45
+    max_speed_mps: float = MAX_RADIAL_SPEED_MPS
+    sidelobe_margin_db: float | None = 10.0
+
+    def __post_init__(self) -> None:
+        if self.detector not in DETECTORS:
+            raise ValueError(f"detector: must be one of {', '.join(DETECTORS)}, got "
+                             f"{self.detector!r}")
+        if not isinstance(self.paper_threshold_db, int | float) or not \
+                0.0 <= self.paper_threshold_db <= 200.0:
+            raise ValueError(f"threshold_db: must be a number of dB in [0, 200], got "
+                             f"{self.paper_threshold_db!r}")
+        if not isinstance(self.max_speed_mps, int | float) or not \
+                0.0 < self.max_speed_mps <= 3.0e4:
+            raise ValueError(f"max_speed_mps: must be in (0, 30000] m/s, got "
+                             f"{self.max_speed_mps!r}")
+
+    def check(self, cfg: RadarConfig) -> None:
+        """ValueError when the settings do not fit ``cfg`` (CFAR window larger than the
+        range-Doppler map)."""
+        if self.detector != "paper":
+            check_window(self.cfar, (cfg.n_range, cfg.n_doppler))

@@ -1,0 +1,141 @@
+"""Detected cells -> point cloud: the one path both the cube (``host.pipeline``) and the
+FPGA's records (``host.record_points``) take (``host.pipeline`` module docstring, steps 3 to
+5), vectorised over the cells.
+
+1. TDM velocity unfolding (``host.tdm``): the angle-spectrum peak of each cell compensated
+   for each alias class that holds one of its velocity hypotheses (``host.angle.
+   peak_powers``), then the decision of every cell (``host.tdm.choose_folds``).
+2. Angles (``host.angle.estimate_angles``) of each cell's vector compensated for its chosen
+   alias order; the chosen class's peak is the first component's.
+3. One point per angle component (:func:`cloud`): range corrected for range-Doppler
+   coupling, x/y, velocity, power, coherent SNR and an RCS estimate from the radar equation
+   with the window's scalloping and coherent gain undone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from host.angle import estimate_angles, peak_powers
+from host.cells import Cells
+from host.params import DetectionParams
+from host.pointcloud import PointCloud
+from host.tdm import choose_folds, hypothesis_classes, tx_phasors
+from model.config import RadarConfig, dbm_to_w
+from model.reference import signed_bins
+from model.simulate import rx_gain, tx_gain
+
+
+def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
+                      frame: int = 0) -> PointCloud:
+    """Point cloud of detected cells (module docstring); ``frame`` is the points' frame
+    index. ValueError when the snapshots do not have ``cfg``'s virtual channels."""
+    n = len(cells)
+    if not n:
+        return PointCloud.empty()
+    nd, nv, ntx = cfg.n_doppler, cfg.n_virtual, cfg.num_tx
+    x = np.ascontiguousarray(cells.snapshot, dtype=np.complex128)
+    if x.shape != (n, nv):
+        raise ValueError(f"cells: snapshots {x.shape}, expected ({n}, {nv}) for {cfg.name}")
+    noise = np.asarray(cells.noise, dtype=float)
+    sb = signed_bins(nd)[np.asarray(cells.doppler_bin)].astype(np.int64)
+    snr_db = cell_snr_db(np.asarray(cells.power, dtype=float), noise, nv)
+    measured = (sb + cells.offsets[:, 1]) * cfg.velocity_bin_mps
+    first_sin = None
+    if ntx > 1 and params.unfold_velocity:
+        # (cell, class) pairs of the classes that hold a hypothesis: only these enter the
+        # decision; the others' power stays 0 (choose_folds masks them)
+        ci, cc = np.nonzero(hypothesis_classes(cfg, measured, params.max_speed_mps))
+        pw, sn = peak_powers(x, params.angle.n_fft, tx_phasors(cfg, sb[ci] + cc * nd), ci)
+        class_power = np.zeros((n, ntx))
+        class_power[ci, cc] = pw
+        pair = np.full((n, ntx), -1, np.int64)
+        pair[ci, cc] = np.arange(len(ci))
+        fold, ambiguous = choose_folds(class_power, cfg, measured, snr_db, params)
+        # the fold's class always holds a hypothesis: its peak was computed
+        first_sin = sn[pair[np.arange(n), fold % ntx]]
+    else:
+        fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, snr_db, params)
+    k = sb + fold * nd
+    ang = estimate_angles(x, noise / nv, params.angle, tx_phasors(cfg, k), first_sin)
+    return cloud(cfg, params, np.asarray(cells.range_bin), cells.offsets, k, ambiguous,
+                 ang.cell, ang.azimuth_deg, ang.amplitude, ang.snr_db, frame)
+
+
+def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndarray:
+    """SNR of detected cells over the coherent sum of their channels, dB, float (n,):
+    (power - noise) / noise of the non-coherent map (power, noise float (n,)) plus the
+    coherent gain 10 log10(n_virtual); a zero noise estimate (noiseless input: every
+    training cell 0) counts as 1e-30, as the angle estimator's noise floor."""
+    noise = np.maximum(noise, 1e-30)
+    return 10 * np.log10(np.maximum(power - noise, 1e-30) / noise) + 10 * np.log10(n_virtual)
+
+
+def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.ndarray,
+          k: np.ndarray, ambiguous: np.ndarray, cell: np.ndarray, az: np.ndarray,
+          amplitude: np.ndarray, snr_db: np.ndarray, frame: int) -> PointCloud:
+    """Step 3 of the module docstring, one point per angle component: range (Doppler
+    coupling removed), velocity of the unfolded bin ``k``, power and RCS (window
+    scalloping and coherent gain undone).
+
+    Per cell (n,): r range bin, k unfolded signed Doppler bin, ambiguous flag; offsets
+    float (n, 2) bins. Per component (m,): ``cell`` its cell index, ``az`` deg,
+    ``amplitude`` complex (LSB), ``snr_db``."""
+    nr, nd = cfg.n_range, cfg.n_doppler
+    dr, dd = offsets[:, 0], offsets[:, 1]
+    velocity = (k + dd) * cfg.velocity_bin_mps
+    # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
+    coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
+    range_m = (r + dr - coupling) * cfg.range_bin_m
+    scallop = _window_response(nr, dr, params.range_window) * _window_response(
+        nd, dd, params.doppler_window)
+    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
+    amp = np.abs(amplitude)
+    amp_adc = amp / (cg * scallop[cell])
+    rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
+    return PointCloud.from_polar(
+        range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr_db,
+        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
+
+
+def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:
+    """The real factor of the Dirichlet kernel D(y) = sum_{t<n} exp(-j 2 pi y t / n) =
+    exp(-j pi y (n - 1) / n) sin(pi y) / sin(pi y / n), float like y (|y| < n; n at y = 0);
+    sin_pi_y: sin(pi y), given (callers share it)."""
+    den = np.sin(np.pi * y / n)
+    small = np.abs(den) < 1e-12
+    return np.where(small, n, sin_pi_y / np.where(small, 1.0, den))
+
+
+def _window_response(n: int, offset: np.ndarray | float, windowed: bool) -> np.ndarray:
+    """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
+    a bin centre, float (m,) or scalar; W is the DFT of the periodic Hann window
+    (``model.reference.hann_periodic``: 0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the
+    Dirichlet kernel D) or of the rectangular one (D). The three kernels share their phase
+    up to exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
+    |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
+    R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
+    x = np.asarray(offset, dtype=float)
+    s = np.sin(np.pi * x)
+    r0 = _dirichlet_ratio(x, n, s)
+    if not windowed:
+        return np.abs(r0) / n
+    rm = _dirichlet_ratio(x - 1, n, -s)
+    rp = _dirichlet_ratio(x + 1, n, -s)
+    phi = np.pi * (n - 1) / n
+    re = 0.5 * r0 - 0.25 * np.cos(phi) * (rm + rp)
+    im = 0.25 * np.sin(phi) * (rp - rm)
+    return np.hypot(re, im) / (n / 2)
+
+
+def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.ndarray,
+                      azimuth_deg: np.ndarray, beamforming: bool) -> np.ndarray:
+    """Radar-equation inverse: RCS (dBsm) from the ADC-referred tone amplitude (LSB)."""
+    pr = (np.asarray(amplitude_adc) / cfg.adc_full_scale) ** 2 * dbm_to_w(cfg.adc_full_scale_dbm)
+    lam = cfg.wavelength_m
+    g = dbm_to_w(cfg.tx_power_dbm) * tx_gain(cfg, azimuth_deg, beamforming) \
+        * rx_gain(cfg, azimuth_deg) * lam**2
+    loss = 10 ** (cfg.system_loss_db / 10)
+    with np.errstate(divide="ignore"):
+        sigma = pr * (4 * np.pi) ** 3 * np.asarray(range_m) ** 4 * loss / np.maximum(g, 1e-30)
+        return 10 * np.log10(np.maximum(sigma, 1e-30))
