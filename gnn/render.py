@@ -3,14 +3,11 @@
 ``render_points`` runs ``model.simulate`` and the host detection chain
 (``host.pipeline.process_frame``, ``full`` preset), so the network sees exactly what our radar
 produces (the shipped dataset and checkpoint use it). :func:`stand_in_points`
-(``backend="stand-in"``, also what ``"auto"`` falls back to without ``host/pipeline.py``) maps
-scatterers to points through the model's radar equation and resolution cells instead, about
-500x faster: the unit tests use it.
+(``backend="stand-in"``) maps scatterers to points through the model's radar equation and
+resolution cells instead, about 500x faster: the unit tests use it.
 """
 
 from __future__ import annotations
-
-import importlib.util
 
 import numpy as np
 
@@ -28,25 +25,20 @@ STAND_IN_WINDOW_LOSS_DB = 3.5
 """Stand-in processing loss of the two Hann windows (range and Doppler), dB."""
 
 
-def pipeline_available() -> bool:
-    """True when the host detection chain ``host.pipeline`` can be imported."""
-    return importlib.util.find_spec("host.pipeline") is not None
-
-
 def resolve_backend(backend: str) -> str:
-    """``auto`` -> ``pipeline`` if the host chain exists, else ``stand-in``."""
+    """``auto`` -> ``pipeline`` (the host chain); the others as given."""
     if backend not in BACKENDS:
         raise ValueError(f"backend: unknown backend {backend!r}; choose one of "
                          f"{', '.join(BACKENDS)}")
     if backend == "auto":
-        return "pipeline" if pipeline_available() else "stand-in"
+        return "pipeline"
     return backend
 
 
 def render_points(scene: Scene, backend: str = "auto", frame_index: int = 0) -> PointCloud:
     """Point cloud of ``scene`` as our radar sees it (see the module docstring)."""
     if resolve_backend(backend) == "pipeline":
-        from host.pipeline import process_frame  # optional until host.pipeline exists
+        from host.pipeline import process_frame
 
         adc = simulate_scene(scene, frame_index).samples
         return process_frame(adc, scene.config)

@@ -118,9 +118,3 @@ def adc_frame_to_stream(adc: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     sof = np.zeros(n, bool)
     sof[0] = True
     return words, tlast, sof
-
-
-def memory_bits(num_rx: int, n_range: int, data_w: int = 16) -> int:
-    """Ping-pong RAM bits (two banks of 2^ceil(log2 n_range) words)."""
-    depth = 1 << max(1, (n_range - 1).bit_length())
-    return 2 * depth * num_rx * 2 * data_w

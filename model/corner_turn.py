@@ -58,12 +58,6 @@ def _permute(x: np.ndarray, perm: np.ndarray) -> np.ndarray:
     return out
 
 
-def output_tlast(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
-    """bool ``(frame_words,)``: TLAST of each output word (last word of each Doppler vector)."""
-    j = np.arange(num_tx * n_range * n_doppler)
-    return (j % n_doppler) == n_doppler - 1
-
-
 def address_bits(num_tx: int, n_range: int, n_doppler: int) -> tuple[int, int]:
     """(B, ROT): address bits of one frame and the per-frame rotation of the in-place scheme."""
     bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
@@ -132,10 +126,3 @@ def frame_period(num_tx: int, n_range: int, n_doppler: int, read_order: int = 0)
     while not np.array_equal(perm, np.arange(b)):
         perm, k = s[perm], k + 1
     return k
-
-
-def memory_bits(num_tx: int, num_rx: int, n_range: int, n_doppler: int, data_w: int = 16,
-                in_place: bool = True) -> int:
-    """Frame-buffer bits: one frame in place, two for the paper's double buffer."""
-    words = num_tx * n_range * n_doppler
-    return words * num_rx * 2 * data_w * (1 if in_place else 2)

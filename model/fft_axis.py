@@ -403,31 +403,3 @@ def sqnr_db(y: np.ndarray, ref: np.ndarray) -> float:
     """Signal to quantization noise ratio in dB of ``y`` against ``ref`` (same shape)."""
     err = np.sum(np.abs(y - ref) ** 2)
     return float(10 * np.log10(np.sum(np.abs(ref) ** 2) / max(err, 1e-300)))
-
-
-def pack_words(x: np.ndarray, data_w: int = 16) -> np.ndarray:
-    """complex (beats, lanes) integer I/Q -> Python-int-ready uint64 words per lane
-    ``{Q, I}`` (I in the low half), object array (beats,) of the full multi-lane words."""
-    mask = (1 << data_w) - 1
-    re = np.real(x).astype(np.int64) & mask
-    im = np.imag(x).astype(np.int64) & mask
-    lane = (im << data_w) | re
-    out = np.zeros(lane.shape[0], dtype=object)
-    for c in range(lane.shape[1]):
-        out = out + (lane[:, c].astype(object) << (2 * data_w * c))
-    return out
-
-
-def unpack_words(words: np.ndarray, lanes: int, data_w: int = 16) -> np.ndarray:
-    """Inverse of :func:`pack_words`: (beats,) ints -> complex128 (beats, lanes)."""
-    mask = (1 << data_w) - 1
-    out = np.zeros((len(words), lanes), dtype=np.complex128)
-    for c in range(lanes):
-        lane = np.array([(int(v) >> (2 * data_w * c)) & ((1 << 2 * data_w) - 1) for v in words],
-                        dtype=np.int64)
-        re = lane & mask
-        im = (lane >> data_w) & mask
-        re = np.where(re >= 1 << (data_w - 1), re - (1 << data_w), re)
-        im = np.where(im >= 1 << (data_w - 1), im - (1 << data_w), im)
-        out[:, c] = re + 1j * im
-    return out

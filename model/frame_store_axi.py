@@ -25,7 +25,6 @@ each group leaves as its Doppler vectors, (r, t, d) inside the group.
 
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -212,11 +211,6 @@ def interleaved_trace(g: StoreGeometry, n_frames: int) -> list[tuple[int, int, s
         tagged += [(p, 1, int(a), int(b), READ) for p, (a, b) in zip(rpos, r, strict=True)]
         out += [(a, b, kind) for _, _, a, b, kind in sorted(tagged)]
     return out
-
-
-def burst_histogram(trace: list[tuple[int, int, str]]) -> dict[tuple[str, int], int]:
-    """Bursts per (direction, beats)."""
-    return dict(Counter((kind, beats) for _, beats, kind in trace))
 
 
 # ---- DRAM page model ---------------------------------------------------------------------------

@@ -47,17 +47,3 @@ def nci(words: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
     i, q = lane_iq(w, data_w)
     p = (i * i + q * q).reshape(n_range, num_tx, n_doppler, num_rx)
     return p.sum(axis=(1, 3))
-
-
-def cube_to_words(cube: np.ndarray, data_w: int = 16) -> np.ndarray:
-    """Doppler-FFT cube -> mode-1 input words.
-
-    cube: integer-valued complex ``(num_tx, n_range, n_doppler, num_rx)`` (the mode-0 order of
-    ``model.axis_packetizer.cube_to_payload``). Returns uint64 ``(n_range * num_tx * n_doppler,
-    num_rx)`` packed ``{Q, I}`` lanes in (r, t, d) order.
-    """
-    c = np.asarray(cube).transpose(1, 0, 2, 3)
-    mask = (1 << data_w) - 1
-    i = np.real(c).astype(np.int64) & mask
-    q = np.imag(c).astype(np.int64) & mask
-    return ((q << data_w) | i).astype(np.uint64).reshape(-1, c.shape[-1])

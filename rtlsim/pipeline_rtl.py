@@ -1,9 +1,14 @@
-"""ADC frames through the Verilated ``radar_pipeline`` from ordinary Python (the RTL frame
-source of ``radar detect --backend rtl``).
+"""ADC frames through the Verilated ``radar_pipeline`` from ordinary Python, driven by cocotb
+(:mod:`rtlsim.pipeline_test`, :class:`rtlsim.pipeline.PipelineTB`), and the top's RTL file
+list :data:`PIPELINE_SOURCES`.
 
-The model is built once per parameter set under ``sim_build/radar_pipeline/`` (the first
-run compiles for a minute or two), then the frames stream through it back to back at one
-sample per clock and the DMA packets come back as bytes, exactly as the board sends them.
+``radar detect --backend rtl`` runs the faster C++ harness (:mod:`rtlsim.harness`);
+:func:`run_pipeline_rtl` is the cocotb path the harness is checked against
+(``tb/radar_pipeline/test_harness.py``: identical DMA bytes and counters) and timed against
+(``tb/radar_pipeline/bench_harness.py``). The model is built once per parameter set under
+``sim_build/radar_pipeline/`` (the first run compiles for a minute or two), then the frames
+stream through it back to back at one sample per clock and the DMA packets come back as
+bytes, exactly as the board sends them.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from model.radar_pipeline import PipelineParams
 from rtlsim.toolchain import build_and_test, rtl_sources
 
 PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "detect/*.sv", "top/*.sv")
+"""Globs (under ``rtl/``) of the files the ``radar_pipeline`` top elaborates."""
 
 
 def _cfar_scale(cfg: RadarConfig, chain: PipelineParams) -> int:

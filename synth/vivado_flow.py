@@ -1,6 +1,6 @@
 """Vivado flow driver: every job of a set through ``synth/vivado/run.tcl``, one at a time.
 
-Same job sets and HDL parameters as the Yosys estimate (:func:`synth.yosys_estimate.job_sets`):
+Same job sets and HDL parameters as the Yosys estimate (:func:`synth.jobs.job_sets`):
 the blocks and the ``radar_pipeline`` top of ``paper-fpga`` (FRAME_STORE = 0, on-chip corner
 turn) and of ``full`` (FRAME_STORE = 1, 512-bit m_axi_mem). Each job gets a generated script
 ``OUT/<set>/<block>/job.tcl`` (:func:`job_tcl`: top, HDL parameters and the file list the top
@@ -23,7 +23,7 @@ import sys
 import time
 from pathlib import Path
 
-from synth.yosys_estimate import PAPER_TABLE_II, ROOT, TOP_FILE, Job, files_for, job_sets, rtl_files
+from synth.jobs import PAPER_TABLE_II, ROOT, TOP_FILE, Job, files_for, job_sets, rtl_files
 
 TCL = ROOT / "synth" / "vivado" / "run.tcl"
 INSTALL_HINT = ("vivado is not on PATH: install AMD Vivado ML (the free Standard edition "
@@ -60,7 +60,7 @@ def _tcl_list(items: list[str]) -> str:
 def job_tcl(job: Job, out_dir: Path, impl: bool, files: list[Path] | None = None) -> str:
     """The Vivado script of one job: sets ``top``, ``out_dir``, ``impl``, ``generics``
     (NAME=VALUE per HDL parameter), ``pkgs`` and ``mods`` (absolute paths of the files the top
-    elaborates, :func:`synth.yosys_estimate.files_for`, packages first) and sources
+    elaborates, :func:`synth.jobs.files_for`, packages first) and sources
     ``synth/vivado/run.tcl``."""
     files = files_for(job.top, rtl_files()) if files is None else files
     pkgs = [str(p) for p in files if p.stem.endswith("_pkg")]

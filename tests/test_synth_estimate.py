@@ -14,21 +14,11 @@ from pathlib import Path
 import pytest
 
 from model.config import FULL_AXI_DATA_W
+from synth.jobs import RTL, Job, files_for, job_sets, rtl_files
 from synth.vivado_flow import TCL, job_tcl, parse_utilization
-from synth.yosys_estimate import (
-    RTL,
-    XCZU7EV,
-    Job,
-    Result,
-    _wait,
-    capacity_table,
-    files_for,
-    job_sets,
-    main,
-    markdown,
-    merge_reports,
-    rtl_files,
-)
+from synth.yosys_estimate import main
+from synth.yosys_report import XCZU7EV, Result, capacity_table, markdown, merge_reports
+from synth.yosys_run import _wait
 
 
 def _code(path: Path) -> str:

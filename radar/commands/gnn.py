@@ -44,7 +44,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--test", type=int, default=200, help="held-out test frames (default 200)")
     p.add_argument("--backend", default="auto", choices=("auto", "pipeline", "stand-in"),
                    help="scene -> points: host chain (pipeline) or the model stand-in; "
-                   "auto = pipeline when host.pipeline exists")
+                   "auto = pipeline")
     p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
     p.add_argument("--radarscenes", default=None, metavar="SEQ_DIR",
                    help="instead: convert one RadarScenes sequence folder (radar_data.h5 + "
