@@ -140,3 +140,35 @@ def test_paper_detector_runs():
 def test_cube_shape_checked():
     with pytest.raises(ValueError, match="expected shape"):
         process_cube(np.zeros((2, 2, 2), complex), get_preset("full"))
+
+
+@pytest.mark.parametrize("preset", ["full", "paper-fpga"])
+def test_cube_path_is_the_one_it_replaced(preset):
+    """Issue 28 (one path from cells to points): the cube path now runs the records path's
+    code (``host.points``); on Table I (three noise seeds), random scenes and other settings
+    its clouds are those of the numpy path the cube took before
+    (``tests.oracles.points.process_cube_reference``): integer and flag fields exactly,
+    floats within 1e-9."""
+    from dataclasses import fields
+
+    from tests.oracles.points import process_cube_reference
+    from tests.scenes import random_scene
+    scenes = [table1_scene(preset, seed=s) for s in (1, 2, 3)]
+    scenes += [random_scene(preset, s) for s in range(4 if preset == "full" else 12)]
+    settings = (DetectionParams(), DetectionParams(max_speed_mps=30.0, detector="os"),
+                DetectionParams(unfold_velocity=False, sidelobe_margin_db=None))
+    compared = 0
+    for i, scene in enumerate(scenes):
+        cube = radar_cube(simulate_scene(scene).samples, scene.config)
+        params = settings[i % len(settings)]
+        new, old = process_cube(cube, scene.config, params), process_cube_reference(
+            cube, scene.config, params)
+        assert len(new) == len(old)
+        compared += len(new)
+        for f in fields(new):
+            a, b = getattr(new, f.name), getattr(old, f.name)
+            if a.dtype.kind in "fc":
+                np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9, err_msg=f.name)
+            else:
+                np.testing.assert_array_equal(a, b, err_msg=f.name)
+    assert compared > len(scenes)
