@@ -22,6 +22,7 @@ from model.radar_pipeline import dma_packets, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
+from tests.oracles.chain import run_chain_reference
 
 
 def best_of(fn: Callable[[], object], repeat: int, clock=time.perf_counter) -> float:
@@ -45,7 +46,7 @@ def main() -> None:
     for preset in ("paper-fpga", "full"):
         cfg = get_preset(preset)
         adc = simulate_scene(table1_scene(preset, seed=1)).samples
-        t_ref = best_of(lambda a=adc, c=cfg: run_chain(a, c, reference=True), 1)
+        t_ref = best_of(lambda a=adc, c=cfg: run_chain_reference(a, c), 1)
         t_fast = best_of(lambda a=adc, c=cfg: run_chain(a, c), args.repeat)
         cpu_fast = best_of(lambda a=adc, c=cfg: run_chain(a, c), args.repeat,
                            time.process_time)

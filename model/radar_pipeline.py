@@ -37,7 +37,7 @@ from model.cfar_2d import pack_scale
 from model.config import RadarConfig, hdl_parameters
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
-from model.fft_axis import fft_fixed_planar, fft_fixed_reference, from_planar, to_planar
+from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
 
 RANGE_SCALE_SCH = 0xFFF
@@ -188,17 +188,22 @@ class ChainOutput:
         return self.payload.transpose(0, 3, 1, 2).reshape(num_tx * num_rx, n_range, n_doppler)
 
 
-def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None,
-              reference: bool = False) -> ChainOutput:
+def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
+              ) -> ChainOutput:
     """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube (and, in
-    mode 1, the record stream of the frame as the first after reset).
-
-    ``reference``: use the stage-by-stage int64 FFT (``fft_fixed_reference``, slow) instead
-    of the fast path; the results are identical (checked by tests/test_model_fast.py).
-    """
+    mode 1, the record stream of the frame as the first after reset). The FFTs run on planar
+    I/Q (``model.fft_axis.fft_fixed_planar``); the stage-by-stage int64 FFT gives the same
+    words (the oracle chain of tests/oracles/chain.py, tests/test_model_fast.py)."""
     params = params or PipelineParams()
     params.check_mode(cfg)
-    dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params, reference)
+    return chain_output(*_doppler_out(adc, cfg, params), cfg, params)
+
+
+def chain_output(dop: np.ndarray, rng_ov: int, dop_ov: int, cfg: RadarConfig,
+                 params: PipelineParams) -> ChainOutput:
+    """The :class:`ChainOutput` of the Doppler-FFT output words ``dop`` (integer-valued
+    complex (frame words, num_rx) in the corner turn's read order) and the FFTs' overflow
+    beats: the cube, and in mode 1 the frame's detection records."""
     if params.output_mode == 0:
         return ChainOutput(dop.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx),
                            rng_ov, dop_ov)
@@ -208,28 +213,20 @@ def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None =
     return ChainOutput(payload.transpose(1, 0, 2, 3), rng_ov, dop_ov, records)
 
 
-def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams, reference: bool
+def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams
                  ) -> tuple[np.ndarray, int, int]:
     """Doppler-FFT output words, integer-valued complex ``(frame words, num_rx)`` in the
     corner turn's read order (mode 0: (t, r, d); mode 1: (r, t, d)), and the overflow beats
     of the range and Doppler FFTs."""
     cfg.check_adc(adc)
     order = params.output_mode
-    if reference:
-        rng = fft_fixed_reference(np.transpose(adc, (0, 2, 1)), window=params.window,
-                                  scale_sch=params.range_scale_sch)
-        words = rng.y.reshape(-1, cfg.num_rx)                   # chirp-major input order
-        turned = _turn(words, cfg, params)
-        dop = fft_fixed_reference(turned.reshape(-1, cfg.n_doppler, cfg.num_rx),
-                                  window=params.window, scale_sch=params.doppler_scale_sch)
-        return dop.y.reshape(-1, cfg.num_rx), int(rng.overflow.sum()), int(dop.overflow.sum())
     # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values
     planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_range, rx, 2)
     rng_p, rng_ov = fft_fixed_planar(planar, window=params.window,
                                      scale_sch=params.range_scale_sch)
     if params.frame_store:     # through the external layout's bursts and strip buffer
         words = from_planar(rng_p).reshape(-1, cfg.num_rx)
-        turned = to_planar(_turn(words, cfg, params)).astype(rng_p.dtype)
+        turned = to_planar(turn(words, cfg, params)).astype(rng_p.dtype)
     else:
         turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
                              cfg.n_doppler, read_order=order)
@@ -238,7 +235,7 @@ def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams, refe
     return from_planar(dop_p).reshape(-1, cfg.num_rx), int(rng_ov.sum()), int(dop_ov.sum())
 
 
-def _turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndarray:
+def turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndarray:
     """Range-FFT words complex (num_tx * n_doppler * n_range, num_rx), chirp-major input
     order -> Doppler-vector order ((t, r, d) in mode 0, (r, t, d) in mode 1), through the
     on-chip corner turn or, with ``params.frame_store``, through the external store's bursts
@@ -269,7 +266,7 @@ def record_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
     if params.output_mode != 1:
         raise ValueError("record_frames needs output_mode=1")
     params.check(cfg)
-    words = (pack_iq(_doppler_out(adc, cfg, params, False)[0]) for adc in adc_frames)
+    words = (pack_iq(_doppler_out(adc, cfg, params)[0]) for adc in adc_frames)
     return detect_stream(words, params.detect_config(cfg), first_frame_id=first_frame_id)
 
 
@@ -308,7 +305,7 @@ def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
     if params.output_mode == 1:
         def words():                    # one frame's Doppler output at a time
             for adc in adc_frames:
-                dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params, False)
+                dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params)
                 overflow.append((rng_ov, dop_ov))
                 yield pack_iq(dop)
         payloads = detect_stream(words(), params.detect_config(cfg),

@@ -21,6 +21,7 @@ from model.radar_pipeline import (
 )
 from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_frame, simulate_scene
+from tests.oracles.chain import run_chain_reference
 
 SMALL4 = RadarConfig(name="small4", num_tx=4, num_rx=4, n_range=32, n_doppler=32,
                      sample_rate_hz=10e6, chirp_period_s=4e-6, design_max_range_m=50.0)
@@ -77,7 +78,7 @@ def test_small4_records_are_the_detector_on_the_cube() -> None:
 def test_reference_path_equals_fast_path_in_mode1() -> None:
     adc = small4_frames(1)[0]
     p1 = PipelineParams(packet_words=256, output_mode=1, detect=small4_detect())
-    a, b = run_chain(adc, SMALL4, p1), run_chain(adc, SMALL4, p1, reference=True)
+    a, b = run_chain(adc, SMALL4, p1), run_chain_reference(adc, SMALL4, p1)
     np.testing.assert_array_equal(a.records, b.records)
 
 
