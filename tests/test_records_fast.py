@@ -52,7 +52,6 @@ from host.records import (
     inside_map,
     outside_map,
     record_arrays,
-    record_arrays_reference,
 )
 from model import cfar_2d as cm
 from model.axis_packetizer import packetize_stream, words_to_bytes
@@ -60,7 +59,6 @@ from model.config import get_preset
 from model.detect_records import (
     TAG_RECORD,
     decode_frame,
-    decode_frame_reference,
     encode_frame,
     record_words,
 )
@@ -68,6 +66,7 @@ from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.reference import radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
+from tests.oracles.records import decode_frame_reference, record_arrays_reference
 
 
 def _same_records(a: list, b: list) -> None:
@@ -76,6 +75,7 @@ def _same_records(a: list, b: list) -> None:
         assert (x.range_bin, x.doppler_bin, x.power, x.noise_sum, x.cells, x.index,
                 x.frame_id) == (y.range_bin, y.doppler_bin, y.power, y.noise_sum, y.cells,
                                 y.index, y.frame_id)
+        assert x.neighbours == y.neighbours
         assert x.snapshot.dtype == y.snapshot.dtype
         np.testing.assert_array_equal(x.snapshot, y.snapshot)
 
@@ -85,6 +85,10 @@ def _same_arrays(a: RecordArrays, b: RecordArrays) -> None:
         x, y = getattr(a, name), getattr(b, name)
         assert x.dtype == y.dtype and x.shape == y.shape, name
         np.testing.assert_array_equal(x, y, err_msg=name)
+    assert (a.neighbours is None) == (b.neighbours is None)
+    if a.neighbours is not None:
+        assert a.neighbours.dtype == b.neighbours.dtype
+        np.testing.assert_array_equal(a.neighbours, b.neighbours)
 
 
 def _same_decode(words: np.ndarray, num_tx: int) -> None:
@@ -103,7 +107,9 @@ def _same_decode(words: np.ndarray, num_tx: int) -> None:
         _same_records([lst[-1]], b.records[-1:])
     nv = words.shape[1] * num_tx
     for gain in (1.0, 37.0):
-        _same_arrays(record_arrays(lst, nv, gain), record_arrays_reference(b.records, nv, gain))
+        ref = record_arrays_reference(b.records, nv, gain)
+        _same_arrays(record_arrays(lst, nv, gain), ref)
+        _same_arrays(record_arrays(b.records, nv, gain), ref)     # from Record objects
         _same_arrays(record_arrays(lst[:cut], nv, gain),
                      record_arrays_reference(b.records[:cut], nv, gain))
 
