@@ -65,6 +65,7 @@ from model.radar_pipeline import PipelineParams, chain_gain, run_chain
 from model.scene import Scene, table1_scene
 from model.simulate import simulate_scene, thermal_noise
 from tests.oracles.points import process_cube_reference, process_records_reference
+from tests.oracles.records import RecordDecoderReference, record_arrays_reference
 from tests.scenes import random_scene, synthetic_records
 
 FRAME_RATE_HZ = 111.0
@@ -241,9 +242,11 @@ def _decoded(packets: list[bytes], cfg: RadarConfig, dcfg: DetectConfig, gain: f
              reference: bool = False) -> RecordArrays:
     """The record arrays the host decoder makes of a frame's payloads (DMA bytes); gain:
     the chain's (``model.radar_pipeline.chain_gain``)."""
-    dec = RecordDecoder(dcfg, UDP_PACKET_WORDS[cfg.name], reference=reference)
+    dec = (RecordDecoderReference if reference else RecordDecoder)(dcfg,
+                                                                   UDP_PACKET_WORDS[cfg.name])
     got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
-    return record_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
+    to_arrays = record_arrays_reference if reference else record_arrays
+    return to_arrays(got[0].records[:got[0].usable_records], cfg.n_virtual, gain)
 
 
 def _frame_arrays(cfg: RadarConfig, n: int, varied: bool, params: DetectionParams

@@ -1,15 +1,15 @@
-"""Decoding of the FPGA's detection-record stream (``OUTPUT_MODE = 1``, DESIGN 3.4).
+"""Decoding of the FPGA's detection-record stream (``OUTPUT_MODE = 1``, docs/detect.md).
 
 The record layout is defined once, in ``model.detect_records`` (docs/detect.md): per frame
 ``record 0 .. record n-1, trailer, zero words`` up to a fixed ``frame_words``, cut into
 packets by the unchanged packetizer. This module reuses both: :class:`RecordDecoder` is the
 packet framing of :class:`host.stream.PacketDecoder` (lost, repeated, truncated, reordered
-packets reported, never raised) with ``model.detect_records.decode_frame`` on each frame's
-payload. A frame with a lost packet is *damaged* (``complete`` False); the records that
+packets reported, never raised) with the layout's decoding on each frame's payload. A frame with a lost packet is *damaged* (``complete`` False); the records that
 arrived intact before the first missing word are still offered (``usable_records``).
 
 The decoder reads a frame's records straight into arrays (:func:`decode_record_fields`, the
-same fields as ``model.detect_records.decode_frame``, no per-record Python object);
+same fields as ``model.detect_records.decode_frame``, unpacked by the layout's field table
+``model.detect_records.unpack_records``, no per-record Python object);
 ``DetectionFrame.records`` is a :class:`RecordList` over them that builds a
 ``model.detect_records.Record`` only when one is looked at. :func:`record_arrays` turns a
 frame's records into the arrays the host processing needs (``host.record_points``); on a
@@ -30,14 +30,14 @@ from model.axis_packetizer import unpack_iq
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.detect_records import (
-    HDR_LANES,
+    RECORD_FIELDS,
     Record,
     Trailer,
-    decode_frame,
     frame_end,
-    neighbour_powers,
     record_scan,
     record_words,
+    records_of,
+    unpack_records,
 )
 
 DEFAULT_MAX_DETECTIONS = 256
@@ -63,7 +63,8 @@ def fpga_detect_config(cfg: RadarConfig, cfar: CfarParams, kind: str = "ca",
 @dataclass(frozen=True)
 class RecordFields:
     """The fields of n records as arrays (``model.detect_records.Record``'s, record k in
-    row k): ``range_bin``, ``doppler_bin``, ``cells``, ``index``, ``frame_id``: int64 (n,);
+    row k; the header fields as ``model.detect_records.unpack_headers`` gives them):
+    ``range_bin``, ``doppler_bin``, ``cells``, ``index``, ``frame_id``: int64 (n,);
     ``power``, ``noise_sum``: uint64 (n,) (the 64-bit header fields); ``snapshot``: uint32
     (n, num_tx, num_rx) packed {Q, I}; ``neighbours``: uint64 (n, 4) the neighbour powers
     (range - 1, range + 1, Doppler - 1, Doppler + 1)."""
@@ -85,6 +86,23 @@ class RecordFields:
         """Rows ``sl`` (views)."""
         return RecordFields(*(getattr(self, f)[sl] for f in self.__dataclass_fields__))
 
+    def header(self) -> dict[str, np.ndarray]:
+        """The header fields by name (``model.detect_records.RECORD_FIELDS``)."""
+        return {f.name: getattr(self, f.name) for f in RECORD_FIELDS}
+
+    @classmethod
+    def of_records(cls, records: Sequence[Record], n_virtual: int) -> RecordFields:
+        """The fields of ``Record`` objects (snapshots (num_tx, num_rx) each; no records:
+        snapshot (0, 1, n_virtual))."""
+        n = len(records)
+        fields = {f.name: np.array([getattr(r, f.name) for r in records],
+                                   np.uint64 if f.width > 32 else np.int64
+                                   ).reshape((n, f.count) if f.count > 1 else n)
+                  for f in RECORD_FIELDS}
+        snap = (np.stack([np.asarray(r.snapshot, np.uint32) for r in records]) if n
+                else np.zeros((0, 1, n_virtual), np.uint32))
+        return cls(snapshot=snap, **fields)
+
     def noise(self) -> np.ndarray:
         """float64 (n,) the CFAR's noise estimates noise_sum / max(cells, 1), each the
         correctly rounded quotient as ``Record.noise`` (Python int / int) gives it."""
@@ -94,14 +112,6 @@ class RecordFields:
         for i in big:
             out[i] = int(self.noise_sum[i]) / int(cells[i])
         return out
-
-
-def empty_fields(num_tx: int, num_rx: int) -> RecordFields:
-    """:class:`RecordFields` of no record."""
-    z = np.zeros(0, np.int64)
-    u = np.zeros(0, np.uint64)
-    return RecordFields(z, z, u, u, z, z, z, np.zeros((0, num_tx, num_rx), np.uint32),
-                        np.zeros((0, 4), np.uint64))
 
 
 class RecordList(Sequence[Record]):
@@ -123,13 +133,9 @@ class RecordList(Sequence[Record]):
     def __getitem__(self, i: int | slice) -> Record | RecordList:
         if isinstance(i, slice):
             return RecordList(self.fields.take(i))
-        f = self.fields
-        i = range(len(f))[i]                   # IndexError, negative indices
-        return Record(range_bin=int(f.range_bin[i]), doppler_bin=int(f.doppler_bin[i]),
-                      power=int(f.power[i]), noise_sum=int(f.noise_sum[i]),
-                      cells=int(f.cells[i]), snapshot=f.snapshot[i], index=int(f.index[i]),
-                      frame_id=int(f.frame_id[i]),
-                      neighbours=tuple(int(v) for v in f.neighbours[i]))  # type: ignore[arg-type]
+        i = range(len(self.fields))[i]         # IndexError, negative indices
+        one = self.fields.take(slice(i, i + 1))
+        return records_of(one.header(), one.snapshot)[0]
 
     def __iter__(self) -> Iterator[Record]:
         return (self[i] for i in range(len(self)))
@@ -148,23 +154,9 @@ def decode_record_fields(words: np.ndarray, num_tx: int
     ``Record`` per detection. words: uint32 (n_words, num_rx), padding allowed; never
     raises on bad data."""
     w, pos, n, hw = record_scan(words, num_tx)
-    num_rx = w.shape[1]
-    rw = hw + num_tx
-    if n:
-        # all records are one (n, rw, num_rx) block: header lanes, then num_tx snapshot words
-        block = w[:n * rw].reshape(n, rw, num_rx)
-        lane = block[:, :hw].reshape(n, hw * num_rx)[:, :HDR_LANES].astype(np.int64)
-        u = lane.astype(np.uint64)
-        fields = RecordFields(
-            range_bin=(lane[:, 0] >> 12) & 0xFFF, doppler_bin=lane[:, 0] & 0xFFF,
-            power=u[:, 2] | (u[:, 3] << np.uint64(32)),
-            noise_sum=u[:, 4] | (u[:, 5] << np.uint64(32)),
-            cells=lane[:, 1] & 0xFFFF, index=lane[:, 1] >> 16, frame_id=lane[:, 6],
-            snapshot=block[:, hw:], neighbours=neighbour_powers(lane))
-    else:
-        fields = empty_fields(num_tx, num_rx)
+    header, snapshot = unpack_records(w, n, num_tx)
     tr, errors = frame_end(w, pos, n, hw)
-    return fields, tr, errors
+    return RecordFields(snapshot=snapshot, **header), tr, errors
 
 
 @dataclass
@@ -205,28 +197,24 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
     """DMA packets of the record stream -> :class:`DetectionFrame` per frame.
 
     ``dcfg``: the detector's configuration (lanes, TX, MAX_DETECTIONS fix the frame length);
-    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``;
-    ``reference``: decode into ``Record`` objects (``model.detect_records.decode_frame``, the
-    path :func:`decode_record_fields` replaced; the benchmark's old-vs-new timing).
+    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``.
     """
 
-    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2,
-                 reference: bool = False) -> None:
+    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2
+                 ) -> None:
         super().__init__(dcfg.num_rx, dcfg.frame_words, packet_words, reorder_window)
         self.dcfg = dcfg
-        self.reference = reference
+
+    def _decode(self, words: np.ndarray
+                ) -> tuple[Sequence[Record], Trailer | None, list[str], set[int]]:
+        """A frame's payload words -> (records, trailer, decoding errors, the frame ids the
+        records carry), the records read straight into arrays (:func:`decode_record_fields`)."""
+        fields, trailer, errors = decode_record_fields(words, self.dcfg.num_tx)
+        return RecordList(fields), trailer, errors, set(np.unique(fields.frame_id).tolist())
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
                     problems: list[str]) -> DetectionFrame:
-        records: Sequence[Record]
-        if self.reference:
-            dec = decode_frame(words, self.dcfg.num_tx)
-            records, trailer, dec_errors = dec.records, dec.trailer, dec.errors
-            frame_ids = {r.frame_id for r in records}
-        else:
-            fields, trailer, dec_errors = decode_record_fields(words, self.dcfg.num_tx)
-            records = RecordList(fields)
-            frame_ids = set(np.unique(fields.frame_id).tolist())
+        records, trailer, dec_errors, frame_ids = self._decode(words)
         rw = record_words(self.dcfg.num_tx, self.dcfg.num_rx)
         # leading records whose words all arrived (a lost packet zero-fills its words)
         bad = np.flatnonzero(~valid)
@@ -309,7 +297,7 @@ def record_arrays(records: Sequence[Record], n_virtual: int, gain: float = 1.0
     straight from its arrays (same values as from its ``Record`` objects: tests)."""
     if isinstance(records, RecordList):
         return fields_arrays(records.fields, n_virtual, gain)
-    return record_arrays_reference(records, n_virtual, gain)
+    return fields_arrays(RecordFields.of_records(records, n_virtual), n_virtual, gain)
 
 
 def fields_arrays(fields: RecordFields, n_virtual: int, gain: float = 1.0) -> RecordArrays:
@@ -324,22 +312,3 @@ def fields_arrays(fields: RecordFields, n_virtual: int, gain: float = 1.0) -> Re
                         fields.power.astype(np.float64) / g2, fields.noise() / g2,
                         (snap / gain).astype(np.complex64),
                         fields.neighbours.astype(np.float64) / g2)
-
-
-def record_arrays_reference(records: Sequence[Record], n_virtual: int, gain: float = 1.0
-                            ) -> RecordArrays:
-    """:func:`record_arrays` from ``Record`` objects (the implementation the array decode
-    replaced; benchmark and tests)."""
-    n = len(records)
-    rb = np.fromiter((r.range_bin for r in records), dtype=np.int64, count=n)
-    db = np.fromiter((r.doppler_bin for r in records), dtype=np.int64, count=n)
-    power = np.fromiter((r.power for r in records), dtype=np.float64, count=n)
-    noise = np.fromiter((r.noise for r in records), dtype=np.float64, count=n)
-    nb = np.array([r.neighbours for r in records], dtype=np.float64).reshape(n, 4)
-    if n:
-        snap = unpack_iq(np.stack([r.snapshot for r in records])).reshape(n, n_virtual)
-    else:
-        snap = np.zeros((0, n_virtual), np.complex64)
-    g2 = gain * gain
-    return RecordArrays(rb, db, power / g2, noise / g2, (snap / gain).astype(np.complex64),
-                        nb / g2)

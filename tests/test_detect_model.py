@@ -60,6 +60,36 @@ def test_blanked_rows_never_detect_or_train() -> None:
     assert (res.noise()[:13] == 1000).all()
 
 
+@pytest.mark.parametrize("table", [dr.RECORD_FIELDS, dr.TRAILER_FIELDS])
+def test_header_fields_are_disjoint_and_round_trip(table: tuple[dr.Field, ...]) -> None:
+    """No two fields of a header (tag included) share a bit; any values, cut to their
+    widths, come back from ``unpack_headers`` (and ``unpack_header``) of ``pack_headers``."""
+    used = np.zeros((dr.HDR_LANES, 32), bool)
+    for f in (dr.TAG, *table):
+        for j in range(f.count):
+            for b in range(f.lsb, f.lsb + f.width):
+                lane, bit = f.lane + j * f.span + b // 32, b % 32
+                assert not used[lane, bit], (f.name, lane, bit)
+                used[lane, bit] = True
+    rng = np.random.default_rng(5)
+    n = 20
+    values = {f.name: [int(v) for v in rng.integers(0, 2 ** 64, n * f.count, np.uint64)]
+              for f in table}
+    lanes = dr.pack_headers(dr.TAG_RECORD, table, {
+        f.name: ([values[f.name][i * f.count:(i + 1) * f.count] for i in range(n)]
+                 if f.count > 1 else values[f.name]) for f in table})
+    assert lanes.dtype == np.uint32 and lanes.shape == (n, dr.HDR_LANES)
+    assert (dr.tag_of(lanes, np.arange(n)) == dr.TAG_RECORD).all()
+    got = dr.unpack_headers(lanes, table)
+    for f in table:
+        want = [v & ((1 << f.width) - 1) for v in values[f.name]]
+        assert got[f.name].shape == ((n, f.count) if f.count > 1 else (n,))
+        assert got[f.name].dtype == (np.uint64 if f.width > 32 else np.int64)
+        assert got[f.name].reshape(-1).tolist() == want, f.name
+        one = dr.unpack_header(lanes[-1], table)[f.name]
+        assert one == (tuple(want[-f.count:]) if f.count > 1 else want[-1]), f.name
+
+
 def test_records_round_trip_and_truncation() -> None:
     cfg = dc.DetectConfig(num_tx=2, num_rx=4, n_range=8, n_doppler=8, guard=(0, 0),
                           train=(1, 1), max_detections=3, pfa=1e-2)

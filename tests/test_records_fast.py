@@ -28,7 +28,6 @@ from host.records import (
     inside_map,
     outside_map,
     record_arrays,
-    record_arrays_reference,
 )
 from host.tdm import choose_folds, hypothesis_classes
 from model import cfar_2d as cm
@@ -37,7 +36,6 @@ from model.config import get_preset
 from model.detect_records import (
     TAG_RECORD,
     decode_frame,
-    decode_frame_reference,
     encode_frame,
     record_words,
 )
@@ -62,6 +60,11 @@ from tests.oracles.points import (
     select_records_reference,
     velocity_hypotheses,
 )
+from tests.oracles.records import (
+    RecordDecoderReference,
+    decode_frame_reference,
+    record_arrays_reference,
+)
 from tests.scenes import random_scene, synthetic_records
 
 
@@ -71,6 +74,7 @@ def _same_records(a: list, b: list) -> None:
         assert (x.range_bin, x.doppler_bin, x.power, x.noise_sum, x.cells, x.index,
                 x.frame_id) == (y.range_bin, y.doppler_bin, y.power, y.noise_sum, y.cells,
                                 y.index, y.frame_id)
+        assert x.neighbours == y.neighbours
         assert x.snapshot.dtype == y.snapshot.dtype
         np.testing.assert_array_equal(x.snapshot, y.snapshot)
 
@@ -80,6 +84,10 @@ def _same_arrays(a: RecordArrays, b: RecordArrays) -> None:
         x, y = getattr(a, name), getattr(b, name)
         assert x.dtype == y.dtype and x.shape == y.shape, name
         np.testing.assert_array_equal(x, y, err_msg=name)
+    assert (a.neighbours is None) == (b.neighbours is None)
+    if a.neighbours is not None:
+        assert a.neighbours.dtype == b.neighbours.dtype
+        np.testing.assert_array_equal(a.neighbours, b.neighbours)
 
 
 def _same_decode(words: np.ndarray, num_tx: int) -> None:
@@ -98,7 +106,9 @@ def _same_decode(words: np.ndarray, num_tx: int) -> None:
         _same_records([lst[-1]], b.records[-1:])
     nv = words.shape[1] * num_tx
     for gain in (1.0, 37.0):
-        _same_arrays(record_arrays(lst, nv, gain), record_arrays_reference(b.records, nv, gain))
+        ref = record_arrays_reference(b.records, nv, gain)
+        _same_arrays(record_arrays(lst, nv, gain), ref)
+        _same_arrays(record_arrays(b.records, nv, gain), ref)     # from Record objects
         _same_arrays(record_arrays(lst[:cut], nv, gain),
                      record_arrays_reference(b.records[:cut], nv, gain))
 
@@ -256,7 +266,7 @@ def _same_cloud(a: PointCloud, b: PointCloud) -> None:
 
 
 def test_decoder_frames_are_arrays_with_the_reference_records() -> None:
-    """RecordDecoder's frames (RecordList over arrays) against reference=True (Record
+    """RecordDecoder's frames (RecordList over arrays) against the oracle's (Record
     objects): same records, problems and counts; a lost packet keeps the intact prefix."""
     cfg = get_preset("full")
     params = DetectionParams()
@@ -268,7 +278,7 @@ def test_decoder_frames_are_arrays_with_the_reference_records() -> None:
     packets = packets[:9] + packets[10:]           # frame 2 loses words 100..199
     out = []
     for ref in (False, True):
-        dec = RecordDecoder(dcfg, 100, reference=ref)
+        dec = (RecordDecoderReference if ref else RecordDecoder)(dcfg, 100)
         got = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
         out.append(sorted(got, key=lambda f: f.frame_id))   # a damaged frame closes late
     assert isinstance(out[0][0].records, RecordList)
