@@ -13,7 +13,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Self
 
 from host.stream import PacketDecoder
 
@@ -70,7 +70,22 @@ class SendLog:
     reordered: list[int] = field(default_factory=list)
 
 
-class UdpSender:
+class _UdpSocket:
+    """A UDP socket (``self.sock``) closed by :meth:`close` or at the end of a ``with``."""
+
+    sock: socket.socket
+
+    def close(self) -> None:
+        self.sock.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class UdpSender(_UdpSocket):
     """Sends packets to ``(host, port)``; ``rate_bps`` paces the stream (None: as fast as
     the socket goes)."""
 
@@ -84,15 +99,6 @@ class UdpSender:
         self.rate_bps = rate_bps
         self.imp = impairments or Impairments()
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-
-    def close(self) -> None:
-        self.sock.close()
-
-    def __enter__(self) -> UdpSender:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     def send(self, packets: Iterable[bytes]) -> SendLog:
         rng = random.Random(self.imp.seed)
@@ -131,7 +137,7 @@ class UdpSender:
         return log
 
 
-class UdpReceiver:
+class UdpReceiver(_UdpSocket):
     """Bound UDP socket (port 0 = an ephemeral port, see :attr:`port`)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0,
@@ -148,15 +154,6 @@ class UdpReceiver:
     @property
     def port(self) -> int:
         return int(self.sock.getsockname()[1])
-
-    def close(self) -> None:
-        self.sock.close()
-
-    def __enter__(self) -> UdpReceiver:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     def receive(self, decoder: PacketDecoder[Any] | None, max_frames: int | None = None,
                 idle_timeout_s: float = 1.0, total_timeout_s: float = 60.0,
