@@ -176,7 +176,9 @@ class DetectionFrame:
     decoder runs with ``reference``; ``trailer``: None when it did not arrive;
     ``problems``: packet and record errors (empty when ``complete``); ``valid``: bool
     (frame_words,) True where the payload word arrived intact; ``usable_records``: how many
-    leading records arrived intact (all of them in a complete frame).
+    leading records arrived intact (all of them in a complete frame); ``n_virtual``: channels
+    of a snapshot (num_tx * num_rx); ``gain``: the chain's gain over the float reference,
+    divided out by :meth:`arrays`.
     """
 
     frame_id: int
@@ -185,6 +187,12 @@ class DetectionFrame:
     problems: list[str]
     valid: np.ndarray
     usable_records: int
+    n_virtual: int
+    gain: float = 1.0
+
+    def arrays(self) -> RecordArrays:
+        """The intact leading records as :class:`RecordArrays` in float-reference units."""
+        return record_arrays(self.records[:self.usable_records], self.n_virtual, self.gain)
 
     @property
     def complete(self) -> bool:
@@ -207,14 +215,17 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
     ``dcfg``: the detector's configuration (lanes, TX, MAX_DETECTIONS fix the frame length);
     ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``;
     ``reference``: decode into ``Record`` objects (``model.detect_records.decode_frame``, the
-    path :func:`decode_record_fields` replaced; the benchmark's old-vs-new timing).
+    path :func:`decode_record_fields` replaced; the benchmark's old-vs-new timing);
+    ``gain``: the chain's gain over the float reference (``model.radar_pipeline.chain_gain``),
+    divided out of the frames' :meth:`DetectionFrame.arrays`.
     """
 
     def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2,
-                 reference: bool = False) -> None:
+                 reference: bool = False, gain: float = 1.0) -> None:
         super().__init__(dcfg.num_rx, dcfg.frame_words, packet_words, reorder_window)
         self.dcfg = dcfg
         self.reference = reference
+        self.gain = gain
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
                     problems: list[str]) -> DetectionFrame:
@@ -246,7 +257,8 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
                 errors.append(f"frame {fid}: records carry frame id(s) {sorted(ids)[:4]}")
         trailer = trailer if valid.all() else None
         return DetectionFrame(frame_id=fid, records=records, trailer=trailer,
-                              problems=errors, valid=valid, usable_records=intact)
+                              problems=errors, valid=valid, usable_records=intact,
+                              n_virtual=self.dcfg.num_tx * self.dcfg.num_rx, gain=self.gain)
 
 
 @dataclass(frozen=True)
