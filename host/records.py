@@ -4,8 +4,9 @@ The record layout is defined once, in ``model.detect_records`` (docs/detect.md):
 ``record 0 .. record n-1, trailer, zero words`` up to a fixed ``frame_words``, cut into
 packets by the unchanged packetizer. This module reuses both: :class:`RecordDecoder` is the
 packet framing of :class:`host.stream.PacketDecoder` (lost, repeated, truncated, reordered
-packets reported, never raised) with the layout's decoding on each frame's payload. A frame with a lost packet is *damaged* (``complete`` False); the records that
-arrived intact before the first missing word are still offered (``usable_records``).
+packets reported, never raised) with the layout's decoding on each frame's payload. A frame
+with a lost packet is *damaged* (``complete`` False); the records that arrived intact before
+the first missing word are still offered (``usable_records``).
 
 The decoder reads a frame's records straight into arrays (:func:`decode_record_fields`, the
 same fields as ``model.detect_records.decode_frame``, unpacked by the layout's field table
@@ -168,7 +169,9 @@ class DetectionFrame:
     decoder runs with ``reference``; ``trailer``: None when it did not arrive;
     ``problems``: packet and record errors (empty when ``complete``); ``valid``: bool
     (frame_words,) True where the payload word arrived intact; ``usable_records``: how many
-    leading records arrived intact (all of them in a complete frame).
+    leading records arrived intact (all of them in a complete frame); ``n_virtual``: channels
+    of a snapshot (num_tx * num_rx); ``gain``: the chain's gain over the float reference,
+    divided out by :meth:`arrays`.
     """
 
     frame_id: int
@@ -177,6 +180,12 @@ class DetectionFrame:
     problems: list[str]
     valid: np.ndarray
     usable_records: int
+    n_virtual: int
+    gain: float = 1.0
+
+    def arrays(self) -> RecordArrays:
+        """The intact leading records as :class:`RecordArrays` in float-reference units."""
+        return record_arrays(self.records[:self.usable_records], self.n_virtual, self.gain)
 
     @property
     def complete(self) -> bool:
@@ -197,13 +206,16 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
     """DMA packets of the record stream -> :class:`DetectionFrame` per frame.
 
     ``dcfg``: the detector's configuration (lanes, TX, MAX_DETECTIONS fix the frame length);
-    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``.
+    ``packet_words``: PACKET_WORDS; ``reorder_window``: see ``host.stream.PacketDecoder``;
+    ``gain``: the chain's gain over the float reference (``model.radar_pipeline.chain_gain``),
+    divided out of the frames' :meth:`DetectionFrame.arrays`.
     """
 
-    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2
-                 ) -> None:
+    def __init__(self, dcfg: DetectConfig, packet_words: int, reorder_window: int = 2,
+                 gain: float = 1.0) -> None:
         super().__init__(dcfg.num_rx, dcfg.frame_words, packet_words, reorder_window)
         self.dcfg = dcfg
+        self.gain = gain
 
     def _decode(self, words: np.ndarray
                 ) -> tuple[Sequence[Record], Trailer | None, list[str], set[int]]:
@@ -234,7 +246,8 @@ class RecordDecoder(PacketDecoder[DetectionFrame]):
                 errors.append(f"frame {fid}: records carry frame id(s) {sorted(ids)[:4]}")
         trailer = trailer if valid.all() else None
         return DetectionFrame(frame_id=fid, records=records, trailer=trailer,
-                              problems=errors, valid=valid, usable_records=intact)
+                              problems=errors, valid=valid, usable_records=intact,
+                              n_virtual=self.dcfg.num_tx * self.dcfg.num_rx, gain=self.gain)
 
 
 @dataclass(frozen=True)

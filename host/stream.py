@@ -83,18 +83,23 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
                      f"from its header)")
 
 
-def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
+def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig, gain: float = 1.0
+                          ) -> np.ndarray:
     """Frame payload, uint32 (frame_words, num_rx) in DMA order -> radar cube complex64
-    (n_virtual, n_range, n_doppler). Same result as ``model.reference.dma_order_to_cube(
-    model.axis_packetizer.payload_to_cube(...))``, several times faster on a ``full`` frame: the
-    32-bit {Q, I} words are transposed to channel order while still words (one strided
-    copy), then widened contiguously."""
+    (n_virtual, n_range, n_doppler), divided by ``gain`` (the chain's gain over the float
+    reference, ``model.radar_pipeline.chain_gain``: float-reference units; 1.0: LSB). Same
+    result as ``model.reference.dma_order_to_cube(model.axis_packetizer.payload_to_cube(
+    ...)) / gain``, several times faster on a ``full`` frame: the 32-bit {Q, I} words are
+    transposed to channel order while still words (one strided copy), then widened
+    contiguously."""
     w = np.ascontiguousarray(words, dtype="<u4").reshape(
         cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
     t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
     t[...] = w.transpose(0, 3, 1, 2)
     iq = np.empty(t.shape + (2,), np.float32)
     iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
+    if gain != 1.0:
+        iq /= np.float32(gain)
     return iq.view(np.complex64).reshape(cfg.cube_shape)
 
 
@@ -102,7 +107,8 @@ def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
 class Frame:
     """One decoded frame.
 
-    ``cube``: complex64 (n_virtual, n_range, n_doppler), zeros where words are missing.
+    ``cube``: complex64 (n_virtual, n_range, n_doppler) in the payload's LSB, zeros where
+    words are missing.
     ``valid``: bool (num_tx, n_range, n_doppler): True where the word arrived intact.
     ``problems``: what is wrong with the frame (empty when ``complete``).
     """
@@ -362,8 +368,7 @@ class StreamDecoder(PacketDecoder[Frame]):
     """
 
     def __init__(self, cfg: RadarConfig, packet_words: int, reorder_window: int = 2) -> None:
-        super().__init__(cfg.num_rx, cfg.num_tx * cfg.n_range * cfg.n_doppler, packet_words,
-                         reorder_window)
+        super().__init__(cfg.num_rx, cube_frame_words(cfg), packet_words, reorder_window)
         self.cfg = cfg
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,

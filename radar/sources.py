@@ -8,7 +8,7 @@ radar cubes complex (n_virtual, n_range, n_doppler) in the float reference's uni
   exactly what the FPGA sends, divided by the chain's gain;
 - ``float``: the float64 reference of the chain (:func:`model.reference.radar_cube`), fast;
 - ``rtl``: the Verilated ``radar_pipeline`` (:func:`rtlsim.harness.run_pipeline`, the C++ harness),
-  its DMA packets decoded by :class:`host.stream.StreamDecoder` like the board's.
+  its DMA packets decoded like the board's (``host.receiver.chain_decoder``).
 
 With the on-chip detector (``radar detect --detect fpga``, ``OUTPUT_MODE = 1``) a source
 gives the frames' detection records instead (:meth:`FrameSource.record_frames`): ``model``
@@ -28,11 +28,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from host.records import DetectionFrame, RecordDecoder
+from host.receiver import chain_decoder
+from host.records import DetectionFrame
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, RadarConfig
 from model.detect_chain import DetectConfig
-from model.radar_pipeline import PipelineParams, chain_gain, record_frames, scaled_cube
+from model.radar_pipeline import PipelineParams, record_frames, scaled_cube
 from model.reference import radar_cube
 
 SOURCES: dict[str, type[FrameSource]] = {}
@@ -86,7 +87,7 @@ class FrameSource:
         """Consecutive ADC frames -> their decoded record frames, in order: the DMA packets
         of :meth:`record_packets` go through :class:`host.records.RecordDecoder` as bytes,
         exactly as the board's would."""
-        dec = RecordDecoder(dcfg, self.chain.packet_words)
+        dec = chain_decoder(cfg, self.chain.packet_words, self.chain, dcfg)
         for p in self.record_packets(adc_frames, cfg, dcfg):
             yield from dec.push_packet(p if isinstance(p, bytes) else words_to_bytes(p))
         yield from dec.flush()
@@ -162,19 +163,16 @@ class RtlSource(FrameSource):
     def cubes(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig) -> Iterator[np.ndarray]:
         """All frames stream through the RTL back to back (one simulation); the DMA packets
         are decoded like the board's."""
-        from host.stream import StreamDecoder
-
         adcs = list(adc_frames)
         packets, status = self._run(adcs, cfg, self._chain(cfg))
-        dec = StreamDecoder(cfg, self.chain.packet_words)
+        dec = chain_decoder(cfg, self.chain.packet_words, self.chain)
         decoded = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
         if len(decoded) != len(adcs) or not all(f.complete for f in decoded):
             problems = [p for f in decoded for p in f.problems] + dec.stream_problems
             raise SourceError(f"{len(decoded)} frame(s) back, problems: {problems[:3]}, "
                               f"status {status}")
-        gain = chain_gain(cfg, self.chain)
         for f in sorted(decoded, key=lambda f: f.frame_id):
-            yield f.cube / gain
+            yield f.cube()
 
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:

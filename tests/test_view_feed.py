@@ -12,15 +12,18 @@ import pytest
 
 from host.capture import frame_packets
 from host.pointcloud import PointCloud
+from host.receiver import Receiver
 from host.stream import StreamDecoder
 from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import get_preset
 from model.reference import cube_to_dma_order, range_doppler_power
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth, missing_packets
+from radar.view.ingest import packet_ingest
+from radar.view.processor import Processor, channel_power_sum
 from radar.view.render import MAX_AXIS, box_outline, frame_message, heatmap, pool_max
 from radar.view.server import STATIC_DIR, plotly_js_path
-from radar.view.sources import PacketIngest, Processor, channel_power_sum, replay_loop
+from radar.view.sources import replay_loop
 
 CFG = get_preset("paper-fpga")
 PACKET_WORDS = 1023
@@ -46,15 +49,14 @@ class _Recorder(Processor):
         super().__init__(CFG, Feed(), health)
         self.got: list[int] = []
 
-    def submit(self, frame_id: int, cube: np.ndarray, scale: float = 1.0,
-               cfg: object = None) -> None:
+    def submit(self, frame_id: int, frame: object, cfg: object = None) -> None:
         self.got.append(frame_id)
 
 
-def _ingest() -> tuple[PacketIngest, LinkHealth, _Recorder]:
+def _ingest() -> tuple[Receiver, LinkHealth, _Recorder]:
     health = LinkHealth()
     rec = _Recorder(health)
-    return PacketIngest(CFG, PACKET_WORDS, health, rec, gain=1.0), health, rec
+    return packet_ingest(CFG, PACKET_WORDS, health, rec), health, rec
 
 
 def test_clean_stream_counts_frames(frames):
@@ -115,7 +117,7 @@ def test_packet_words_learnt_from_the_header(packet_words):
     restarts with another PACKET_WORDS is learnt again."""
     health = LinkHealth()
     rec = _Recorder(health)
-    ingest = PacketIngest(CFG, None, health, rec, gain=1.0)
+    ingest = packet_ingest(CFG, None, health, rec)
     for k in range(3):
         for p in frame_packets(_cube(k), CFG, packet_words, k):
             ingest.push(p)
@@ -135,7 +137,7 @@ def test_packet_words_learnt_from_the_header(packet_words):
 def test_preset_learnt_from_the_header():
     """A UDP stream without --preset: the view starts on ``full`` and learns paper-fpga
     (and its PACKET_WORDS) from the first packet; cubes reach the processor with that
-    preset's shape and gain."""
+    preset's shape and chain gain (divided out where the cube is decoded)."""
     from model.config import PRESETS
     from model.radar_pipeline import PipelineParams, chain_gain
 
@@ -144,17 +146,17 @@ def test_preset_learnt_from_the_header():
     got: list[tuple[int, tuple[int, ...], float, str]] = []
 
     class Rec(Processor):
-        def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:
-            got.append((frame_id, cube.cube().shape, scale, cfg.name))  # lazy: decoded here
+        def submit(self, frame_id, frame, cfg=None) -> None:
+            got.append((frame_id, frame.cube().shape, frame.gain, cfg.name))  # decoded here
 
-    ingest = PacketIngest(full, None, health, Rec(full, Feed(), health), gain=1.0,
-                          configs=list(PRESETS.values()))
+    ingest = packet_ingest(full, None, health, Rec(full, Feed(), health),
+                           configs=list(PRESETS.values()))
     for k in range(2):
         for p in frame_packets(_cube(k), CFG, 4093, k):
             ingest.push(p)
     ingest.idle()
     gain = chain_gain(CFG, PipelineParams())
-    assert got == [(k, CFG.cube_shape, pytest.approx(1 / gain), "paper-fpga") for k in (0, 1)]
+    assert got == [(k, CFG.cube_shape, pytest.approx(gain), "paper-fpga") for k in (0, 1)]
     s = health.snapshot()
     assert (s["frames_complete"], s["malformed"], s["packets_lost"]) == (2, 0, 0)
 

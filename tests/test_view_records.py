@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 
 from host.capture import CaptureInfo, write_capture
+from host.receiver import CUBE, RECORDS, Receiver
+from host.records import DetectionFrame
 from model.config import PRESETS, get_preset
 from model.detect_records import TAG_RECORD, hdr_words
 from model.radar_pipeline import PipelineParams, chain_gain
@@ -19,15 +21,10 @@ from model.scene import table1_scene
 from radar.cli import main as radar_main
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
+from radar.view.ingest import packet_ingest
+from radar.view.processor import Processor
 from radar.view.render import frame_message
-from radar.view.sources import (
-    CUBE,
-    RECORDS,
-    PacketIngest,
-    Processor,
-    replay_loop,
-    scene_record_frames,
-)
+from radar.view.sources import replay_loop, scene_record_frames
 
 CFG = get_preset("paper-fpga")
 PACKET_WORDS = 256
@@ -59,27 +56,27 @@ class _Keep(Processor):
         self.records: list[tuple[int, int, float, str]] = []
         self.cubes: list[int] = []
 
-    def submit_records(self, frame, gain, cfg=None) -> None:  # noqa: ANN001
-        self.records.append((frame.frame_id, len(frame.records), gain, cfg.name))
-
-    def submit(self, frame_id, cube, scale=1.0, cfg=None) -> None:  # noqa: ANN001
-        self.cubes.append(frame_id)
+    def submit(self, frame_id, frame, cfg=None) -> None:  # noqa: ANN001
+        if isinstance(frame, DetectionFrame):
+            self.records.append((frame.frame_id, len(frame.records), frame.gain, cfg.name))
+        else:
+            self.cubes.append(frame_id)
 
 
 def _ingest(kind: str | None, max_det: int, packet_words: int | None = PACKET_WORDS,
-            learn: bool = False) -> tuple[PacketIngest, LinkHealth, _Keep]:
+            learn: bool = False) -> tuple[Receiver, LinkHealth, _Keep]:
     health = LinkHealth()
     keep = _Keep(health)
     dcfg = _chain(max_det).detect
     cfg = get_preset("full") if learn else CFG
-    ingest = PacketIngest(cfg, packet_words, health, keep, gain=1.0,
-                          configs=list(PRESETS.values()) if learn else None, kind=kind,
-                          detect_config=lambda c: PipelineParams(output_mode=1).detect_config(c)
-                          if c != CFG else dcfg)
+    ingest = packet_ingest(cfg, packet_words, health, keep,
+                           configs=list(PRESETS.values()) if learn else None, kind=kind,
+                           detect_config=lambda c: PipelineParams(
+                               output_mode=1).detect_config(c) if c != CFG else dcfg)
     return ingest, health, keep
 
 
-def _push(ingest: PacketIngest, frames: list[list[bytes]]) -> None:
+def _push(ingest: Receiver, frames: list[list[bytes]]) -> None:
     for f in frames:
         for p in f:
             ingest.push(p)
@@ -97,7 +94,8 @@ def test_record_stream_counts_frames_and_trailer_figures(streams):
     assert [(fid, cfg) for fid, _, _, cfg in keep.records] == [(0, "paper-fpga"),
                                                              (1, "paper-fpga")]
     assert keep.records[-1][1] == s["records"] and keep.cubes == []
-    assert all(g == 1.0 for _, _, g, _ in keep.records)
+    gain = chain_gain(CFG, PipelineParams())   # divided out where the records are decoded
+    assert all(g == gain for _, _, g, _ in keep.records)
 
 
 def test_truncated_flag_is_sticky_and_shown(streams):
@@ -109,8 +107,8 @@ def test_truncated_flag_is_sticky_and_shown(streams):
     assert s["truncated"] and s["frames_truncated"] == 2 and s["records"] == 4
     assert s["cfar_detections"] > 4
     assert any("TRUNCATED" in p and "MAX_DETECTIONS 4" in p for p in s["problems"])
-    ingest2 = PacketIngest(CFG, PACKET_WORDS, health, _Keep(health), 1.0, kind=RECORDS,
-                           detect_config=lambda c: _chain(64).detect)
+    ingest2 = packet_ingest(CFG, PACKET_WORDS, health, _Keep(health), kind=RECORDS,
+                            detect_config=lambda c: _chain(64).detect)
     _push(ingest2, streams["plenty"])
     s = health.snapshot()
     assert s["truncated"] and s["frames_truncated"] == 2 and s["frames_complete"] == 4
@@ -200,8 +198,8 @@ def test_record_frames_processed_into_a_view_frame(streams):
     without an error."""
     health, feed = LinkHealth(), Feed()
     proc = Processor(CFG, feed, health)
-    ingest = PacketIngest(CFG, PACKET_WORDS, health, proc, chain_gain(CFG, PipelineParams()),
-                          kind=RECORDS, detect_config=lambda c: _chain(64).detect)
+    ingest = packet_ingest(CFG, PACKET_WORDS, health, proc, kind=RECORDS,
+                           detect_config=lambda c: _chain(64).detect)
     stop = threading.Event()
     t = threading.Thread(target=proc.run, args=(stop,))
     t.start()

@@ -13,11 +13,12 @@ from typing import Any
 
 from host.cfar import paper_threshold
 from host.evaluate import alias_note, match_targets, table3
-from host.pipeline import DetectionParams, process_cube
+from host.pipeline import DetectionParams
 from model.reference import range_doppler_power
 from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
 from radar.figures import truth_range_doppler, truth_xy
+from radar.frame_cloud import frame_cloud
 from radar.objects import gnn_objects, object_boxes
 from radar.sources import SOURCES, get_source
 
@@ -74,10 +75,10 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     adc = simulate_scene(scene)
     cube = source.cube(adc.samples, cfg)
     t_first = time.perf_counter()
-    cloud = process_cube(cube, cfg, params)
+    cloud = frame_cloud(cube, cfg, params, 0, "demo").cloud
     t_first = time.perf_counter() - t_first
     t_host = time.perf_counter()              # again: a frame's time once the process runs
-    process_cube(cube, cfg, params)
+    frame_cloud(cube, cfg, params, 0, "demo")
     t_host = time.perf_counter() - t_host
     matches, used = match_targets(cloud, scene.targets, cfg)
     print(f"Table I scene, preset {cfg.name} ({cfg.num_tx} TX x {cfg.num_rx} RX, "

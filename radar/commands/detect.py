@@ -19,15 +19,14 @@ from typing import Any
 
 import numpy as np
 
-from host.pipeline import DetectionParams, process_cube
+from host.pipeline import DetectionParams
 from host.pointcloud import PointCloud
-from host.record_points import process_records
-from host.records import DEFAULT_MAX_DETECTIONS, fpga_detect_config, record_arrays
+from host.receiver import DetectConfigOf
+from host.records import DEFAULT_MAX_DETECTIONS, fpga_detect_config
 from model.cfar_2d import KINDS
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.observability import scene_report
-from model.radar_pipeline import chain_gain
 from model.simulate import simulate_scene
 from radar.common import (
     CliError,
@@ -35,13 +34,13 @@ from radar.common import (
     count,
     detection_params,
     ego_speed_mps,
-    note_compile,
     out_file,
     progress,
     scene_of,
     warn,
 )
 from radar.figures import detect_plots
+from radar.frame_cloud import frame_cloud
 from radar.objects import describe, gnn_objects, object_boxes
 from radar.sources import SOURCES, SourceError, get_source
 
@@ -66,6 +65,18 @@ def fpga_config(args: argparse.Namespace, cfg: RadarConfig, params: DetectionPar
                                   (params.range_window, params.doppler_window))
     except ValueError as exc:
         raise CliError(f"--detect fpga: {exc}") from None
+
+
+def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
+    """The on-chip detector's configuration for a preset from the options (``--fpga-cfar``,
+    ``--max-detections``, the CFAR options); ValueError when they do not fit the preset."""
+    def of(cfg: RadarConfig) -> DetectConfig:
+        try:
+            return fpga_config(args, cfg, detection_params(args, cfg=cfg))
+        except CliError as exc:
+            raise ValueError(str(exc)) from None
+
+    return of
 
 
 def cmd_detect(args: argparse.Namespace) -> int:
@@ -93,19 +104,17 @@ def cmd_detect(args: argparse.Namespace) -> int:
     try:
         if args.detect == "fpga":
             dcfg = fpga_config(args, cfg, params)
-            gain = chain_gain(cfg, get_source(args.backend).chain)
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
             for f in frames:
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
-                arr = record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain)
-                note_compile("detect")
-                cloud = process_records(arr, cfg, params, frame=k)
+                fc = frame_cloud(f, cfg, params, k, "detect")
+                cloud = fc.cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
                                   "adc_saturated": saturated[k] if k < len(saturated) else 0,
                                   "records": len(f.records), "detections": f.detections,
                                   "truncated": f.truncated, "complete": f.complete,
-                                  "problems": f.problems})
+                                  "problems": f.problems + fc.problems})
                 if f.truncated:
                     warn([f"frame {k}: {f.detections} cells passed the CFAR, only "
                           f"--max-detections {dcfg.max_detections} were sent"], "detect")
@@ -115,7 +124,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
                     objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
         else:
             for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
-                cloud = process_cube(cube, cfg, params, frame=k)
+                cloud = frame_cloud(cube, cfg, params, k, "detect").cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
                                   "adc_saturated": saturated[k]})

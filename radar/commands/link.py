@@ -4,10 +4,11 @@ UDP packets -> point cloud JSON).
 
 With ``--detect fpga`` the stream is the on-chip detector's record stream (``OUTPUT_MODE =
 1``) instead of the radar cube: ``capture`` writes it (a record capture, ``host.capture``),
-``replay`` sends either kind unchanged, and ``receive --detect fpga`` decodes records
-(``host.records.RecordDecoder``) and goes on from them (``host.record_points``). The kind is
-chosen by the flag, not guessed: ``receive`` without it names the record stream in its error
-when the first datagram fits a record stream but no cube."""
+``replay`` sends either kind unchanged, and ``receive --detect fpga`` decodes records and
+goes on from them (``radar.frame_cloud``). ``receive`` learns the stream's geometry from the
+first datagram that fits (``host.receiver.Receiver``); the kind is chosen by the flag, not
+guessed: ``receive`` without it names the record stream in its error when the first datagram
+fits a record stream but no cube."""
 
 from __future__ import annotations
 
@@ -18,27 +19,25 @@ from pathlib import Path
 from typing import Any
 
 from host.capture import CaptureInfo, read_capture, write_capture
-from host.pipeline import process_cube
 from host.pointcloud import PointCloud
-from host.record_points import process_records
-from host.records import RecordDecoder, inside_map, outside_problem, record_arrays
+from host.receiver import CUBE, RECORDS, Receiver
 from model.axis_packetizer import words_to_bytes
-from model.config import PRESETS, RadarConfig, get_preset
+from model.config import PRESETS, get_preset
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.simulate import simulate_scene
-from radar.commands.detect import add_fpga_options, fpga_config
+from radar.commands.detect import add_fpga_options, detect_config_of, fpga_config
 from radar.common import (
     CliError,
     add_detection_options,
     check,
     count,
     detection_params,
-    note_compile,
     out_file,
     progress,
     scene_of,
     warn,
 )
+from radar.frame_cloud import frame_cloud
 from radar.sources import get_source
 
 MAX_CAPTURE_FRAMES = 1000
@@ -115,20 +114,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return 0
 
 
-def _record_decoder(args: argparse.Namespace, cfg: RadarConfig,
-                    packet_words: int | None, first: bytes | None = None) -> RecordDecoder:
-    """The record decoder for ``cfg`` (PACKET_WORDS given, or learnt from ``first``)."""
-    from host.stream import geometry_from_packet
-
-    dcfg = fpga_config(args, cfg, detection_params(args, cfg=cfg))
-    if packet_words is None:
-        assert first is not None
-        _, packet_words = geometry_from_packet(first, [cfg], lambda _: dcfg.frame_words)
-    return RecordDecoder(dcfg, packet_words)
-
-
 def cmd_receive(args: argparse.Namespace) -> int:
-    from host.stream import PacketDecoder, StreamDecoder, geometry_from_packet
     from host.udp import UdpReceiver, check_seconds
 
     out = out_file(args.json, ".json", "--json")
@@ -144,51 +130,16 @@ def cmd_receive(args: argparse.Namespace) -> int:
 
     records = args.detect == "fpga"
     configs = [fixed] if fixed else list(PRESETS.values())
-
-    def make_decoder(first: bytes) -> PacketDecoder[Any]:
-        """Geometry from the options if given, else learnt from the first datagram."""
-        if records:
-            try:   # a radar-cube packet: its stream's last packet may fit records too
-                cube_of = geometry_from_packet(first, configs)[0].name
-            except ValueError:
-                cube_of = None
-            cube = (f"it is a radar-cube stream packet of {cube_of} (leave out --detect "
-                    f"fpga)") if cube_of else None
-            errors = []
-            for cfg in configs:
-                try:
-                    dec = _record_decoder(args, cfg, args.packet_words, first)
-                except (ValueError, CliError) as exc:
-                    errors.append(f"{cfg.name}: {exc}")
-                    continue
-                if cube:      # both fit: wait for a packet that says which
-                    raise ValueError(f"a packet that fits records of {cfg.name} but {cube}")
-                return dec
-            raise ValueError(cube or ("not a record-stream packet of " + "; ".join(errors)
-                                      + " (check --max-detections)"))
-        try:
-            cfg, pw = geometry_from_packet(first, configs)
-        except ValueError as exc:
-            for cfg in configs:   # say so when it is a record stream
-                try:
-                    _record_decoder(args, cfg, args.packet_words, first)
-                except (ValueError, CliError):
-                    continue
-                raise ValueError(f"{exc}; it fits a detection-record stream of {cfg.name}: "
-                                 f"use --detect fpga") from None
-            raise
-        return StreamDecoder(cfg, args.packet_words or pw)
-
+    # the geometry from the options if given, else learnt from the first datagram that fits
+    receiver = Receiver(configs, args.packet_words, RECORDS if records else CUBE,
+                        detect_config_of(args))
     try:
         if records:
             for cfg in configs:   # check the detector options before listening
                 fpga_config(args, cfg, detection_params(args, cfg=cfg))
         if fixed and args.packet_words:
             # check the geometry before listening
-            if records:
-                _record_decoder(args, fixed, args.packet_words)
-            else:
-                StreamDecoder(fixed, args.packet_words)
+            receiver.decoder_for(fixed, receiver.kind, args.packet_words)
         rx = UdpReceiver(args.host, args.port)
     except ValueError as exc:
         raise CliError(str(exc)) from None
@@ -197,9 +148,9 @@ def cmd_receive(args: argparse.Namespace) -> int:
     print(f"listening on {args.host}:{rx.port}", flush=True)
     with rx:
         frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
-                            total_timeout_s=args.timeout, make_decoder=make_decoder)
+                            total_timeout_s=args.timeout, make_decoder=receiver.learn)
     decoder = rx.decoder
-    cfg = _decoder_config(decoder, configs) if decoder else fixed
+    cfg = receiver.cfg if decoder else fixed
     if decoder and cfg:
         params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
@@ -208,21 +159,14 @@ def cmd_receive(args: argparse.Namespace) -> int:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
                                      "problems": f.problems}
             if decoder and cfg and (f.complete or args.use_damaged):
-                gain = chain_gain(cfg, PipelineParams(packet_words=decoder.packet_words))
+                fc = frame_cloud(f, cfg, params, f.frame_id, "receive")
+                if fc.problems:
+                    entry["problems"] = [*f.problems, *fc.problems]
                 if records:
-                    arr, dropped = inside_map(
-                        record_arrays(f.records[:f.usable_records], cfg.n_virtual, gain), cfg)
-                    if dropped:          # corrupt words that still looked like records
-                        entry["problems"] = [*f.problems, outside_problem(
-                            f.frame_id, dropped, cfg)]
-                    note_compile("receive")
-                    cloud = process_records(arr, cfg, params, frame=f.frame_id)
                     entry.update({"records": len(f.records), "detections": f.detections,
                                   "truncated": f.truncated})
-                else:
-                    cloud = process_cube(f.cube / gain, cfg, params, frame=f.frame_id)
-                clouds.append(cloud)
-                entry["points"] = len(cloud)
+                clouds.append(fc.cloud)
+                entry["points"] = len(fc.cloud)
             frames_doc.append(entry)
     except KeyboardInterrupt:
         rx.interrupted = True
@@ -254,15 +198,6 @@ def cmd_receive(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     return 0
-
-
-def _decoder_config(decoder: Any, configs: list[RadarConfig]) -> RadarConfig | None:
-    """The radar configuration a decoder was built for."""
-    if isinstance(decoder, RecordDecoder):
-        d = decoder.dcfg
-        return next((c for c in configs if (c.num_tx, c.num_rx, c.n_range, c.n_doppler)
-                     == (d.num_tx, d.num_rx, d.n_range, d.n_doppler)), None)
-    return decoder.cfg
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:

@@ -28,13 +28,13 @@ from pathlib import Path
 from typing import Any
 
 from host.capture import read_capture
+from host.receiver import CUBE, RECORDS
 from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
-from model.detect_chain import DetectConfig
-from model.radar_pipeline import PipelineParams, chain_gain
+from model.radar_pipeline import PipelineParams
 from model.scene import load_scene
 from model.simulate import simulate_scene
-from radar.commands.detect import add_fpga_options, fpga_config
+from radar.commands.detect import add_fpga_options, detect_config_of
 from radar.common import (
     CliError,
     add_detection_options,
@@ -46,13 +46,10 @@ from radar.common import (
 from radar.sources import get_source
 from radar.view.feed import Feed
 from radar.view.health import LinkHealth
+from radar.view.ingest import packet_ingest
+from radar.view.processor import Processor
 from radar.view.server import ViewServer
 from radar.view.sources import (
-    CUBE,
-    RECORDS,
-    DetectConfigOf,
-    PacketIngest,
-    Processor,
     capture_info,
     load_replay,
     replay_loop,
@@ -85,18 +82,6 @@ def preset_of_capture(path: Path) -> RadarConfig:
         if info.matches(cfg):
             return cfg
     raise ValueError(f"{path}: no preset has the capture's geometry {info}")
-
-
-def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
-    """The on-chip detector's configuration for a preset from the options (``--fpga-cfar``,
-    ``--max-detections``, the CFAR options); ValueError when they do not fit the preset."""
-    def of(cfg: RadarConfig) -> DetectConfig:
-        try:
-            return fpga_config(args, cfg, detection_params(args, cfg=cfg))
-        except CliError as exc:
-            raise ValueError(str(exc)) from None
-
-    return of
 
 
 def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
@@ -187,20 +172,18 @@ def build(args: argparse.Namespace, stop: threading.Event
                            f"scene runs the bit-accurate model (--backend model)")
         dcfg = detect_config(cfg)
         chain = PipelineParams(output_mode=1, detect=dcfg)
-        gain = chain_gain(cfg, chain)
-        ingest = PacketIngest(cfg, chain.packet_words, health, processor, gain, kind=RECORDS,
-                              detect_config=lambda _: dcfg)
+        ingest = packet_ingest(cfg, chain.packet_words, health, processor, kind=RECORDS,
+                               detect_config=lambda _: dcfg, chain=chain)
         threads.append(threading.Thread(
             target=replay_loop, name="view-scene", daemon=True,
             args=(scene_record_frames(scene, chain, args.frames), ingest, stop, args.fps,
                   True, args.loss, args.seed)))
         return feed, health, threads, desc
-    gain = chain_gain(cfg, PipelineParams())  # the FFT scaling only, not PACKET_WORDS
     try:
         # a UDP stream without --preset: the preset is learnt from the packet headers too
         learn = None if args.replay or args.preset else list(PRESETS.values())
-        ingest = PacketIngest(cfg, packet_words, health, processor, gain, configs=learn,
-                              kind=kind, detect_config=detect_config)
+        ingest = packet_ingest(cfg, packet_words, health, processor, configs=learn,
+                               kind=kind, detect_config=detect_config)
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
     if args.replay:

@@ -3,8 +3,11 @@ boxes, range profile, link health), like TI's mmWave Demo Visualizer.
 
 Data flow (each stage one module)::
 
-    source (UDP / replay / scene / later: detection records)   radar.view.sources
+    source (UDP / replay of a capture / scene)                 radar.view.sources
+        -> packets -> frames (cube or records), link policy      host.receiver
+        -> LinkHealth counters, frames to the processor          radar.view.ingest
         -> LinkHealth counters                                    radar.view.health
+        -> host processing of the newest frame                    radar.view.processor
         -> ViewFrame (cube and/or point cloud, objects)           radar.view.feed
         -> Feed: newest frame only, never a queue                 radar.view.feed
         -> per browser: JSON message (downsampled, quantised)     radar.view.render

@@ -28,7 +28,8 @@ class ViewFrame:
     """One frame as displayed.
 
     ``seq``: publication counter (increases by one per published frame).
-    ``cube``: complex64 (n_virtual, n_range, n_doppler) in LSB, or None (record stream).
+    ``cube``: complex (n_virtual, n_range, n_doppler) in float-reference units (LSB of a
+    1/N-per-FFT chain), or None (record stream).
     ``nci``: float (n_range, n_doppler) power summed over channels, LSB^2, or None.
     ``cloud``: the frame's detections. ``objects``: GNN objects (``gnn.infer.detect_objects``
     dicts: class, score, x_m, y_m, length_m, width_m, heading_deg).

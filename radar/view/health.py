@@ -107,7 +107,8 @@ class LinkHealth:
 
     def on_frame(self, frame: LinkFrame, packet_words: int, n_packets: int,
                  id_gap: int) -> None:
-        """A decoded frame; ``id_gap``: frames missing entirely before it (by frame id)."""
+        """A decoded frame; ``id_gap``: frames missing entirely before it (by frame id),
+        -1 when it is one of those counted missing, arrived after all (reordered)."""
         lost = missing_packets(frame, packet_words)
         with self.lock:
             self._frame_times.append(time.monotonic())

@@ -1,0 +1,58 @@
+"""One frame -> its point cloud, whatever carried it: a radar cube (the host runs the CFAR,
+``host.pipeline.process_cube_nci``) or the on-chip detector's records
+(``host.record_points.process_records``). Every command that makes clouds (``radar detect``,
+``radar receive``, ``radar view``) goes through :func:`frame_cloud`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from host.pipeline import DetectionParams, process_cube_nci
+from host.pointcloud import PointCloud
+from host.record_points import process_records
+from host.records import DetectionFrame, RecordArrays, inside_map, outside_problem
+from model.config import RadarConfig
+from radar.common import note_compile
+
+
+class CubeFrame(Protocol):
+    """A cube frame decoded on demand (``host.receiver.PayloadFrame``)."""
+
+    def cube(self) -> np.ndarray: ...
+
+
+@dataclass(frozen=True)
+class FrameCloud:
+    """A frame's point cloud and what it came from.
+
+    ``cube``: complex (n_virtual, n_range, n_doppler) and ``nci``: float (n_range,
+    n_doppler) its integrated power, both float-reference units (None for records);
+    ``records``: the records inside the map, float-reference units (None for a cube);
+    ``problems``: what was dropped (records outside the map: corrupt words that still looked
+    like records)."""
+
+    cloud: PointCloud
+    cube: np.ndarray | None = None
+    nci: np.ndarray | None = None
+    records: RecordArrays | None = None
+    problems: list[str] = field(default_factory=list)
+
+
+def frame_cloud(frame: np.ndarray | CubeFrame | DetectionFrame, cfg: RadarConfig,
+                params: DetectionParams, frame_id: int, command: str) -> FrameCloud:
+    """The point cloud of one frame of ``cfg``: a cube complex (n_virtual, n_range,
+    n_doppler) in float-reference units, a cube frame (decoded here), or a record frame
+    (its intact leading records inside the map). ``command``: the ``radar`` command, named
+    in the one-time note when the host kernels compile."""
+    if isinstance(frame, DetectionFrame):
+        arr, dropped = inside_map(frame.arrays(), cfg)
+        note_compile(command)           # the kernels may compile now (once per checkout)
+        cloud = process_records(arr, cfg, params, frame=frame_id)
+        return FrameCloud(cloud, records=arr, problems=[
+            outside_problem(frame_id, dropped, cfg)] if dropped else [])
+    cube = frame if isinstance(frame, np.ndarray) else frame.cube()
+    cloud, nci = process_cube_nci(cube, cfg, params, frame_id)
+    return FrameCloud(cloud, cube=cube, nci=nci)
