@@ -40,6 +40,7 @@ import numpy as np
 
 from host.capture import CaptureInfo, frame_packets, read_capture, write_capture
 from host.pipeline import DetectionParams, process_cube
+from host.receiver import CubePayloadDecoder
 from host.records import RecordDecoder
 from host.stream import StreamDecoder
 from model.config import RadarConfig, get_preset
@@ -50,14 +51,9 @@ from model.simulate import simulate_scene
 from radar.view.browser import chromium_missing_reason, launch, start_view
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth
+from radar.view.processor import Job, Processor, channel_power_sum
 from radar.view.render import MessageCache
-from radar.view.sources import (
-    CubePayloadDecoder,
-    Processor,
-    _RecordJob,
-    channel_power_sum,
-    scene_record_frames,
-)
+from radar.view.sources import scene_record_frames
 
 REFERENCE_JS = Path(__file__).with_name("bench_reference.js")
 """The page's draw before the canvas heat maps (main ea510a1), timed beside the new one."""
@@ -102,14 +98,13 @@ def record_costs(capture: Path) -> dict[str, float]:
     dcfg = replace(dcfg, max_detections=info.max_detections)
 
     def ingest() -> Any:
-        d = RecordDecoder(dcfg, info.packet_words)
+        d = RecordDecoder(dcfg, info.packet_words, gain=chain_gain(cfg, PipelineParams()))
         return ([f for p in pkts[:d.n_packets] for f in d.push_packet(p)] + d.flush())[0]
 
     t_in, frame = _cpu_ms(ingest)
     feed = Feed()
     proc = Processor(cfg, feed, LinkHealth())
-    job = _RecordJob(frame.frame_id, frame, chain_gain(cfg, PipelineParams()), cfg)
-    t_proc, _ = _cpu_ms(lambda: proc._process_records(job, 0))  # noqa: SLF001
+    t_proc, _ = _cpu_ms(lambda: proc.process(Job(frame.frame_id, frame, cfg)))
     view = feed.latest()
     t_msg, text = _cpu_ms(lambda: MessageCache().get(view, 0, {}))
     return {"ingest_old_ms": t_in, "ingest_new_ms": t_in, "cube_ms": 0.0,
@@ -155,14 +150,16 @@ def server_costs(capture: Path, cfg: RadarConfig) -> dict[str, float]:
     pkts = list(packets)
     n = StreamDecoder(cfg, info.packet_words).n_packets
 
-    def ingest(cls: Any) -> Any:
-        d = cls(cfg, info.packet_words)
-        return ([f for p in pkts[:n] for f in d.push_packet(p)] + d.flush())[0]
+    gain = chain_gain(cfg, PipelineParams())
 
-    t_old, frame = _cpu_ms(lambda: ingest(StreamDecoder))
-    t_new, payload = _cpu_ms(lambda: ingest(CubePayloadDecoder))
+    def ingest(decoder: Any) -> Any:
+        return ([f for p in pkts[:n] for f in decoder.push_packet(p)] + decoder.flush())[0]
+
+    t_old, frame = _cpu_ms(lambda: ingest(StreamDecoder(cfg, info.packet_words)))
+    t_new, payload = _cpu_ms(lambda: ingest(CubePayloadDecoder(cfg, info.packet_words,
+                                                               gain=gain)))
     t_cube, _ = _cpu_ms(payload.cube)
-    cube = (frame.cube / chain_gain(cfg, PipelineParams())).astype(np.complex64)
+    cube = (frame.cube / gain).astype(np.complex64)
     params = DetectionParams()
 
     def process_old() -> Any:
@@ -171,7 +168,7 @@ def server_costs(capture: Path, cfg: RadarConfig) -> dict[str, float]:
 
     t_proc_old, (cloud, nci) = _cpu_ms(process_old)
     proc = Processor(cfg, Feed(), LinkHealth(), params)
-    t_proc_new, _ = _cpu_ms(lambda: proc._process(0, cube, 0, cfg))  # noqa: SLF001
+    t_proc_new, _ = _cpu_ms(lambda: proc.process(Job(0, cube, cfg)))
     view = ViewFrame(seq=1, frame_id=0, cfg=cfg, cloud=cloud, cube=cube, nci=nci)
     t_msg, text = _cpu_ms(lambda: MessageCache().get(view, 0, {}))
     return {"ingest_old_ms": t_old, "ingest_new_ms": t_new, "cube_ms": t_cube,
