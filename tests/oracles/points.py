@@ -149,10 +149,10 @@ def points_from_cells_numpy(cells: np.ndarray, snapshots: np.ndarray, power: np.
                             noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
                             params: DetectionParams, frame: int = 0) -> PointCloud:
     """The cube path's points before ``host.points.points_from_cells`` (steps 3 to 5 of
-    ``host.pipeline``'s docstring). Vectorised over the cells: the TDM hypotheses' phasors, their
-    angle peaks (coarse FFT + fine-grid search, ``host.angle.fine_peaks``, the same peaks as
-    ``AngleParams.n_fft``-point FFTs), the unfolding decision (:func:`choose_folds`) and
-    the angles run on all cells at once.
+    ``host.pipeline``'s docstring). Vectorised over the cells: the TDM hypotheses' phasors,
+    their angle peaks (coarse FFT + fine-grid search, ``tests.oracles.angle.fine_peaks``, the
+    same peaks as ``AngleParams.n_fft``-point FFTs), the unfolding decision
+    (:func:`choose_folds`) and the angles run on all cells at once.
 
     cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
     (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
