@@ -134,3 +134,10 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
                    help="fastest radial speed to expect, m/s: velocities are unfolded within "
                         "it and a point is flagged ambiguous when another velocity within it "
                         f"explains the measurement (default {MAX_RADIAL_SPEED_MPS:g})")
+
+
+def add_command(sub: argparse._SubParsersAction, name: str, summary: str,
+                description: str) -> argparse.ArgumentParser:
+    """A ``radar`` subcommand's parser: ``summary`` in ``radar --help``, ``description`` (one
+    paragraph; its line breaks and indentation are re-wrapped) on the command's own page."""
+    return sub.add_parser(name, help=summary, description=" ".join(description.split()))

@@ -17,6 +17,7 @@ from host.pipeline import DetectionParams
 from model.reference import range_doppler_power
 from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
+from radar.common import add_command
 from radar.figures import truth_range_doppler, truth_xy
 from radar.frame_cloud import frame_cloud
 from radar.objects import gnn_objects, object_boxes
@@ -129,15 +130,12 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
-    m = sub.add_parser(
-        "demo", help="the paper's Table I scene end to end, with figures",
-        description="Simulate the paper's Table I scene, run the FPGA chain (bit-accurate "
-                    "model) "
-                    "and host processing, print a Table III style comparison (with the "
-                    "paper's hardware errors beside ours) and write the figures: channel-0 "
-                    "range-Doppler map and its threshold (paper Fig. 6), range-azimuth "
-                    "with and without TX beamforming (Fig. 5), the non-coherent "
-                    "range-Doppler map and the x-y point cloud.")
+    m = add_command(sub, "demo", "the paper's Table I scene end to end, with figures", """
+        Simulate the paper's Table I scene, run the FPGA chain (bit-accurate model) and host
+        processing, print a Table III style comparison (with the paper's hardware errors beside
+        ours) and write the figures: channel-0 range-Doppler map and its threshold (paper Fig. 6),
+        range-azimuth with and without TX beamforming (Fig. 5), the non-coherent range-Doppler map
+        and the x-y point cloud.""")
     m.add_argument("--out", default="out", help="folder for figures and JSON (default out/)")
     m.add_argument("--preset", choices=presets, default="full",
                    help="radar preset (default full)")

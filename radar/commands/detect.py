@@ -30,6 +30,7 @@ from model.observability import scene_report
 from model.simulate import simulate_scene
 from radar.common import (
     CliError,
+    add_command,
     add_detection_options,
     count,
     detection_params,
@@ -170,11 +171,9 @@ def add_fpga_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
-    d = sub.add_parser(
-        "detect", help="scene -> point cloud JSON",
-        description="Simulate frames of a scene, run them through the FPGA chain (a model "
-                    "of it or the RTL) and the host processing, and write the point cloud "
-                    "JSON of DESIGN.md section 4.")
+    d = add_command(sub, "detect", "scene -> point cloud JSON", """
+        Simulate frames of a scene, run them through the FPGA chain (a model of it or the RTL) and
+        the host processing, and write the point cloud JSON of DESIGN.md section 4.""")
     d.add_argument("--scene", required=True, help="scene JSON file or built-in name (table1)")
     d.add_argument("--json", required=True, help="output point cloud .json")
     d.add_argument("--backend", choices=list(SOURCES), default="model",

@@ -28,6 +28,7 @@ from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, detect_config_of, fpga_config
 from radar.common import (
     CliError,
+    add_command,
     add_detection_options,
     check,
     count,
@@ -201,11 +202,11 @@ def cmd_receive(args: argparse.Namespace) -> int:
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
-    c = sub.add_parser(
-        "capture", help="write the DMA packets of simulated frames to a capture file",
-        description="Simulate frames, run them through the bit-accurate model of the FPGA "
-                    "chain and write its DMA packets (header word + payload, exactly as the "
-                    "packetizer sends them) to a .dmacap file for `radar replay`.")
+    c = add_command(
+        sub, "capture", "write the DMA packets of simulated frames to a capture file", """
+        Simulate frames, run them through the bit-accurate model of the FPGA chain and write its
+        DMA packets (header word + payload, exactly as the packetizer sends them) to a .dmacap
+        file for `radar replay`.""")
     c.add_argument("--scene", required=True, help="scene JSON file or built-in name")
     c.add_argument("--out", required=True, help="output .dmacap file")
     c.add_argument("--frames", type=int, default=3,
@@ -222,10 +223,9 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     add_detection_options(c)
     c.set_defaults(func=cmd_capture)
 
-    r = sub.add_parser(
-        "replay", help="send a capture over UDP as the board would",
-        description="Send each packet of a .dmacap capture as one UDP datagram, paced to "
-                    "a bit rate, optionally with injected loss, duplication and reordering.")
+    r = add_command(sub, "replay", "send a capture over UDP as the board would", """
+        Send each packet of a .dmacap capture as one UDP datagram, paced to a bit rate,
+        optionally with injected loss, duplication and reordering.""")
     r.add_argument("--capture", required=True, help=".dmacap file")
     r.add_argument("--host", default="127.0.0.1", help="destination address (default "
                                                        "127.0.0.1)")
@@ -240,11 +240,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     r.add_argument("--seed", type=int, default=0, help="seed of the injected faults")
     r.set_defaults(func=cmd_replay)
 
-    v = sub.add_parser(
-        "receive", help="receive DMA packets over UDP and write the point cloud",
-        description="Receive UDP datagrams (one DMA packet each), reassemble frames, report "
-                    "lost/repeated/reordered/corrupt packets, and run host processing on "
-                    "every complete frame.")
+    v = add_command(sub, "receive", "receive DMA packets over UDP and write the point cloud", """
+        Receive UDP datagrams (one DMA packet each), reassemble frames, report
+        lost/repeated/reordered/corrupt packets, and run host processing on every complete
+        frame.""")
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: learnt from the first packet's header)")
     v.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")

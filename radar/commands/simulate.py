@@ -9,7 +9,7 @@ import numpy as np
 from host.params import MAX_RADIAL_SPEED_MPS
 from model.observability import scene_report
 from model.simulate import MAX_FRAME_INDEX, check_frame_index, simulate_scene
-from radar.common import CliError, out_file, scene_of, warn
+from radar.common import CliError, add_command, out_file, scene_of, warn
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -34,11 +34,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
-    s = sub.add_parser(
-        "simulate", help="simulate one frame of ADC samples",
-        description="Simulate one frame of a scene and write the ADC samples as a complex64 "
-                    ".npy array of shape (NUM_TX*N_DOPPLER chirps in transmit order, NUM_RX, "
-                    "N_RANGE samples) holding the integer int16 I/Q codes the FPGA receives.")
+    s = add_command(sub, "simulate", "simulate one frame of ADC samples", """
+        Simulate one frame of a scene and write the ADC samples as a complex64 .npy array of shape
+        (NUM_TX*N_DOPPLER chirps in transmit order, NUM_RX, N_RANGE samples) holding the integer
+        int16 I/Q codes the FPGA receives.""")
     s.add_argument("--scene", required=True,
                    help="scene JSON file, or the name of a built-in scene (table1)")
     s.add_argument("--out", required=True, help="output .npy file")

@@ -34,6 +34,7 @@ from model.config import PRESETS, RadarConfig, get_preset
 from model.radar_pipeline import PipelineParams
 from model.scene import load_scene
 from model.simulate import simulate_scene
+from radar import common
 from radar.commands.detect import add_fpga_options, detect_config_of
 from radar.common import (
     CliError,
@@ -239,15 +240,14 @@ def cmd_view(args: argparse.Namespace) -> int:
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
-    v = sub.add_parser(
-        "view", help="live browser view: range-Doppler maps, point cloud, link health",
-        description="Serve a live view (like TI's mmWave Demo Visualizer) at "
-                    "http://HOST:PORT/: range-Doppler map of one virtual channel and the "
-                    "integrated map, x-y point cloud coloured by velocity with GNN boxes, "
-                    "range profile and link health (frames/s, lost packets, damaged frames, "
-                    "sticky hardware flags, detections per frame). The source is a UDP "
-                    "stream (default), a replayed capture or a simulated scene. Every asset "
-                    "is served from the package: no internet needed.")
+    v = common.add_command(
+        sub, "view", "live browser view: range-Doppler maps, point cloud, link health", """
+        Serve a live view (like TI's mmWave Demo Visualizer) at http://HOST:PORT/: range-Doppler
+        map of one virtual channel and the integrated map, x-y point cloud coloured by velocity
+        with GNN boxes, range profile and link health (frames/s, lost packets, damaged frames,
+        sticky hardware flags, detections per frame). The source is a UDP stream (default), a
+        replayed capture or a simulated scene. Every asset is served from the package: no
+        internet needed.""")
     src = v.add_mutually_exclusive_group()
     src.add_argument("--replay", metavar="FILE.dmacap",
                      help="replay a capture (from `radar capture`), looped")
@@ -255,14 +255,14 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     src.add_argument("--udp-port", type=int, default=0,
                      help="receive DMA packets on this UDP port (default source; 0 = any "
                           "free port, printed)")
-    v.add_argument("--udp-host", default="127.0.0.1",
-                   help="address the UDP receiver binds (default 127.0.0.1)")
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: the capture's geometry, the scene's preset, "
                         "or for UDP learnt from the packet headers)")
     v.add_argument("--packet-words", type=int, default=None,
                    help="PACKET_WORDS of a UDP stream (default: learnt from the packet "
                         "headers, as radar receive does)")
+    v.add_argument("--udp-host", default="127.0.0.1",
+                   help="address the UDP receiver binds (default 127.0.0.1)")
     v.add_argument("--host", default="127.0.0.1",
                    help="address the web page is served on (default 127.0.0.1)")
     v.add_argument("--port", type=int, default=DEFAULT_PORT,
