@@ -162,12 +162,19 @@ def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleP
 
 def _relax(xs: np.ndarray, noise: np.ndarray, params: AngleParams) -> AngleArrays:
     """RELAX (``host._angle_relax.relax_rows``) of rows xs, complex (m, n), noise float (m,)
-    per channel: the components strongest first, without those that collapsed onto a
-    stronger one during refinement (within 0.5 / n in sin(az))."""
-    n = xs.shape[1]
+    per channel, as :func:`_kept_components`."""
     s_c, a_c, count = relax_rows(xs, noise, params.n_fft, params.max_targets,
                                  params.refine_iterations, params.min_snr_db,
                                  params.dynamic_range_db)
+    return _kept_components(s_c, a_c, count, noise, xs.shape[1])
+
+
+def _kept_components(s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray, noise: np.ndarray,
+                     n: int) -> AngleArrays:
+    """The components found per row (sin s_c float (m, k), amplitude a_c complex (m, k), the
+    first count int (m,) slots of each row valid; noise float (m,) per channel, n channels)
+    strongest first (a stable sort), without those that collapsed onto a stronger one during
+    refinement (within 0.5 / n in sin(az)), as flat :class:`AngleArrays`."""
     kmax = s_c.shape[1]
     with np.errstate(divide="ignore"):
         snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots

@@ -16,7 +16,6 @@ import pytest
 from host.angle import AngleParams, estimate_angles
 from host.cells import Cells, peak_offsets
 from host.pipeline import DetectionParams, detect_cells
-from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from host.record_points import process_records, record_cells, select_records
 from host.records import (
@@ -53,6 +52,7 @@ from tests.oracles.angle import (
     screened_components,
 )
 from tests.oracles.points import (
+    assert_same_cloud,
     choose_fold,
     points_from_cells_numpy,
     points_from_cells_reference,
@@ -236,14 +236,8 @@ def test_points_match_reference(preset: str) -> None:
     arr = record_arrays(recs, cfg.n_virtual, 37.0)
     params = DetectionParams()
     new = process_records(arr, cfg, params)
-    old = process_records_reference(arr, cfg, params)
-    assert len(new) == len(old) > 0
-    for f in fields(new):
-        a, b = getattr(new, f.name), getattr(old, f.name)
-        if a.dtype.kind in "fc":
-            np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9, err_msg=f.name)
-        else:
-            np.testing.assert_array_equal(a, b, err_msg=f.name)
+    assert len(new) > 0
+    assert_same_cloud(new, process_records_reference(arr, cfg, params))
     idx = select_records(arr, cfg, params)
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
     off = np.zeros((len(idx), 2))
@@ -253,16 +247,6 @@ def test_points_match_reference(preset: str) -> None:
                                     off, cfg, params)
     np.testing.assert_allclose(a.azimuth_deg, b.azimuth_deg, atol=1e-9)
     np.testing.assert_array_equal(a.doppler_bin, b.doppler_bin)
-
-
-def _same_cloud(a: PointCloud, b: PointCloud) -> None:
-    assert len(a) == len(b)
-    for f in fields(a):
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if x.dtype.kind in "fc":
-            np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9, err_msg=f.name)
-        else:
-            np.testing.assert_array_equal(x, y, err_msg=f.name)
 
 
 def test_decoder_frames_are_arrays_with_the_reference_records() -> None:
@@ -332,7 +316,7 @@ def test_process_records_is_the_reference_on_synthetic_frames(preset: str) -> No
                        DetectionParams(max_speed_mps=5.0),     # cells with no hypothesis
                        DetectionParams(unfold_velocity=False, sidelobe_margin_db=None)):
             new = process_records(arr, cfg, params, frame=3)
-            _same_cloud(new, process_records_reference(arr, cfg, params, frame=3))
+            assert_same_cloud(new, process_records_reference(arr, cfg, params, frame=3))
         assert len(new) > 0.8 * big
     empty = record_arrays([], cfg.n_virtual)
     assert len(process_records(empty, cfg)) == 0 == len(process_records_reference(empty, cfg))
@@ -360,10 +344,10 @@ def test_table1_full_cells_as_records() -> None:
                        cm.neighbours(nci)[cells[:, 0], cells[:, 1]])
     new = process_records(arr, cfg, params)
     assert len(new) >= 4
-    _same_cloud(new, process_records_reference(arr, cfg, params))
+    assert_same_cloud(new, process_records_reference(arr, cfg, params))
     off = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
     cube_cells = Cells(cells[:, 0], cells[:, 1], arr.power, noise, off, arr.snapshot)
-    _same_cloud(points_from_cells(cube_cells, cfg, params),
+    assert_same_cloud(points_from_cells(cube_cells, cfg, params),
                 points_from_cells_numpy(cells, arr.snapshot, arr.power, noise, off, cfg,
                                         params))
 
@@ -381,7 +365,7 @@ def test_random_scenes_through_the_chain() -> None:
         f = [f for p in packetize_stream([out.records], chain.packet_words)
              for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
         arr = record_arrays(f[0].records, cfg.n_virtual, chain_gain(cfg, chain))
-        _same_cloud(process_records(arr, cfg, params),
+        assert_same_cloud(process_records(arr, cfg, params),
                     process_records_reference(arr, cfg, params))
 
 

@@ -20,6 +20,7 @@ import scipy.fft
 from host._angle_peaks import COARSE_FFT, SECOND_LOBE, ZOOM_HALF
 from host._angle_peaks import zoom_tables as _zoom_tables
 from host.angle import AngleArrays, AngleParams
+from host.angle import _kept_components as kept_components
 from model.reference import angle_spectrum
 
 
@@ -260,19 +261,32 @@ def _components(xs: np.ndarray, noise: np.ndarray, params: AngleParams, s1: np.n
                        np.concatenate([snr1[single], snr])[order])
 
 
+def _first_peaks(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
+                 first_sin: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows complex128 (n, n_ch), noise per channel >= 1e-30 float (n,), the rows'
+    strongest peak sin(az) float (n,): ``first_sin`` or :func:`peak_sin_fast`)."""
+    xs = np.asarray(x, dtype=np.complex128)
+    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
+    if not len(xs):
+        return xs, noise, np.zeros(0)
+    return xs, noise, peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
+
+
+def _no_components() -> AngleArrays:
+    z = np.zeros(0)
+    return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
+
+
 def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
                          first_sin: np.ndarray | None = None) -> AngleArrays:
     """:func:`estimate_angles_batch` as flat arrays, the angle peaks by :func:`fine_peaks`
     (no ``n_fft``-point FFT); rows with a second component go through
     :func:`estimate_angles` one by one, as there. ``first_sin``: float (n,) the rows'
     strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
-    xs = np.asarray(x, dtype=np.complex128)
+    xs, noise, s1 = _first_peaks(x, noise_per_channel, params, first_sin)
+    if not len(xs):
+        return _no_components()
     n_rows, n = xs.shape
-    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
-    if not n_rows:
-        z = np.zeros(0)
-        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
-    s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
     st1 = _steering_rows(s1, n)
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2
@@ -301,13 +315,10 @@ def estimate_angles_screened(x: np.ndarray, noise_per_channel: np.ndarray, param
 
     x: complex (n, n_channels); noise_per_channel: float (n,); first_sin: float (n,) the
     rows' strongest peak (:func:`peak_sin_fast`) when the caller has it already."""
-    xs = np.asarray(x, dtype=np.complex128)
+    xs, noise, s1 = _first_peaks(x, noise_per_channel, params, first_sin)
+    if not len(xs):
+        return _no_components()
     n_rows, n = xs.shape
-    noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
-    if not n_rows:
-        z = np.zeros(0)
-        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
-    s1 = peak_sin_fast(xs, params.n_fft)[0] if first_sin is None else first_sin
     a1, p1, maybe = first_component_screen(xs, noise, params, s1)
     return screened_components(xs, noise, params, s1, a1, p1, maybe)
 
@@ -479,30 +490,6 @@ RowsEstimator = Callable[[np.ndarray, np.ndarray, AngleParams], AngleArrays]
 """A function (x complex (m, n), noise_per_channel float (m,), params) -> the
 :class:`AngleArrays` of :func:`estimate_angles_rows`: that function with its default peak
 search, or the compiled ``host._angle_relax.relax_rows``."""
-
-
-def kept_components(s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray, noise: np.ndarray,
-                    n: int) -> AngleArrays:
-    """The end of :func:`estimate_angles_rows`: the components found per row (sin s_c float
-    (m, k), amplitude a_c complex (m, k), the first count int (m,) slots of each row valid;
-    noise float (m,) per channel, n channels) strongest first, without the collapsed ones,
-    as flat :class:`AngleArrays`."""
-    kmax = s_c.shape[1]
-    with np.errstate(divide="ignore"):
-        snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
-    # per row: strongest first (a stable sort, as sorted()), then drop collapsed components
-    # (within 0.5 / n in sin of a kept, stronger one); all rows at once
-    valid = np.arange(kmax)[None, :] < count[:, None]
-    order = np.argsort(np.where(valid, -np.abs(a_c), np.inf), axis=1, kind="stable")
-    s_o = np.take_along_axis(s_c, order, axis=1)
-    kept = np.take_along_axis(valid, order, axis=1)
-    for p in range(kmax):
-        for u in range(p):
-            kept[:, p] &= ~kept[:, u] | (np.abs(s_o[:, p] - s_o[:, u]) > 0.5 / n)
-    rows, pos = np.nonzero(kept)
-    comp = order[rows, pos]
-    return AngleArrays(rows.astype(np.int64), s_c[rows, comp], a_c[rows, comp],
-                       snr_c[rows, comp])
 
 
 def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams

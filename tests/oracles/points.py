@@ -15,6 +15,8 @@ its tests).
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 import numpy as np
 
 from host.cells import peak_offsets
@@ -88,6 +90,18 @@ def class_powers(x: np.ndarray, cfg: RadarConfig, k: np.ndarray, n_fft: int) -> 
     return peak_power_batch(x[:, None, :] * comp, n_fft)
 
 
+def _cell_values(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
+                 noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig
+                 ) -> tuple[np.ndarray, ...]:
+    """(range bins int (n,), snapshots, noise float (n,), signed Doppler bins int (n,), cell
+    SNR dB float (n,), measured (aliased) velocity m/s float (n,)) of detected cells."""
+    sb = signed_bins(cfg.n_doppler)[np.asarray(cells[:, 1])].astype(np.int64)
+    noise = np.asarray(noise, dtype=float)
+    return (np.asarray(cells[:, 0]), np.asarray(snapshots), noise, sb,
+            cell_snr_db(power, noise, cfg.n_virtual),
+            (sb + offsets[:, 1]) * cfg.velocity_bin_mps)
+
+
 def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power: np.ndarray,
                                 noise: np.ndarray, offsets: np.ndarray, cfg: RadarConfig,
                                 params: DetectionParams, frame: int = 0) -> PointCloud:
@@ -108,13 +122,8 @@ def points_from_cells_reference(cells: np.ndarray, snapshots: np.ndarray, power:
     if not n:
         return PointCloud.empty()
     nd, nv = cfg.n_doppler, cfg.n_virtual
-    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
-    x = np.asarray(snapshots)
-    noise = np.asarray(noise, dtype=float)
-    dd = offsets[:, 1]
-    sb = signed_bins(nd)[d].astype(np.int64)
-    snr_db = cell_snr_db(power, noise, nv)
-    measured = (sb + dd) * cfg.velocity_bin_mps
+    r, x, noise, sb, snr_db, measured = _cell_values(cells, snapshots, power, noise, offsets,
+                                                     cfg)
     # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
     class_power = (class_powers(x, cfg, sb, params.angle.n_fft)
                    if cfg.num_tx > 1 and params.unfold_velocity else np.zeros((n, 0)))
@@ -152,25 +161,14 @@ def points_from_cells_numpy(cells: np.ndarray, snapshots: np.ndarray, power: np.
     ``host.pipeline``'s docstring). Vectorised over the cells: the TDM hypotheses' phasors,
     their angle peaks (coarse FFT + fine-grid search, ``tests.oracles.angle.fine_peaks``, the
     same peaks as ``AngleParams.n_fft``-point FFTs), the unfolding decision
-    (:func:`choose_folds`) and the angles run on all cells at once.
-
-    cells: int (n, 2) of (range_bin, doppler_bin natural order); snapshots: complex
-    (n, n_virtual) the cells' Doppler-FFT values per virtual channel (cube units, LSB);
-    power: float (n,) non-coherent power sum_v |x_v|^2; noise: float (n,) mean noise power
-    per cell of the non-coherent map; offsets: float (n, 2) fractional (range, Doppler)
-    offsets of the peak from the cell centre, bins.
-    """
+    (:func:`choose_folds`) and the angles run on all cells at once. Arguments as
+    :func:`points_from_cells_reference`."""
     n = len(cells)
     if not n:
         return PointCloud.empty()
     nd, nv = cfg.n_doppler, cfg.n_virtual
-    r, d = np.asarray(cells[:, 0]), np.asarray(cells[:, 1])
-    x = np.asarray(snapshots)
-    noise = np.asarray(noise, dtype=float)
-    dd = offsets[:, 1]
-    sb = signed_bins(nd)[d].astype(np.int64)
-    snr_db = cell_snr_db(power, noise, nv)
-    measured = (sb + dd) * cfg.velocity_bin_mps
+    r, x, noise, sb, snr_db, measured = _cell_values(cells, snapshots, power, noise, offsets,
+                                                     cfg)
     # step 3: TDM hypothesis powers of every cell and class in one batch, then the decision
     if cfg.num_tx > 1 and params.unfold_velocity:
         c = np.arange(cfg.num_tx)
@@ -239,3 +237,16 @@ def process_cube_reference(cube: np.ndarray, cfg: RadarConfig,
     r, d = cells[:, 0], cells[:, 1]
     return points_from_cells_numpy(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg,
                                    params, frame)
+
+
+def assert_same_cloud(a: PointCloud, b: PointCloud) -> None:
+    """The tests' "same cloud": as many points, integer and flag fields equal, float fields
+    within 1e-9 (relative and absolute; the library evaluates the same sums, partly in
+    another order)."""
+    assert len(a) == len(b)
+    for f in fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if x.dtype.kind in "fc":
+            np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9, err_msg=f.name)
+        else:
+            np.testing.assert_array_equal(x, y, err_msg=f.name)
