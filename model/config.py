@@ -37,6 +37,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from model.profile_fields import PROFILE_FIELDS, check_profile_fields, unsupported_features
+
 C0 = 299_792_458.0
 """Speed of light in vacuum, m/s."""
 BOLTZMANN = 1.380649e-23
@@ -89,11 +91,13 @@ class RadarConfig:
     num_rx: int
     """Receive lanes (RX elements), one ADC lane each."""
     n_range: int
-    """Complex samples per chirp = range FFT length (power of two, 16..4096)."""
+    """Range FFT length (power of two, 16..4096); the ADC samples of a chirp
+    (``n_samples``) are zero-padded to it."""
     n_doppler: int
-    """Chirps per TX per frame = Doppler FFT length (power of two, 16..4096)."""
+    """Doppler FFT length (power of two, 16..4096); the chirp loops of a frame (``n_loops``,
+    chirps per TX) are zero-padded to it."""
     sample_rate_hz: float
-    """Complex (I/Q) ADC sample rate, Hz."""
+    """ADC sample rate (complex I/Q pairs, or real samples for a real ADC), Hz."""
     chirp_period_s: float
     """Chirp repetition interval Tc between consecutive chirps (any TX), s."""
     design_max_range_m: float
@@ -101,7 +105,7 @@ class RadarConfig:
     fc_hz: float = 77e9
     """Carrier (start) frequency, Hz."""
     sweep_bandwidth_hz: float = 86.77e6
-    """Bandwidth swept during the sampled part of the ramp, Hz."""
+    """Bandwidth swept during the sampled part of the ramp (``n_samples`` samples), Hz."""
     adc_bits: int = 16
     """ADC resolution per I and per Q, bits (two's complement)."""
     tx_power_dbm: float = 13.0
@@ -126,10 +130,31 @@ class RadarConfig:
     """Received power at the RX antenna port of a tone that just reaches ADC full scale, dBm.
     Sets the receive gain; at -33 dBm thermal noise sits near -54 dBFS (about 60 LSB rms),
     well above the quantisation floor and far from clipping."""
+    # ---- profile fields (docs/profiles.md); the defaults are the presets' behaviour ----------
+    samples_per_chirp: int | None = None
+    """ADC samples per chirp, 8..n_range (None: n_range, no zero padding)."""
+    loops: int | None = None
+    """Chirp loops per frame, 1..n_doppler; one loop fires every TX once (None: n_doppler)."""
+    tx_order: tuple[int, ...] | None = None
+    """TX index fired in each chirp slot of a loop, a permutation of 0..num_tx-1
+    (None: 0, 1, ..., num_tx-1)."""
+    adc: str = "complex"
+    """ADC kind: ``complex`` (I/Q) or ``real``."""
+    tx_positions: tuple[tuple[float, float], ...] | None = None
+    """(horizontal, vertical) phase centre of each TX in half-wavelengths at fc_hz
+    (None: TX k at (k * num_rx, 0), the contiguous virtual ULA of DESIGN section 2)."""
+    rx_positions: tuple[tuple[float, float], ...] | None = None
+    """(horizontal, vertical) position of each RX in half-wavelengths (None: RX r at (r, 0))."""
+    frame_period_s: float | None = None
+    """Frame repetition period, s (None: frames back to back, ``frame_time_s``)."""
+    max_speed_mps: float | None = None
+    """Fastest radial speed the profile expects, m/s (None: the host's default)."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
+            if f.name in PROFILE_FIELDS:
+                continue
             if f.name == "name":
                 if not isinstance(value, str) or not value:
                     raise ValueError("name: must be a non-empty string")
@@ -162,13 +187,16 @@ class RadarConfig:
             raise ValueError(
                 f"chirp_period_s: {self.chirp_period_s * 1e6:.3f} us is shorter than the sampled "
                 f"ramp n_range/sample_rate_hz = {self.sampled_chirp_s * 1e6:.3f} us")
+        check_profile_fields(self)
         beat = self.beat_frequency_hz(self.design_max_range_m)
-        if beat >= self.sample_rate_hz:
+        if beat >= self.if_bandwidth_hz:
             raise ValueError(
                 f"design_max_range_m: beat frequency {beat / 1e6:.2f} MHz of "
-                f"{self.design_max_range_m} m is at or above sample_rate_hz "
-                f"{self.sample_rate_hz / 1e6:.2f} MHz (complex sampling); raise the sample "
-                f"rate or lower the range")
+                f"{self.design_max_range_m} m is at or above "
+                + (f"sample_rate_hz {self.sample_rate_hz / 1e6:.2f} MHz (complex sampling)"
+                   if self.adc == "complex" else
+                   f"half of sample_rate_hz, {self.if_bandwidth_hz / 1e6:.2f} MHz (real "
+                   f"sampling)") + "; raise the sample rate or lower the range")
 
     # ---- waveform -------------------------------------------------------------------------
     @property
@@ -177,9 +205,29 @@ class RadarConfig:
         return C0 / self.fc_hz
 
     @property
+    def n_samples(self) -> int:
+        """ADC samples per chirp (``samples_per_chirp``, else n_range)."""
+        return self.n_range if self.samples_per_chirp is None else self.samples_per_chirp
+
+    @property
+    def n_loops(self) -> int:
+        """Chirp loops per frame = chirps per TX (``loops``, else n_doppler)."""
+        return self.n_doppler if self.loops is None else self.loops
+
+    @property
+    def tx_sequence(self) -> tuple[int, ...]:
+        """TX index fired in each chirp slot of a loop (``tx_order``, else 0..num_tx-1)."""
+        return tuple(range(self.num_tx)) if self.tx_order is None else self.tx_order
+
+    @property
+    def if_bandwidth_hz(self) -> float:
+        """Largest beat frequency the ADC samples unambiguously: fs (complex), fs / 2 (real)."""
+        return self.sample_rate_hz if self.adc == "complex" else self.sample_rate_hz / 2.0
+
+    @property
     def sampled_chirp_s(self) -> float:
-        """Duration of the sampled part of the ramp, n_range / fs, s."""
-        return self.n_range / self.sample_rate_hz
+        """Duration of the sampled part of the ramp, n_samples / fs, s."""
+        return self.n_samples / self.sample_rate_hz
 
     @property
     def slope_hz_per_s(self) -> float:
@@ -193,24 +241,27 @@ class RadarConfig:
 
     @property
     def frame_time_s(self) -> float:
-        """Duration of one frame (coherent processing interval), num_tx * n_doppler * Tc, s."""
-        return self.num_tx * self.n_doppler * self.chirp_period_s
+        """Duration of one frame's chirps (coherent processing interval), num_tx * n_loops *
+        Tc, s."""
+        return self.num_tx * self.n_loops * self.chirp_period_s
 
     @property
     def n_chirps(self) -> int:
-        """Chirps per frame in transmit order, num_tx * n_doppler."""
-        return self.num_tx * self.n_doppler
+        """Chirps per frame in transmit order, num_tx * n_loops."""
+        return self.num_tx * self.n_loops
 
     # ---- range ----------------------------------------------------------------------------
     @property
     def range_bin_m(self) -> float:
-        """Range bin c / (2 B), m (1.7275 m for both presets)."""
-        return C0 / (2.0 * self.sweep_bandwidth_hz)
+        """Range-FFT bin c / (2 B) * n_samples / n_range, m (1.7275 m for both presets; the
+        range resolution c / (2 B) when there is no zero padding)."""
+        return C0 / (2.0 * self.sweep_bandwidth_hz) * (self.n_samples / self.n_range)
 
     @property
     def max_range_m(self) -> float:
-        """Largest unambiguous range, n_range * range_bin (beat frequency = fs), m."""
-        return self.n_range * self.range_bin_m
+        """Largest unambiguous range, m: n_range * range_bin (beat frequency = fs) for a
+        complex ADC, half of it (fs / 2) for a real one."""
+        return self.n_range * self.range_bin_m * self.if_bandwidth_hz / self.sample_rate_hz
 
     @property
     def detection_bins(self) -> tuple[int, int]:
@@ -241,7 +292,7 @@ class RadarConfig:
     # ---- velocity -------------------------------------------------------------------------
     @property
     def velocity_bin_mps(self) -> float:
-        """Doppler bin lambda / (2 * n_doppler * num_tx * Tc), m/s."""
+        """Doppler-FFT bin lambda / (2 * n_doppler * num_tx * Tc), m/s."""
         return self.wavelength_m / (2.0 * self.n_doppler * self.tx_repetition_s)
 
     @property
@@ -256,13 +307,45 @@ class RadarConfig:
     # ---- angle ----------------------------------------------------------------------------
     @property
     def n_virtual(self) -> int:
-        """Virtual channels num_tx * num_rx (virtual ULA length)."""
+        """Virtual channels num_tx * num_rx; channel v = tx * num_rx + rx."""
         return self.num_tx * self.num_rx
 
     @property
+    def tx_positions_hw(self) -> np.ndarray:
+        """TX phase centres (horizontal, vertical) in half-wavelengths, float (num_tx, 2)."""
+        if self.tx_positions is None:
+            return np.stack([np.arange(self.num_tx) * float(self.num_rx),
+                             np.zeros(self.num_tx)], axis=1)
+        return np.array(self.tx_positions, dtype=float).reshape(self.num_tx, 2)
+
+    @property
+    def rx_positions_hw(self) -> np.ndarray:
+        """RX positions (horizontal, vertical) in half-wavelengths, float (num_rx, 2)."""
+        if self.rx_positions is None:
+            return np.stack([np.arange(self.num_rx, dtype=float), np.zeros(self.num_rx)],
+                            axis=1)
+        return np.array(self.rx_positions, dtype=float).reshape(self.num_rx, 2)
+
+    @property
+    def virtual_positions_hw(self) -> np.ndarray:
+        """Virtual element (tx, rx) at tx + rx, half-wavelengths, float (n_virtual, 2),
+        row v = tx * num_rx + rx."""
+        return (self.tx_positions_hw[:, None, :] + self.rx_positions_hw[None, :, :]).reshape(
+            self.n_virtual, 2)
+
+    @property
+    def uniform_linear_array(self) -> bool:
+        """True when the virtual array is the contiguous horizontal lambda/2 ULA 0..n_virtual-1
+        in channel order (the array the angle estimators assume)."""
+        v = self.virtual_positions_hw
+        return bool(np.array_equal(v[:, 0], np.arange(self.n_virtual)) and not v[:, 1].any())
+
+    @property
     def angle_resolution_rad(self) -> float:
-        """Boresight angle resolution 2 / n_virtual for a lambda/2 ULA, rad."""
-        return 2.0 / self.n_virtual
+        """Boresight azimuth resolution 2 / (horizontal aperture + 1) with the aperture in
+        half-wavelengths (2 / n_virtual for the lambda/2 ULA), rad."""
+        h = self.virtual_positions_hw[:, 0]
+        return 2.0 / float(h.max() - h.min() + 1.0)
 
     @property
     def angle_resolution_deg(self) -> float:
@@ -272,8 +355,9 @@ class RadarConfig:
     # ---- data path ------------------------------------------------------------------------
     @property
     def data_rate_per_lane_bps(self) -> float:
-        """ADC burst data rate of one RX lane, fs * 2 * adc_bits, bit/s."""
-        return self.sample_rate_hz * 2 * self.adc_bits
+        """ADC burst data rate of one RX lane, fs * 2 * adc_bits (complex) or fs * adc_bits
+        (real), bit/s."""
+        return self.sample_rate_hz * (2 if self.adc == "complex" else 1) * self.adc_bits
 
     @property
     def adc_full_scale(self) -> int:
@@ -283,8 +367,8 @@ class RadarConfig:
     # ---- array shapes ---------------------------------------------------------------------
     @property
     def adc_shape(self) -> tuple[int, int, int]:
-        """Shape of one ADC frame: (n_chirps in transmit order, num_rx, n_range samples)."""
-        return (self.n_chirps, self.num_rx, self.n_range)
+        """Shape of one ADC frame: (n_chirps in transmit order, num_rx, n_samples)."""
+        return (self.n_chirps, self.num_rx, self.n_samples)
 
     @property
     def cube_shape(self) -> tuple[int, int, int]:
@@ -293,17 +377,33 @@ class RadarConfig:
 
     def check_adc(self, adc: np.ndarray, what: str = "adc") -> None:
         """ValueError naming the expected and actual shape unless ``adc`` is one ADC frame
-        of this configuration, (n_chirps, num_rx, n_range)."""
+        of this configuration, (n_chirps, num_rx, n_range), and the chain can process it
+        (:meth:`check_processable`)."""
+        self.check_processable()
         if np.shape(adc) != self.adc_shape:
             raise ValueError(f"{what}: expected shape {self.adc_shape} (chirps, rx, samples) "
                              f"for preset {self.name!r}, got {np.shape(adc)}")
 
     def check_cube(self, cube: np.ndarray, what: str = "cube") -> None:
         """ValueError naming the expected and actual shape unless ``cube`` is one radar cube
-        of this configuration, (n_virtual, n_range, n_doppler)."""
+        of this configuration, (n_virtual, n_range, n_doppler), and the chain can process
+        it (:meth:`check_processable`)."""
+        self.check_processable()
         if np.shape(cube) != self.cube_shape:
             raise ValueError(f"{what}: expected shape {self.cube_shape} for preset "
                              f"{self.name!r}, got {np.shape(cube)}")
+
+    def unsupported_features(self) -> list[str]:
+        """What of this configuration the processing chain cannot handle yet, one phrase each
+        (empty for the presets; ``model.profile_fields.unsupported_features``)."""
+        return unsupported_features(self)
+
+    def check_processable(self) -> None:
+        """ValueError naming what the processing chain does not support yet, if anything."""
+        missing = self.unsupported_features()
+        if missing:
+            raise ValueError(f"radar {self.name!r}: the processing chain does not support "
+                             f"{'; '.join(missing)} yet")
 
     # ---- front end ------------------------------------------------------------------------
     @property

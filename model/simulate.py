@@ -165,7 +165,10 @@ def simulate_baseband(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = T
 
     Returns (complex128 (n_chirps, num_rx, n_range), scatterers not simulated: at or
     behind the radar (see :func:`passed_radar`) or beyond the IF band at the frame centre).
+    ValueError for a profile the simulator does not model yet
+    (``RadarConfig.check_processable``).
     """
+    cfg.check_processable()
     beat = cfg.beat_frequency_hz(frame_centre_range_m(cfg, sc, frame_index),
                                  sc.radial_velocity_mps)
     keep = (beat >= 0) & (beat < cfg.sample_rate_hz) & ~passed_radar(cfg, sc, frame_index)
