@@ -78,6 +78,13 @@ class RadarConfig:
     ``num_tx`` TX subarrays whose phase centres are ``num_rx * lambda/2`` apart, so virtual
     channel ``v = tx * num_rx + rx`` sits at ``v * lambda/2``: a contiguous ULA.
 
+    Radar profiles (docs/profiles.md, ``model.profile``) describe other radars through the
+    fields after ``adc_full_scale_dbm``: samples per chirp and loops below the FFT lengths
+    (zero padding), the TX firing order, a real ADC, 2-D / non-uniform array positions, the
+    frame period and the fastest expected speed. Their defaults are the presets' behaviour;
+    :meth:`unsupported_features` lists what of a profile the processing chain cannot handle
+    yet, and :meth:`check_adc` / :meth:`check_cube` refuse such a profile.
+
     RF front-end values (defaults documented in the README, "Radar equation"): TX power per
     subarray, element / subarray / RX gains at broadside (the paper's 10.87 dBi element and
     14.92 dBi 3-element subarray), cosine element field pattern ``cos(az)**element_cos_power``
@@ -183,11 +190,11 @@ class RadarConfig:
                 raise ValueError(f"{name}: must be positive, got {getattr(self, name)}")
         if self.noise_figure_db < 0:
             raise ValueError(f"noise_figure_db: must be >= 0 dB, got {self.noise_figure_db}")
+        check_profile_fields(self)
         if self.chirp_period_s < self.sampled_chirp_s:
             raise ValueError(
                 f"chirp_period_s: {self.chirp_period_s * 1e6:.3f} us is shorter than the sampled "
-                f"ramp n_range/sample_rate_hz = {self.sampled_chirp_s * 1e6:.3f} us")
-        check_profile_fields(self)
+                f"ramp n_samples/sample_rate_hz = {self.sampled_chirp_s * 1e6:.3f} us")
         beat = self.beat_frequency_hz(self.design_max_range_m)
         if beat >= self.if_bandwidth_hz:
             raise ValueError(
@@ -261,7 +268,7 @@ class RadarConfig:
     def max_range_m(self) -> float:
         """Largest unambiguous range, m: n_range * range_bin (beat frequency = fs) for a
         complex ADC, half of it (fs / 2) for a real one."""
-        return self.n_range * self.range_bin_m * self.if_bandwidth_hz / self.sample_rate_hz
+        return self.n_range * self.range_bin_m * (self.if_bandwidth_hz / self.sample_rate_hz)
 
     @property
     def detection_bins(self) -> tuple[int, int]:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -73,10 +74,11 @@ def default_max_range_m(cfg: RadarConfig) -> float:
     return cfg.max_range_m * (1.0 - NEGATIVE_BEAT_GUARD_BINS / cfg.n_range)
 
 
-def build_config(where: str, names: dict[str, str], **kw: object) -> RadarConfig:
-    """RadarConfig(**kw); a ValueError of a field is re-raised naming the field as the source
-    spells it (``names``: RadarConfig field -> source name) and prefixed with ``where``.
-    Without ``design_max_range_m`` the profile's :func:`default_max_range_m` is used."""
+def build_config(names: dict[str, str], **kw: object) -> RadarConfig:
+    """RadarConfig(**kw); a ValueError of a field (``field: ...`` or ``field[i]: ...``) is
+    re-raised naming the field as the source spells it (``names``: RadarConfig field ->
+    source name). Without ``design_max_range_m`` the profile's :func:`default_max_range_m`
+    is used."""
     try:
         if "design_max_range_m" in kw:
             return RadarConfig(**kw)  # type: ignore[arg-type]
@@ -84,7 +86,17 @@ def build_config(where: str, names: dict[str, str], **kw: object) -> RadarConfig
         return replace(cfg, design_max_range_m=default_max_range_m(cfg))
     except ValueError as exc:
         field, _, rest = str(exc).partition(": ")
-        raise ValueError(f"{where}: {names.get(field, field)}: {rest}") from None
+        base, bracket, index = field.partition("[")
+        raise ValueError(f"{names.get(base, base)}{bracket}{index}: {rest}") from None
+
+
+def sourced(parse: Callable[[str, str], Profile], text: str, source: str) -> Profile:
+    """``parse(text, source)`` with the one-line ValueError it raises prefixed by
+    ``source`` (the file a message is about)."""
+    try:
+        return parse(text, source)
+    except ValueError as exc:
+        raise ValueError(f"{source}: {exc}") from None
 
 
 # ---- TOML -----------------------------------------------------------------------------------
@@ -120,10 +132,11 @@ def _typed(table: dict, key: str, kind: type, where: str) -> object:
     ok = {int: lambda v: isinstance(v, int) and not isinstance(v, bool),
           float: lambda v: isinstance(v, int | float) and not isinstance(v, bool)
           and math.isfinite(v),
-          str: lambda v: isinstance(v, str), list: lambda v: isinstance(v, list)}[kind](value)
+          str: lambda v: isinstance(v, str), list: lambda v: isinstance(v, list),
+          bool: lambda v: isinstance(v, bool)}[kind](value)
     if not ok:
         what = {int: "an integer", float: "a finite number", str: "a string",
-                list: "a list"}[kind]
+                list: "a list", bool: "true or false"}[kind]
         raise ValueError(f"{where}.{key}: must be {what}, got {value!r}")
     return float(value) if kind is float else value
 
@@ -143,37 +156,25 @@ def _table(doc: dict, name: str, allowed: tuple[str, ...] | dict, required: bool
     return table
 
 
-def _positions(value: object, key: str) -> tuple[tuple[float, float], ...]:
-    """Array positions: a non-empty list of [horizontal, vertical] number pairs."""
+def _positions(value: object, key: str) -> tuple[object, ...]:
+    """Array positions as tuples (RadarConfig checks each is two numbers)."""
     if not isinstance(value, list) or not value:
         raise ValueError(f"{key}: must be a non-empty list of [horizontal, vertical] "
                          f"positions in half-wavelengths, got {value!r}")
-    out = []
-    for i, pos in enumerate(value):
-        if not isinstance(pos, list) or len(pos) != 2 or any(
-                isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x)
-                for x in pos):
-            raise ValueError(f"{key}[{i}]: must be two numbers [horizontal, vertical] in "
-                             f"half-wavelengths, got {pos!r}")
-        out.append((float(pos[0]), float(pos[1])))
-    return tuple(out)
+    return tuple(tuple(p) if isinstance(p, list) else p for p in value)
 
 
 def profile_from_toml(text: str, source: str = "<profile>") -> Profile:
     """The :class:`Profile` of a TOML profile's text (docs/profiles.md); ValueError
     ``"<source>: <key>: <reason>"`` on a missing or impossible field."""
+    return sourced(_profile_from_text, text, source)
+
+
+def _profile_from_text(text: str, source: str) -> Profile:
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{source}: not valid TOML: {exc}") from None
-    try:
-        return _profile_from_doc(doc, source)
-    except ValueError as exc:
-        msg = str(exc)
-        raise ValueError(msg if msg.startswith(f"{source}: ") else f"{source}: {msg}") from None
-
-
-def _profile_from_doc(doc: dict, source: str) -> Profile:
+        raise ValueError(f"not valid TOML: {exc}") from None
     for key in doc:
         if key not in ("name", "waveform", "array", "capture", "front_end"):
             raise ValueError(f"{key}: unknown key (known: name, [waveform], [array], "
@@ -223,13 +224,14 @@ def _profile_from_doc(doc: dict, source: str) -> Profile:
         kw["design_max_range_m"] = w["max_range_m"]
     kw.update({k: _typed(fe, k, int if k == "subarray_elements" else float, "front_end")
                for k in fe})
-    cfg = normalised(build_config(source, _TOML_NAMES, **kw))
+    cfg = normalised(build_config(_TOML_NAMES, **kw))
     if cfg.max_speed_mps is None:
         cfg = replace(cfg, max_speed_mps=cfg.max_velocity_mps)
     capture = CaptureFormat(
         format=_typed(cap, "format", str, "capture") if "format" in cap else "dca1000",
         lanes=_typed(cap, "lanes", int, "capture") if "lanes" in cap else 2,
-        interleaved=cap.get("interleaved", False))
+        interleaved=_typed(cap, "interleaved", bool, "capture") if "interleaved" in cap
+        else False)
     return Profile(config=cfg, capture=capture, source=source)
 
 

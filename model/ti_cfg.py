@@ -21,7 +21,15 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from model.profile import Calibration, CaptureFormat, Profile, build_config, next_pow2, normalised
+from model.profile import (
+    Calibration,
+    CaptureFormat,
+    Profile,
+    build_config,
+    next_pow2,
+    normalised,
+    sourced,
+)
 
 READ = {"channelCfg": 3, "adcCfg": 2, "profileCfg": 14, "frameCfg": 7}
 """Commands read exactly once, with their argument counts."""
@@ -147,11 +155,7 @@ def _tx_order(single: dict[str, list[float]], chirps: list[list[float]]
 def profile_from_cfg(text: str, source: str = "<cfg>") -> Profile:
     """The :class:`Profile` of a TI mmWave SDK ``.cfg`` text; ValueError ``"<source>:
     <command>: <reason>"`` on an unknown, missing, repeated or contradictory command."""
-    try:
-        return _profile(text, source)
-    except ValueError as exc:
-        msg = str(exc)
-        raise ValueError(msg if msg.startswith(f"{source}: ") else f"{source}: {msg}") from None
+    return sourced(_profile, text, source)
 
 
 def _profile(text: str, source: str) -> Profile:
@@ -192,7 +196,7 @@ def _profile(text: str, source: str) -> Profile:
     tx_numbers = sorted(order)
     frame_period_s = single["frameCfg"][4] * 1e-3
     rx_numbers = _bits(rx_mask)
-    cfg = normalised(build_config(source, _CFG_NAMES, **dict(
+    cfg = normalised(build_config(_CFG_NAMES, **dict(
         name=source.rsplit("/", 1)[-1].rsplit(".", 1)[0] or "cfg", num_tx=len(order),
         num_rx=len(rx_numbers), n_range=next_pow2(n_samples), n_doppler=next_pow2(loops),
         sample_rate_hz=fs_ksps * 1e3, chirp_period_s=(idle_us + ramp_us) * 1e-6,
