@@ -43,7 +43,9 @@ _POINTFIELD_MSGS = [{"name": name, "offset": POINT_DTYPE.fields[name][1], "datat
 OBJECT_HEIGHT_M = 1.5
 """Height of an object's box in the markers (the planar array measures no height)."""
 _CLASS_COLOURS = {"car": (0.2, 0.6, 1.0), "pedestrian": (1.0, 0.3, 0.3),
-                  "cyclist": (1.0, 0.8, 0.1)}
+                  "pedestrian_group": (1.0, 0.55, 0.1), "two_wheeler": (1.0, 0.85, 0.1),
+                  "large_vehicle": (0.65, 0.4, 1.0)}
+"""Marker colour (r, g, b) per class of ``gnn.classes.OBJECT_CLASSES``; others grey."""
 _OTHER_COLOUR = (0.7, 0.7, 0.7)
 _CUBE, _TEXT, _DELETEALL = 1, 9, 3
 
