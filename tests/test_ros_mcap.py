@@ -17,13 +17,14 @@ from rosbags.typesys.msg import get_types_from_msg
 from host.pointcloud import PointCloud
 from host.ros.messages import (
     POINT_DTYPE,
+    TOPICS,
     FrameStatus,
     Mount,
     cloud_points,
     missing_packets,
 )
 from host.ros.msgdefs import FRAME_STATUS, schema_text
-from host.ros.recording import TOPICS, Recorder, RecordingError
+from host.ros.recording import Recorder, RecordingError
 from host.ros.summary import read_points, summarize
 
 PERIOD_S = 0.00897024

@@ -14,7 +14,15 @@ from typing import Any
 import numpy as np
 
 from host.pointcloud import PointCloud
+from host.ros.msgdefs import FRAME_STATUS
 
+TOPICS: dict[str, tuple[str, str]] = {
+    "points": ("/radar/points", "sensor_msgs/msg/PointCloud2"),
+    "objects": ("/radar/objects", "visualization_msgs/msg/MarkerArray"),
+    "status": ("/radar/status", FRAME_STATUS),
+    "tf": ("/tf_static", "tf2_msgs/msg/TFMessage"),
+}
+"""Role -> (topic, ROS 2 type) of the messages of a recording or live channel."""
 RADAR_FRAME = "radar"
 """The radar's tf frame: the point cloud, markers and status are stamped in it."""
 BASE_FRAME = "base_link"
@@ -185,3 +193,16 @@ def frame_status(status: FrameStatus, t_ns: int) -> dict[str, Any]:
             "truncated": status.truncated, "detections": status.detections,
             "processing_time_ms": status.processing_time_s * 1e3,
             "problems": list(status.problems)}
+
+
+def frame_messages(cloud: PointCloud | None, status: FrameStatus,
+                   objects: list[dict[str, Any]] | None, t_ns: int
+                   ) -> list[tuple[str, dict[str, Any]]]:
+    """One frame's messages as (role of :data:`TOPICS`, message), stamped ``t_ns``: its
+    cloud (None: a frame that gave no cloud, e.g. a damaged one left out), its objects when
+    given (GNN run), its status."""
+    out = [] if cloud is None else [("points", point_cloud2(cloud_points(cloud), t_ns))]
+    if objects is not None:
+        out.append(("objects", marker_array(objects, t_ns)))
+    out.append(("status", frame_status(status, t_ns)))
+    return out

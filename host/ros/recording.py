@@ -14,28 +14,14 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any, BinaryIO
 
-from mcap.writer import CompressionType
-from mcap_ros2.writer import Writer
+from mcap.well_known import MessageEncoding, SchemaEncoding
+from mcap.writer import CompressionType, Writer
 
 from host.pointcloud import PointCloud
-from host.ros.messages import (
-    FrameStatus,
-    Mount,
-    cloud_points,
-    frame_status,
-    marker_array,
-    point_cloud2,
-    tf_message,
-)
-from host.ros.msgdefs import FRAME_STATUS, schema_text
+from host.ros.cdr import encoder
+from host.ros.messages import TOPICS, FrameStatus, Mount, frame_messages, tf_message
+from host.ros.msgdefs import schema_text
 
-TOPICS: dict[str, tuple[str, str]] = {
-    "points": ("/radar/points", "sensor_msgs/msg/PointCloud2"),
-    "objects": ("/radar/objects", "visualization_msgs/msg/MarkerArray"),
-    "status": ("/radar/status", FRAME_STATUS),
-    "tf": ("/tf_static", "tf2_msgs/msg/TFMessage"),
-}
-"""Role -> (topic, ROS 2 type) of the messages of a recording."""
 CHUNK_BYTES = 1 << 20
 """Uncompressed bytes per MCAP chunk (zstd): what a cut-short recording loses at most."""
 
@@ -63,11 +49,11 @@ class Recorder:
         self._first_id: int | None = None
         self._last_index = -1
         self._closed = False
+        self._channels: dict[str, int] = {}
         try:
             self._writer = Writer(self._file, chunk_size=CHUNK_BYTES,
                                   compression=CompressionType.ZSTD)
-            self._schemas = {role: self._writer.register_msgdef(rtype, schema_text(rtype))
-                             for role, (_, rtype) in TOPICS.items()}
+            self._writer.start(profile="ros2", library="radar-array-processor host.ros")
             self._write("tf", tf_message(mount or Mount(), self.start_ns), self.start_ns)
         except BaseException:
             with suppress(OSError):
@@ -75,8 +61,15 @@ class Recorder:
             raise
 
     def _write(self, role: str, msg: dict[str, Any], t_ns: int) -> None:
-        self._writer.write_message(TOPICS[role][0], self._schemas[role], msg, log_time=t_ns,
-                                   publish_time=t_ns, sequence=self.frames)
+        topic, typename = TOPICS[role]
+        if role not in self._channels:        # a channel appears with its first message
+            schema = self._writer.register_schema(typename, SchemaEncoding.ROS2,
+                                                  schema_text(typename).encode())
+            self._channels[role] = self._writer.register_channel(topic, MessageEncoding.CDR,
+                                                                 schema)
+        self._writer.add_message(self._channels[role], log_time=t_ns,
+                                 data=encoder(typename)(msg), publish_time=t_ns,
+                                 sequence=self.frames)
 
     def time_ns(self, frame_id: int) -> int:
         """The stamp of frame ``frame_id``: ids count frames from the first one written; an
@@ -100,11 +93,8 @@ class Recorder:
         fails."""
         t = self.time_ns(status.frame)
         try:
-            if cloud is not None:
-                self._write("points", point_cloud2(cloud_points(cloud), t), t)
-            if objects is not None:
-                self._write("objects", marker_array(objects, t), t)
-            self._write("status", frame_status(status, t), t)
+            for role, msg in frame_messages(cloud, status, objects, t):
+                self._write(role, msg, t)
         except OSError as exc:
             raise self._failed(exc) from exc
         self.frames += 1

@@ -15,8 +15,7 @@ from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
-from host.ros.messages import points_of
-from host.ros.recording import TOPICS
+from host.ros.messages import TOPICS, points_of
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 _READ_ERRORS = (McapError, struct.error, ValueError, EOFError, KeyError)
