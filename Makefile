@@ -81,6 +81,7 @@ bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_host
 	$(RUN) python -m benchmarks.bench_detect
 	$(RUN) python -m benchmarks.bench_unfold
+	$(RUN) python -m benchmarks.bench_mcap
 
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py

@@ -7,6 +7,7 @@
     radar replay   --capture FILE.dmacap --port P     (send as the board would, over UDP)
     radar receive  --port P --preset ... --json OUT   (decode UDP packets -> point cloud)
     radar view     --replay F | --udp-port P | --scene S   (live browser view)
+    radar mcap info FILE.mcap                         (summarise an --mcap recording)
     radar gnn      dataset|train|eval|detect ...      (the GNN object detector)
     radar profile  show NAME|FILE.toml|FILE.cfg       (a radar profile's derived numbers)
 
@@ -20,10 +21,10 @@ import argparse
 import sys
 
 from model.config import PRESETS
-from radar.commands import demo, detect, gnn, link, profile, simulate, view
+from radar.commands import demo, detect, gnn, link, mcap, profile, simulate, view
 from radar.common import CliError
 
-COMMAND_GROUPS = (simulate, detect, demo, link, view, profile)
+COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile)
 """Command modules, each with ``add_parsers(sub, presets)``, in ``--help`` order."""
 
 

@@ -23,6 +23,7 @@ from host.pipeline import DetectionParams
 from host.pointcloud import PointCloud
 from host.receiver import DetectConfigOf
 from host.records import DEFAULT_MAX_DETECTIONS, fpga_detect_config
+from host.ros.messages import FrameStatus
 from model.cfar_2d import KINDS
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
@@ -43,6 +44,7 @@ from radar.common import (
 from radar.figures import detect_plots
 from radar.frame_cloud import frame_cloud
 from radar.objects import describe, gnn_objects, object_boxes
+from radar.recording import add_mcap_options, close_recording, open_recording
 from radar.sources import SOURCES, SourceError, get_source
 
 MAX_DETECT_FRAMES = 10_000
@@ -102,11 +104,22 @@ def cmd_detect(args: argparse.Namespace) -> int:
             saturated.append(adc.saturated)
             yield adc.samples
 
+    def finish_frame(k: int, cloud: PointCloud, t_start: float, **status: Any) -> None:
+        """The objects (--gnn) and the recording (--mcap) of frame k."""
+        objs = gnn_objects(cloud, ego) if args.gnn else None
+        if objs is not None:
+            objects.extend({"frame": k, **o} for o in objs)
+        if rec is not None:
+            rec.write_frame(cloud, FrameStatus(k, len(cloud), processing_time_s=(
+                time.perf_counter() - t_start), **status), objs)
+
+    dcfg = fpga_config(args, cfg, params) if args.detect == "fpga" else None
+    rec = open_recording(args, cfg.frame_time_s)
     try:
-        if args.detect == "fpga":
-            dcfg = fpga_config(args, cfg, params)
+        if dcfg is not None:
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
             for f in frames:
+                t_start = time.perf_counter()
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
                 fc = frame_cloud(f, cfg, params, k, "detect")
                 cloud = fc.cloud
@@ -121,21 +134,23 @@ def cmd_detect(args: argparse.Namespace) -> int:
                           f"--max-detections {dcfg.max_detections} were sent"], "detect")
                 if not f.complete:
                     warn([f"frame {k} damaged: {'; '.join(f.problems[:3])}"], "detect")
-                if args.gnn:
-                    objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
+                finish_frame(k, cloud, t_start, complete=f.complete, truncated=f.truncated,
+                             detections=f.detections, problems=f.problems + fc.problems)
         else:
             for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
+                t_start = time.perf_counter()
                 cloud = frame_cloud(cube, cfg, params, k, "detect").cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
                                   "adc_saturated": saturated[k]})
-                if args.gnn:
-                    objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
+                finish_frame(k, cloud, t_start)
                 last_cube = cube
     except SourceError as exc:
         raise CliError(f"--backend {args.backend}: {exc}") from None
     except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
         raise CliError(str(exc)) from None
+    finally:
+        close_recording(rec)
     clipped = [k for k, n in enumerate(saturated) if n]
     if clipped:
         warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
@@ -198,4 +213,5 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(--backend model or rtl)")
     add_fpga_options(d)
     add_detection_options(d)
+    add_mcap_options(d)
     d.set_defaults(func=cmd_detect)

@@ -15,12 +15,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
 from host.capture import CaptureInfo, read_capture, write_capture
 from host.pointcloud import PointCloud
 from host.receiver import CUBE, RECORDS, Receiver
+from host.ros.messages import FrameStatus, missing_packets
 from model.axis_packetizer import words_to_bytes
 from model.config import PRESETS, get_preset
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
@@ -39,6 +41,7 @@ from radar.common import (
     warn,
 )
 from radar.frame_cloud import frame_cloud
+from radar.recording import add_mcap_options, close_recording, open_recording
 from radar.sources import get_source
 
 MAX_CAPTURE_FRAMES = 1000
@@ -146,19 +149,32 @@ def cmd_receive(args: argparse.Namespace) -> int:
         raise CliError(str(exc)) from None
     except OSError as exc:
         raise CliError(f"--host {args.host} --port {args.port}: {exc}") from None
+    try:   # frames are stamped from now on (the stream carries no time)
+        rec = open_recording(args, fixed.frame_time_s if fixed else None, time.time_ns())
+    except CliError:
+        rx.close()
+        raise
     print(f"listening on {args.host}:{rx.port}", flush=True)
-    with rx:
-        frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
-                            total_timeout_s=args.timeout, make_decoder=receiver.learn)
+    try:
+        with rx:
+            frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
+                                total_timeout_s=args.timeout, make_decoder=receiver.learn)
+    except BaseException:
+        close_recording(rec)
+        raise
     decoder = rx.decoder
     cfg = receiver.cfg if decoder else fixed
     if decoder and cfg:
         params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
+    if rec is not None and cfg:
+        rec.frame_period_s = cfg.frame_time_s
     try:
         for f in frames:
+            t_start = time.perf_counter()
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
                                      "problems": f.problems}
+            fc = None
             if decoder and cfg and (f.complete or args.use_damaged):
                 fc = frame_cloud(f, cfg, params, f.frame_id, "receive")
                 if fc.problems:
@@ -169,8 +185,16 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 clouds.append(fc.cloud)
                 entry["points"] = len(fc.cloud)
             frames_doc.append(entry)
+            if rec is not None and decoder and cfg:
+                rec.write_frame(fc.cloud if fc else None, FrameStatus(
+                    f.frame_id, entry.get("points", 0), f.complete,
+                    missing_packets(f.valid, decoder.packet_words),
+                    entry.get("truncated", False), entry.get("detections", 0),
+                    time.perf_counter() - t_start, entry["problems"]))
     except KeyboardInterrupt:
         rx.interrupted = True
+    finally:
+        close_recording(rec)
     cloud = PointCloud.concat(clouds)
     doc = cloud.to_json_dict(cfg.name if cfg else "unknown", len(frames))
     doc.update({"backend": "udp", "detect": args.detect,
@@ -268,4 +292,5 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(radar capture --detect fpga), decoded with the same --max-detections")
     add_fpga_options(v)
     add_detection_options(v)
+    add_mcap_options(v)
     v.set_defaults(func=cmd_receive)

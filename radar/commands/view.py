@@ -4,15 +4,16 @@ capture or a scene.
     radar view --replay FILE.dmacap [--fps 20] [--loss P]   a capture, looped
     radar view --udp-port P [--preset P]                    what `radar replay`/the board sends
     radar view --scene table1 [--preset paper-fpga]          simulated frames
-    ... [--host 127.0.0.1] [--port 8050] [--gnn]
+    ... [--host 127.0.0.1] [--port 8050] [--gnn] [--foxglove [PORT]]
 
 The stream is the radar cube or, with on-chip detection (``OUTPUT_MODE = 1``), the
 detector's records: a capture says which in its header (``RDMAREC2``), a UDP stream is
 recognised by its frame length (records need the sender's ``--max-detections``), a scene
 sends records with ``--detect fpga`` (bit-accurate model of the chain).
 
-The page is at http://HOST:PORT/. Binding to an address other than loopback needs
-``--allow-remote`` (the page has no authentication).
+The page is at http://HOST:PORT/; ``--foxglove`` also serves the frames to Foxglove
+(``radar.view.foxglove``) on HOST. Binding to an address other than loopback needs
+``--allow-remote`` (neither has authentication).
 """
 
 from __future__ import annotations
@@ -60,6 +61,8 @@ from radar.view.sources import (
 )
 
 DEFAULT_PORT = 8050
+DEFAULT_FOXGLOVE_PORT = 8765
+"""``--foxglove``'s port (Foxglove's own default)."""
 
 
 def is_loopback(host: str) -> bool:
@@ -215,10 +218,25 @@ async def _serve(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise CliError(f"--host/--port: cannot listen on {args.host}:{args.port}: "
                        f"{exc.strerror or exc}") from None
+    live = None
+    if args.foxglove is not None:
+        from radar.view.foxglove import FoxglovePublisher
+
+        try:
+            live = FoxglovePublisher(feed, args.host, args.foxglove, gnn=args.gnn)
+        except OSError as exc:
+            await server.close()
+            raise CliError(f"--foxglove: cannot listen on {args.host}:{args.foxglove}: "
+                           f"{exc}") from None
+        threads.append(threading.Thread(target=live.run, args=(stop,), name="view-foxglove",
+                                        daemon=True))
     for t in threads:
         t.start()
     print(f"radar view: http://{args.host}:{server.port}/ showing {desc} (Ctrl-C stops)",
           flush=True)
+    if live is not None:
+        print(f"radar view: Foxglove WebSocket ws://{args.host}:{live.port} (open it in "
+              f"Foxglove: Open connection)", flush=True)
     t_end = time.monotonic() + args.duration if args.duration else None
     try:
         while t_end is None or time.monotonic() < t_end:
@@ -226,6 +244,8 @@ async def _serve(args: argparse.Namespace) -> int:
     finally:
         stop.set()
         await server.close()
+        if live is not None:
+            live.close()
     return 0
 
 
@@ -291,6 +311,11 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v.add_argument("--ego-speed", type=float, default=None,
                    help="ego speed along +x for the GNN's velocity compensation, m/s "
                         "(default: 27.78 for --scene table1, else 0)")
+    v.add_argument("--foxglove", type=int, nargs="?", const=DEFAULT_FOXGLOVE_PORT,
+                   default=None, metavar="PORT",
+                   help="also publish the frames live as ROS 2 messages (the topics of --mcap, "
+                        "docs/ros.md) on a Foxglove WebSocket server on --host, port PORT "
+                        f"(default {DEFAULT_FOXGLOVE_PORT}; 0 = any free port, printed)")
     v.add_argument("--duration", type=float, default=None,
                    help="stop after this many seconds (default: run until Ctrl-C)")
     add_fpga_options(v)
