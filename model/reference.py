@@ -25,6 +25,11 @@ import numpy as np
 
 from model.config import RadarConfig
 
+HANN_MAIN_LOBE_BINS = 2
+"""Half width of the periodic Hann window's main lobe, bins: a tone spreads over +-2 bins of
+its FFT (host CFAR sidelobe masking starts beyond it; a profile's near-range guard covers the
+leakage's main lobe, ``model.profile.default_min_range_m``)."""
+
 
 def hann_periodic(n: int) -> np.ndarray:
     """Periodic Hann window w[i] = 0.5 - 0.5 cos(2 pi i / n), float64 (n,) (w[0] = 0)."""
@@ -77,8 +82,8 @@ def doppler_fft(turned: np.ndarray, cfg: RadarConfig, window: bool = True) -> np
 
 def remove_static(turned: np.ndarray) -> np.ndarray:
     """Static-clutter removal: each slow-time vector less its mean over the frame's chirps,
-    i.e. per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing real
-    data"). turned: complex (..., n_doppler) -> the same shape; returns a new array."""
+    i.e. per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing a
+    capture"). turned: complex (..., n_doppler) -> the same shape; returns a new array."""
     return turned - turned.mean(axis=-1, keepdims=True)
 
 

@@ -3,15 +3,17 @@ streamed and selected, static-clutter removal, the profile's maximum speed, and 
 one line with exit status 2 and nothing written."""
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from host.adc_capture import open_capture, write_npy
-from host.params import MAX_RADIAL_SPEED_MPS
+from host.params import MAX_RADIAL_SPEED_MPS, DetectionParams
+from host.pipeline import process_frame
 from model.config import PRESETS
-from model.profile import load_profile
+from model.profile import LEAKAGE_RANGE_M, load_profile, profile_from_toml, profile_to_toml
 from model.reference import radar_cube, range_doppler_power
 from model.scene import Scatterers
 from model.simulate import simulate_frame
@@ -148,3 +150,34 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
     err = capsys.readouterr().err.strip()
     assert code == 2 and doc is None
     assert err.count("\n") == 0 and want in err, err
+
+
+def test_near_range_guard_from_the_profile():
+    """A TOML or .cfg profile guards the leakage zone plus the range window's main lobe
+    (model.profile.default_min_range_m), or the min_range_m it states; the presets guard
+    range bin 0 only (test_profiles)."""
+    cfg = OPENRADAR.config
+    assert cfg.min_range_m == pytest.approx(LEAKAGE_RANGE_M + 2 * cfg.range_bin_m)
+    assert cfg.detection_bins == (5, cfg.n_range - 4)        # 0.244 m .. with 4.88 cm bins
+    text = profile_to_toml(OPENRADAR)
+    assert f"min_range_m = {cfg.min_range_m!r}" in text
+    half = profile_from_toml(text.replace(f"min_range_m = {cfg.min_range_m!r}",
+                                          "min_range_m = 0.5"), "x.toml").config
+    assert half.detection_bins[0] == 11 and half.min_detection_range_m >= 0.5
+    for value, want in (("-1.0", "waveform.min_range_m: must be positive"),
+                        ("7.0", "waveform.min_range_m: 7.0 m leaves no range bin")):
+        with pytest.raises(ValueError, match=want):
+            profile_from_toml(text.replace(f"min_range_m = {cfg.min_range_m!r}",
+                                           f"min_range_m = {value}"), "x.toml")
+
+
+def test_real_frame_leakage_guarded():
+    """The real frame's TX-RX leakage (range bin 1, zero Doppler) is a point with the
+    presets' one-bin guard and none with the profile's."""
+    frame = open_capture(BIN_FILE, OPENRADAR).frame(0)
+    cfg = OPENRADAR.config
+    params = DetectionParams(max_speed_mps=cfg.max_speed_mps)
+    one_bin = process_frame(frame, replace(cfg, min_range_m=None), params)
+    assert ((one_bin.range_bin == 1) & (one_bin.doppler_bin == 0)).sum() == 3
+    guarded = process_frame(frame, cfg, params)
+    assert guarded.range_m.min() > 0.6 and len(guarded) == len(one_bin) - 3
