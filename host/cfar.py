@@ -38,6 +38,7 @@ from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports th
     effective_cells_mask,
     os_factor,
 )
+from model.reference import HANN_MAIN_LOBE_BINS
 
 OS_MAX_ELEMENTS = 2 * 10**8
 """OS-CFAR holds (cells x training cells) values at once: bound on that product."""
@@ -184,7 +185,7 @@ def paper_threshold(cube: np.ndarray, threshold_db: float) -> tuple[np.ndarray, 
     return p0 > floor * 10.0 ** (threshold_db / 10.0), p0
 
 
-MAIN_LOBE_BINS = 2
+MAIN_LOBE_BINS = HANN_MAIN_LOBE_BINS
 """Half width of the periodic Hann main lobe, bins: sidelobe masking starts beyond it."""
 
 

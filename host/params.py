@@ -14,6 +14,13 @@ MAX_RADIAL_SPEED_MPS = 100.0
 180 km/h head-on). Velocities are unfolded and flagged ``ambiguous`` against it."""
 
 
+def default_max_speed_mps(cfg: RadarConfig) -> float:
+    """The fastest radial speed to expect for ``cfg`` when the user gives none, m/s: the
+    profile's ``max_speed_mps`` (a TOML or ``.cfg`` profile: its unambiguous speed unless it
+    states one, ``model.profile``), else (the presets) :data:`MAX_RADIAL_SPEED_MPS`."""
+    return MAX_RADIAL_SPEED_MPS if cfg.max_speed_mps is None else cfg.max_speed_mps
+
+
 @dataclass(frozen=True)
 class DetectionParams:
     """Host processing settings.

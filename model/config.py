@@ -25,7 +25,8 @@ the beat frequency -k fs/N just as much as (N-k) fs/N: a target at range <= 0 (o
 driven past the radar), and the window sidelobes of a strong near target, land in the top
 bins. The detectors therefore treat the range axis as circular (CFAR windows wrap, they are
 not cut) and never report the ``NEGATIVE_BEAT_GUARD_BINS`` top bins nor the
-``DC_GUARD_BINS`` lowest ones (DC offset / TX leakage); :meth:`RadarConfig.detection_bins` is
+``DC_GUARD_BINS`` lowest ones (DC offset / TX leakage; a profile's ``min_range_m`` guards
+more); :meth:`RadarConfig.detection_bins` is
 that one rule, for the host CFAR and the FPGA detector alike, and
 :attr:`RadarConfig.max_detection_range_m` the largest range a detection can report.
 """
@@ -156,6 +157,9 @@ class RadarConfig:
     """Frame repetition period, s (None: frames back to back, ``frame_time_s``)."""
     max_speed_mps: float | None = None
     """Fastest radial speed the profile expects, m/s (None: the host's default)."""
+    min_range_m: float | None = None
+    """Near-range guard: range bins below min_range_m are never detections (TX-RX leakage),
+    m (None: only the ``DC_GUARD_BINS``; ``model.profile.default_min_range_m``)."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -273,8 +277,11 @@ class RadarConfig:
     @property
     def detection_bins(self) -> tuple[int, int]:
         """Range bins a detector may report: ``lo <= bin < hi`` (see the module docstring:
-        DC guard below, negative-beat guard at the top of the circular range axis)."""
-        return DC_GUARD_BINS, self.n_range - NEGATIVE_BEAT_GUARD_BINS
+        DC guard, or the ``min_range_m`` near-range guard, below; negative-beat guard at the
+        top of the circular range axis)."""
+        lo = DC_GUARD_BINS if self.min_range_m is None else max(
+            DC_GUARD_BINS, math.ceil(self.min_range_m / self.range_bin_m - 1e-9))
+        return lo, self.n_range - NEGATIVE_BEAT_GUARD_BINS
 
     @property
     def max_detection_range_m(self) -> float:

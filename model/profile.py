@@ -17,11 +17,16 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from model.config import NEGATIVE_BEAT_GUARD_BINS, PRESETS, RadarConfig
+from model.reference import HANN_MAIN_LOBE_BINS
 
 CAPTURE_FORMATS = ("dca1000", "npy")
 """Capture file formats (docs/profiles.md, "Captures")."""
 LVDS_LAYOUTS = {(4, True): "xWR12xx/14xx", (2, False): "xWR16xx/18xx/68xx"}
 """The DCA1000 LVDS layouts TI documents, (lanes, interleaved) -> devices."""
+LEAKAGE_RANGE_M = 0.1
+"""Range within which a radar board's TX-RX leakage arrives (on-chip and antenna coupling,
+the radome), m: the near-range guard of a profile that states none starts here
+(:func:`default_min_range_m`)."""
 
 
 @dataclass(frozen=True)
@@ -74,6 +79,14 @@ def default_max_range_m(cfg: RadarConfig) -> float:
     return cfg.max_range_m * (1.0 - NEGATIVE_BEAT_GUARD_BINS / cfg.n_range)
 
 
+def default_min_range_m(cfg: RadarConfig) -> float:
+    """The near-range guard of a TOML or ``.cfg`` profile that states no ``min_range_m``, m:
+    the leakage zone ``LEAKAGE_RANGE_M`` plus the range window's main lobe
+    (``HANN_MAIN_LOBE_BINS`` range bins) that spreads the leakage beyond it. The presets
+    keep ``min_range_m`` None (only range bin 0 guarded)."""
+    return LEAKAGE_RANGE_M + HANN_MAIN_LOBE_BINS * cfg.range_bin_m
+
+
 def build_config(names: dict[str, str], **kw: object) -> RadarConfig:
     """RadarConfig(**kw); a ValueError of a field (``field: ...`` or ``field[i]: ...``) is
     re-raised naming the field as the source spells it (``names``: RadarConfig field ->
@@ -109,7 +122,7 @@ _WAVEFORM = {"start_frequency_hz": float, "slope_hz_per_s": float, "sample_rate_
              "ramp_end_time_s": float, "chirp_period_s": float, "adc_start_time_s": float,
              "loops": int, "doppler_fft": int, "tx_order": list, "adc": str,
              "frame_period_s": float, "max_speed_mps": float, "max_range_m": float,
-             "adc_bits": int}
+             "min_range_m": float, "adc_bits": int}
 """Keys of ``[waveform]`` and their types (docs/profiles.md)."""
 _REQUIRED = ("start_frequency_hz", "slope_hz_per_s", "sample_rate_hz", "samples_per_chirp",
              "loops")
@@ -121,7 +134,8 @@ _TOML_NAMES = {"fc_hz": "waveform.start_frequency_hz", "sample_rate_hz":
                "tx_order": "waveform.tx_order", "adc": "waveform.adc", "tx_positions":
                "array.tx", "rx_positions": "array.rx", "num_tx": "array.tx", "num_rx":
                "array.rx", "frame_period_s": "waveform.frame_period_s", "max_speed_mps":
-               "waveform.max_speed_mps", "sweep_bandwidth_hz": "waveform.slope_hz_per_s",
+               "waveform.max_speed_mps", "min_range_m": "waveform.min_range_m",
+               "sweep_bandwidth_hz": "waveform.slope_hz_per_s",
                "adc_bits": "waveform.adc_bits", **{f: f"front_end.{f}" for f in _FRONT_END}}
 """RadarConfig field -> the TOML key a message names."""
 
@@ -191,7 +205,7 @@ def _profile_from_text(text: str, source: str) -> Profile:
             raise ValueError(f"waveform.{key}: missing")
     w = {k: _typed(wf, k, t, "waveform") for k, t in _WAVEFORM.items() if k in wf}
     for key in ("start_frequency_hz", "slope_hz_per_s", "sample_rate_hz", "idle_time_s",
-                "ramp_end_time_s", "chirp_period_s", "max_range_m"):
+                "ramp_end_time_s", "chirp_period_s", "max_range_m", "min_range_m"):
         if key in w and w[key] <= 0:
             raise ValueError(f"waveform.{key}: must be positive, got {w[key]!r}")
     if "adc_start_time_s" in w and w["adc_start_time_s"] < 0:
@@ -217,22 +231,29 @@ def _profile_from_text(text: str, source: str) -> Profile:
         samples_per_chirp=ns, loops=loops,
         tx_order=tuple(order) if isinstance(order, list) else order,
         tx_positions=tx, rx_positions=rx, frame_period_s=w.get("frame_period_s"),
-        max_speed_mps=w.get("max_speed_mps"))
+        max_speed_mps=w.get("max_speed_mps"), min_range_m=w.get("min_range_m"))
     if "adc_bits" in w:
         kw["adc_bits"] = w["adc_bits"]
     if "max_range_m" in w:
         kw["design_max_range_m"] = w["max_range_m"]
     kw.update({k: _typed(fe, k, int if k == "subarray_elements" else float, "front_end")
                for k in fe})
-    cfg = normalised(build_config(_TOML_NAMES, **kw))
-    if cfg.max_speed_mps is None:
-        cfg = replace(cfg, max_speed_mps=cfg.max_velocity_mps)
+    cfg = with_profile_defaults(normalised(build_config(_TOML_NAMES, **kw)))
     capture = CaptureFormat(
         format=_typed(cap, "format", str, "capture") if "format" in cap else "dca1000",
         lanes=_typed(cap, "lanes", int, "capture") if "lanes" in cap else 2,
         interleaved=_typed(cap, "interleaved", bool, "capture") if "interleaved" in cap
         else False)
     return Profile(config=cfg, capture=capture, source=source)
+
+
+def with_profile_defaults(cfg: RadarConfig) -> RadarConfig:
+    """``cfg`` with the defaults a TOML or ``.cfg`` profile gets where it states none
+    (docs/profiles.md): ``max_speed_mps`` its unambiguous speed, ``min_range_m``
+    :func:`default_min_range_m`."""
+    return replace(cfg, max_speed_mps=cfg.max_velocity_mps if cfg.max_speed_mps is None
+                   else cfg.max_speed_mps, min_range_m=default_min_range_m(cfg)
+                   if cfg.min_range_m is None else cfg.min_range_m)
 
 
 def _chirp_period(w: dict, sampled_s: float) -> float:
@@ -300,6 +321,8 @@ def profile_to_toml(profile: Profile) -> str:
         lines.append(f"frame_period_s = {_num(cfg.frame_period_s)}")
     if cfg.max_speed_mps is not None:
         lines.append(f"max_speed_mps = {_num(cfg.max_speed_mps)}")
+    if cfg.min_range_m is not None:
+        lines.append(f"min_range_m = {_num(cfg.min_range_m)}")
     lines += ["", "[array]", f"tx = {pos(cfg.tx_positions_hw.tolist())}",
               f"rx = {pos(cfg.rx_positions_hw.tolist())}", "", "[capture]",
               f'format = "{cap.format}"', f"lanes = {cap.lanes}",

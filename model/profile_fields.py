@@ -11,7 +11,8 @@ if TYPE_CHECKING:
     from model.config import RadarConfig
 
 PROFILE_FIELDS = frozenset({"samples_per_chirp", "loops", "tx_order", "adc", "tx_positions",
-                            "rx_positions", "frame_period_s", "max_speed_mps"})
+                            "rx_positions", "frame_period_s", "max_speed_mps",
+                            "min_range_m"})
 """RadarConfig fields that may be None or not numbers (checked by check_profile_fields)."""
 
 
@@ -55,11 +56,15 @@ def check_profile_fields(cfg: RadarConfig) -> None:
         _positions(cfg.tx_positions, "tx_positions", cfg.num_tx)
     if cfg.rx_positions is not None:
         _positions(cfg.rx_positions, "rx_positions", cfg.num_rx)
-    for name in ("frame_period_s", "max_speed_mps"):
+    for name in ("frame_period_s", "max_speed_mps", "min_range_m"):
         value = getattr(cfg, name)
         if value is not None and (isinstance(value, bool) or not isinstance(value, int | float)
                                   or not math.isfinite(value) or value <= 0):
             raise ValueError(f"{name}: must be a positive number, got {value!r}")
+    lo, hi = cfg.detection_bins
+    if lo >= hi:
+        raise ValueError(f"min_range_m: {cfg.min_range_m} m leaves no range bin to detect in "
+                         f"(the top {cfg.n_range - hi} are guarded too)")
     if cfg.frame_period_s is not None and cfg.frame_period_s < cfg.frame_time_s:
         raise ValueError(f"frame_period_s: {cfg.frame_period_s * 1e3:.3f} ms is shorter than "
                          f"the frame's chirps, {cfg.frame_time_s * 1e3:.3f} ms")

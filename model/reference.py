@@ -25,6 +25,11 @@ import numpy as np
 
 from model.config import RadarConfig
 
+HANN_MAIN_LOBE_BINS = 2
+"""Half width of the periodic Hann window's main lobe, bins: a tone spreads over +-2 bins of
+its FFT (host CFAR sidelobe masking starts beyond it; a profile's near-range guard covers the
+leakage's main lobe, ``model.profile.default_min_range_m``)."""
+
 
 def hann_periodic(n: int) -> np.ndarray:
     """Periodic Hann window w[i] = 0.5 - 0.5 cos(2 pi i / n), float64 (n,) (w[0] = 0)."""
@@ -75,13 +80,24 @@ def doppler_fft(turned: np.ndarray, cfg: RadarConfig, window: bool = True) -> np
     return np.fft.fft(x, axis=-1) / cfg.n_doppler
 
 
+def remove_static(turned: np.ndarray) -> np.ndarray:
+    """Static-clutter removal: each slow-time vector less its mean over the frame's chirps,
+    i.e. per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing a
+    capture"). turned: complex (..., n_doppler) -> the same shape; returns a new array."""
+    return turned - turned.mean(axis=-1, keepdims=True)
+
+
 def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
-               doppler_window: bool = True) -> np.ndarray:
-    """The FPGA chain in float: ADC frame -> radar cube.
+               doppler_window: bool = True, remove_static_clutter: bool = False
+               ) -> np.ndarray:
+    """The FPGA chain in float: ADC frame -> radar cube; ``remove_static_clutter``: apply
+    :func:`remove_static` before the Doppler FFT (not a step of the FPGA chain).
 
     adc: complex (n_chirps, num_rx, n_range) -> complex128 (n_virtual, n_range, n_doppler).
     """
     turned = corner_turn(range_fft(adc, cfg, range_window), cfg)
+    if remove_static_clutter:
+        turned = remove_static(turned)
     cube = doppler_fft(turned, cfg, doppler_window)
     return cube.reshape(cfg.cube_shape)
 

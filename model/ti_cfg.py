@@ -19,8 +19,6 @@ interleaved channels (xWR14xx: 4 lanes, interleaved).
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from model.profile import (
     Calibration,
     CaptureFormat,
@@ -29,6 +27,7 @@ from model.profile import (
     next_pow2,
     normalised,
     sourced,
+    with_profile_defaults,
 )
 
 READ = {"channelCfg": 3, "adcCfg": 2, "profileCfg": 14, "frameCfg": 7}
@@ -206,7 +205,7 @@ def _profile(text: str, source: str) -> Profile:
         tx_positions=_tx_layout(tx_numbers), rx_positions=tuple((float(r), 0.0)
                                                                   for r in rx_numbers),
         frame_period_s=frame_period_s if frame_period_s > 0 else None)))
-    cfg = replace(cfg, max_speed_mps=cfg.max_velocity_mps)
+    cfg = with_profile_defaults(cfg)
     calibration = None
     if "compRangeBiasAndRxChanPhase" in single:
         calibration = _calibration(single["compRangeBiasAndRxChanPhase"], tx_numbers,

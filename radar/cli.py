@@ -10,6 +10,7 @@
     radar mcap info FILE.mcap                         (summarise an --mcap recording)
     radar gnn      dataset|train|eval|detect ...      (the GNN object detector)
     radar profile  show NAME|FILE.toml|FILE.cfg       (a radar profile's derived numbers)
+    radar process  --radar PROFILE --capture FILE --json OUT   (a capture -> point cloud)
 
 One module per command group under :mod:`radar.commands`. Bad input ends with exit status 2
 and a one-line reason on stderr. ``radar <cmd> --help`` explains every option.
@@ -21,10 +22,10 @@ import argparse
 import sys
 
 from model.config import PRESETS
-from radar.commands import demo, detect, gnn, link, mcap, profile, simulate, view
+from radar.commands import demo, detect, gnn, link, mcap, process, profile, simulate, view
 from radar.common import CliError
 
-COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile)
+COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile, process)
 """Command modules, each with ``add_parsers(sub, presets)``, in ``--help`` order."""
 
 

@@ -117,8 +117,10 @@ def ego_speed_mps(args: argparse.Namespace, scene: Scene | None) -> float:
     return default_ego_speed_mps(scene) if scene is not None else 0.0
 
 
-def add_detection_options(p: argparse.ArgumentParser) -> None:
-    """Detector choice and CFAR settings."""
+def add_detection_options(p: argparse.ArgumentParser, max_speed_default: str | None = None
+                          ) -> None:
+    """Detector choice and CFAR settings; ``max_speed_default``: what ``--max-speed``
+    defaults to when the command fills it in (the option's default is then None)."""
     p.add_argument("--detector", choices=DETECTORS, default="ca",
                    help="ca: 2-D CA-CFAR on the non-coherent map (default); os: OS-CFAR "
                         "(slower); paper: the paper's threshold on channel 0")
@@ -130,10 +132,12 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
                    help="CFAR training cells per side (default 4 8)")
     p.add_argument("--threshold-db", type=float, default=15.0,
                    help="paper detector: threshold over the channel-0 median, dB (default 15)")
-    p.add_argument("--max-speed", type=float, default=MAX_RADIAL_SPEED_MPS,
+    p.add_argument("--max-speed", type=float,
+                   default=MAX_RADIAL_SPEED_MPS if max_speed_default is None else None,
                    help="fastest radial speed to expect, m/s: velocities are unfolded within "
                         "it and a point is flagged ambiguous when another velocity within it "
-                        f"explains the measurement (default {MAX_RADIAL_SPEED_MPS:g})")
+                        "explains the measurement (default "
+                        f"{max_speed_default or format(MAX_RADIAL_SPEED_MPS, 'g')})")
 
 
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,

@@ -47,3 +47,24 @@ def detect_plots(folder: Path, cfg: RadarConfig, scene: Scene, cube: np.ndarray,
                               f"{cfg.name}: point cloud ({len(cloud)} points)",
                               truth_xy(scene), boxes, missed_labels(scene, cloud))]
     print("figures: " + ", ".join(str(p) for p in paths))
+
+
+def process_plots(folder: Path, cfg: RadarConfig, cube: np.ndarray, cloud: PointCloud,
+                  frame: int) -> None:
+    """``radar process --plots``: frame ``frame``'s range-Doppler map (cube complex
+    (n_virtual, n_range, n_doppler)) with its detections circled, its range-azimuth map and
+    its x-y point cloud, written to ``folder``."""
+    from host.angle import range_azimuth_power
+    from host.plots import plot_point_cloud, plot_range_azimuth_pair, plot_range_doppler
+
+    title = f"{cfg.name} frame {frame}"
+    ra, az = range_azimuth_power(cube, cfg)
+    marks = [(float(r), float(v), "") for r, v in zip(cloud.range_m, cloud.radial_velocity_mps,
+                                                      strict=True)]
+    paths = [plot_range_doppler(range_doppler_power(cube), cfg, folder / "range_doppler.png",
+                                f"{title}: range-Doppler, detections circled", marks),
+             plot_range_azimuth_pair([(ra, f"{title}: range-azimuth")], az, cfg,
+                                     folder / "range_azimuth.png"),
+             plot_point_cloud(cloud.x_m, cloud.y_m, cloud.snr_db, folder / "point_cloud.png",
+                              f"{title}: point cloud ({len(cloud)} points)")]
+    print("figures: " + ", ".join(str(p) for p in paths))

@@ -10,6 +10,7 @@ import pytest
 
 from model.config import PRESETS
 from model.profile import (
+    default_min_range_m,
     load_profile,
     preset_profile,
     profile_from_toml,
@@ -68,10 +69,13 @@ def test_presets_are_profiles_unchanged():
         assert (cfg.n_samples, cfg.n_loops) == (cfg.n_range, cfg.n_doppler)
         assert np.array_equal(cfg.virtual_positions_hw[:, 0], np.arange(cfg.n_virtual))
         # TOML round trip: the same radar (a profile's max speed defaults to its own
-        # unambiguous speed, the preset keeps the host's default)
+        # unambiguous speed and its near-range guard to the leakage zone; the preset
+        # keeps the host's default speed and guards range bin 0 only)
         back = profile_from_toml(profile_to_toml(p), "x.toml").config
         assert back.max_speed_mps == pytest.approx(cfg.max_velocity_mps)
-        back = replace(back, max_speed_mps=None, name=cfg.name)
+        assert back.min_range_m == pytest.approx(default_min_range_m(cfg))
+        assert cfg.min_range_m is None and cfg.detection_bins[0] == 1
+        back = replace(back, max_speed_mps=None, min_range_m=None, name=cfg.name)
         assert back.sweep_bandwidth_hz == pytest.approx(cfg.sweep_bandwidth_hz, rel=1e-15)
         assert replace(back, sweep_bandwidth_hz=cfg.sweep_bandwidth_hz) == cfg
 

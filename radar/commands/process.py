@@ -1,0 +1,137 @@
+"""``radar process``: a capture of a radar profile -> the point cloud JSON (docs/profiles.md).
+
+The profile (``--radar``: a preset, a TOML profile or a TI ``.cfg``, ``model.profile``) says
+how to read the capture (``--capture``: a DCA1000 ``.bin`` or a ``.npy``,
+``host.adc_capture.open_capture``); its frames are read one at a time, turned into radar cubes
+by the float reference of the chain (``model.reference.radar_cube``) and into point clouds by
+the host processing (``radar.frame_cloud``), as ``radar detect`` does with simulated frames.
+The JSON is ``radar detect``'s, each point carrying its frame's index in the capture.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+from host.adc_capture import open_capture
+from host.params import default_max_speed_mps
+from host.pointcloud import PointCloud
+from model.profile import Profile, load_profile
+from model.reference import radar_cube
+from radar.common import (
+    CliError,
+    add_command,
+    add_detection_options,
+    detection_params,
+    out_file,
+    progress,
+    warn,
+)
+from radar.figures import process_plots
+from radar.frame_cloud import frame_cloud
+
+BACKENDS = ("float",)
+"""Frame sources ``radar process`` runs: the float reference only (the bit-accurate model
+and the RTL process the presets' frames, ``radar detect``; profiles are later work)."""
+
+
+def frame_range(text: str | None, n_frames: int) -> range:
+    """The frames of ``--frames A:B`` (A..B-1; A defaults to 0 and B to the capture's end;
+    a single number A is frame A alone) in a capture of ``n_frames``; CliError unless
+    0 <= A < B <= n_frames."""
+    if text is None:
+        return range(n_frames)
+    a, colon, b = text.partition(":")
+    try:
+        start = int(a) if a.strip() else 0
+        stop = (int(b) if b.strip() else n_frames) if colon else start + 1
+    except ValueError:
+        raise CliError(f"--frames: must be A:B (frame numbers), got {text!r}") from None
+    if not 0 <= start < stop <= n_frames:
+        raise CliError(f"--frames: {text} selects no frames of the capture's 0..{n_frames - 1}"
+                       if start >= stop or start >= n_frames else
+                       f"--frames: {text} is outside the capture's frames 0..{n_frames - 1}")
+    return range(start, stop)
+
+
+def profile_of(spec: str) -> Profile:
+    """The profile of ``--radar``, one the chain can process; CliError (one line) if not."""
+    try:
+        profile = load_profile(spec)
+        profile.config.check_processable()
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    return profile
+
+
+def cmd_process(args: argparse.Namespace) -> int:
+    out = out_file(args.json, ".json", "--json")
+    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
+        raise CliError(f"--plots: {args.plots} is a file, not a folder")
+    if args.backend not in BACKENDS:
+        raise CliError(f"--backend {args.backend}: radar process runs only "
+                       f"{', '.join(BACKENDS)} for now")
+    profile = profile_of(args.radar)
+    cfg = profile.config
+    if args.max_speed is None:
+        args.max_speed = default_max_speed_mps(cfg)
+    params = detection_params(args, cfg=cfg)
+    try:
+        capture = open_capture(args.capture, profile)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if capture.dropped_bytes:
+        warn([capture.report()], "process")
+    frames = frame_range(args.frames, capture.n_frames)
+    t0 = time.perf_counter()
+    clouds, per_frame = [], []
+    cube = None
+    for k in progress(frames, "frames"):
+        cube = radar_cube(capture.frame(k), cfg, params.range_window, params.doppler_window,
+                          remove_static_clutter=args.remove_static)
+        fc = frame_cloud(cube, cfg, params, k, "process")
+        clouds.append(fc.cloud)
+        per_frame.append({"frame": k, "points": len(fc.cloud)})
+    cloud = PointCloud.concat(clouds)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, len(frames))
+    doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
+                "capture": str(args.capture), "remove_static": args.remove_static,
+                "max_speed_mps": params.max_speed_mps,
+                "min_detection_range_m": cfg.min_detection_range_m,
+                "frame_info": per_frame})
+    out.write_text(json.dumps(doc, indent=1))
+    print(f"{len(cloud)} points in {len(frames)} frame(s) of {args.capture} "
+          f"({time.perf_counter() - t0:.2f} s) -> {out}")
+    if args.plots and cube is not None:
+        process_plots(Path(args.plots), cfg, cube, clouds[-1], frames[-1])
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
+    p = add_command(sub, "process", "radar capture -> point cloud JSON", """
+        Read an ADC capture of a radar profile (a DCA1000 .bin or a .npy, docs/profiles.md),
+        run its frames through the float reference of the chain and the host processing, and
+        write the point cloud JSON `radar detect` writes (each point with its frame's index
+        in the capture).""")
+    p.add_argument("--radar", required=True, metavar="NAME|FILE",
+                   help=f"the radar: preset ({', '.join(presets)}), profile .toml or TI .cfg")
+    p.add_argument("--capture", required=True, metavar="FILE",
+                   help="ADC capture: DCA1000 .bin (the profile's layout) or .npy")
+    p.add_argument("--json", required=True, help="output point cloud .json")
+    p.add_argument("--frames", default=None, metavar="A:B",
+                   help="frames A..B-1 of the capture (A: or :B open-ended; default all)")
+    p.add_argument("--remove-static", action="store_true",
+                   help="subtract each range bin's mean over the frame's chirps, per channel, "
+                        "before the Doppler FFT (static clutter and TX-RX leakage)")
+    p.add_argument("--backend", default="float",
+                   help="frame source: float, the float64 reference of the chain (the only "
+                        "one for now: model and rtl process presets in `radar detect`)")
+    p.add_argument("--plots", default=None,
+                   help="folder for the last frame's range-Doppler map with its detections, "
+                        "range-azimuth map and x-y point cloud")
+    add_detection_options(p, max_speed_default="the profile's max_speed_mps: its unambiguous "
+                                              "speed unless it says; 100 for the presets")
+    p.set_defaults(func=cmd_process)
