@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import TypeVar
@@ -91,18 +92,57 @@ def note_compile(command: str) -> None:
               "first run in this checkout, 20-30 s)", file=sys.stderr)
 
 
-def out_file(path: str, suffix: str, option: str) -> Path:
-    """``path`` checked to end in ``suffix``, its folder created."""
+def out_file(path: str, suffix: str | None, option: str) -> Path:
+    """``path`` checked, before any work, to end in ``suffix`` (None: any name) and to be a
+    file this process can write (its folder created; an existing file is not changed)."""
     p = Path(path)
-    if p.suffix != suffix:
+    if suffix is not None and p.suffix != suffix:
         raise CliError(f"{option}: {p} must end in {suffix}")
     if p.is_dir():
         raise CliError(f"{option}: {p} is a folder, not a file")
+    _make_folder(p.parent, option)
     try:
-        p.parent.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise CliError(f"{option}: {p.parent} is a file, not a folder") from None
+        if p.exists():
+            with open(p, "ab"):          # writable? (append mode: the content stays)
+                pass
+        else:
+            with open(p, "xb"):
+                pass
+            p.unlink()
+    except OSError as exc:
+        raise CliError(f"{option}: cannot write {p}: {exc.strerror or exc}") from None
     return p
+
+
+def out_folder(path: str, option: str) -> Path:
+    """``path`` checked, before any work, to be a folder this process can write in (created
+    if missing)."""
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise CliError(f"{option}: {p} is a file, not a folder")
+    _make_folder(p, option)
+    try:
+        with tempfile.NamedTemporaryFile(dir=p, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise CliError(f"{option}: cannot write in {p}: {exc.strerror or exc}") from None
+    return p
+
+
+def _make_folder(p: Path, option: str) -> None:
+    """``p`` created with its parents (CliError naming ``option`` when it cannot be)."""
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise CliError(f"{option}: {p} is a file, not a folder") from None
+    except OSError as exc:
+        raise CliError(f"{option}: cannot make the folder {p}: {exc.strerror or exc}") from None
+
+
+def port(value: int, option: str, allow_zero: bool = True) -> int:
+    """A port option checked to be in 0..65535 (1..65535 without ``allow_zero``)."""
+    lo = 0 if allow_zero else 1
+    return check(value, option, lo <= value <= 65535, f"a port number in {lo}..65535")
 
 
 def ego_speed_mps(args: argparse.Namespace, scene: Scene | None) -> float:

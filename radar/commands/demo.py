@@ -17,7 +17,7 @@ from host.pipeline import DetectionParams
 from model.reference import range_doppler_power
 from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
-from radar.common import add_command
+from radar.common import add_command, out_folder
 from radar.figures import truth_range_doppler, truth_xy
 from radar.frame_cloud import frame_cloud
 from radar.objects import gnn_objects, object_boxes
@@ -49,6 +49,7 @@ class GnnWorker:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
+    out_folder(args.out, "--out")               # before any work
     gnn = None if args.no_gnn else GnnWorker()
     try:
         return _demo(args, gnn)
@@ -67,7 +68,6 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     )
 
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     scene = table1_scene(args.preset)
     cfg = scene.config
     params = DetectionParams()

@@ -14,7 +14,6 @@ import argparse
 import json
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -36,6 +35,7 @@ from radar.common import (
     detection_params,
     ego_speed_mps,
     out_file,
+    out_folder,
     progress,
     scene_of,
     warn,
@@ -84,8 +84,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     scene = scene_of(args)
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
-    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
-        raise CliError(f"--plots: {args.plots} is a file, not a folder")
+    plots = out_folder(args.plots, "--plots") if args.plots else None
     cfg = scene.config
     params = detection_params(args, scene.tx_beamforming, cfg)
     clouds, per_frame, objects = [], [], []
@@ -102,6 +101,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
             saturated.append(adc.saturated)
             yield adc.samples
 
+    stopped: str | None = None      # why the run ended early: what was done is written
     try:
         if args.detect == "fpga":
             dcfg = fpga_config(args, cfg, params)
@@ -132,30 +132,46 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 if args.gnn:
                     objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
                 last_cube = cube
+    except KeyboardInterrupt:
+        stopped = "interrupted"
     except SourceError as exc:
-        raise CliError(f"--backend {args.backend}: {exc}") from None
+        stopped = f"--backend {args.backend}: {exc}"
     except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
-        raise CliError(str(exc)) from None
+        stopped = str(exc)
+    if stopped and not per_frame:
+        if stopped == "interrupted":
+            raise KeyboardInterrupt
+        raise CliError(stopped)
     clipped = [k for k, n in enumerate(saturated) if n]
     if clipped:
         warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
               f"harmonics of the clipped echo can appear as false points"], "detect")
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
+    done = len(per_frame) if stopped else args.frames
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "scene": scene.name,
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
                 "frame_info": per_frame, **report})
     if args.gnn:
         doc["objects"] = objects
+    if stopped:
+        doc.update({"interrupted": stopped == "interrupted", "error": stopped,
+                    "frames_requested": args.frames})
     out.write_text(json.dumps(doc, indent=1))
-    print(f"{len(cloud)} points in {args.frames} frame(s) ({time.perf_counter() - t0:.2f} s) "
+    print(f"{len(cloud)} points in {done} frame(s) ({time.perf_counter() - t0:.2f} s) "
           f"-> {out}")
     if args.gnn:
         print(f"GNN: {len(objects)} object(s): " + describe(objects))
-    if args.plots and last_cube is not None:
+    if stopped == "interrupted":
+        warn([f"interrupted: wrote the {done} of {args.frames} frame(s) processed"], "detect")
+        return 130
+    if stopped:
+        raise CliError(f"{stopped} (after {done} of {args.frames} frame(s): those are in "
+                       f"{out})")
+    if plots and last_cube is not None:
         last = [o for o in objects if o["frame"] == args.frames - 1]
-        detect_plots(Path(args.plots), cfg, scene, last_cube, clouds[-1], object_boxes(last))
+        detect_plots(plots, cfg, scene, last_cube, clouds[-1], object_boxes(last))
     return 0
 
 

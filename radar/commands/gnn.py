@@ -10,15 +10,17 @@ import sys
 from collections.abc import Callable
 
 from radar.commands import gnn_tasks as tasks
+from radar.common import CliError
 
 
 def _guarded(cmd: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
-    """``cmd`` that turns a ValueError (bad input) into ``error: <reason>`` on stderr and
-    exit status 2, so callers (``radar gnn``) need no knowledge of our exceptions."""
+    """``cmd`` that turns a ValueError or CliError (bad input) into ``error: <reason>`` on
+    stderr and exit status 2, so callers (``radar gnn``) need no knowledge of our
+    exceptions."""
     def run(args: argparse.Namespace) -> int:
         try:
             return int(cmd(args))
-        except ValueError as exc:
+        except (ValueError, CliError) as exc:
             print(f"radar gnn: error: {exc}", file=sys.stderr)
             return 2
     return run

@@ -6,15 +6,21 @@ from __future__ import annotations
 
 import argparse
 import json
-import tempfile
 from pathlib import Path
 from typing import Any
 
 from host.pointcloud import PointCloud
+from radar.common import out_file, out_folder
 
 
 def cmd_dataset(args: argparse.Namespace) -> int:
     from gnn.dataset import build_split, save_frames
+
+    for option in ("--train", "--val", "--test"):
+        n = getattr(args, option[2:])
+        if n < 0:
+            raise ValueError(f"{option}: must be a number of frames >= 0, got {n}")
+    out_folder(args.cache_dir, "--cache-dir")    # before rendering, not after
 
     if args.radarscenes is not None:
         from gnn.radarscenes import load_sequence
@@ -42,7 +48,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     from gnn.train import TrainConfig, train
 
     _threads(torch, args.threads)
-    _writable(Path(args.out))           # before training, not after
+    out_file(args.out, None, "--out")   # before training, not after
     paths = [Path(d) for d in args.data] if args.data else [_data_path(args, "train")]
     frames, meta = [], {}
     for path in paths:
@@ -72,24 +78,6 @@ def _threads(torch: Any, threads: int) -> None:
     torch.set_num_threads(threads)
 
 
-def _writable(path: Path) -> None:
-    """ValueError unless a file can be written at ``path`` (its folder exists or can be
-    made, the path is not a folder)."""
-    if path.is_dir():
-        raise ValueError(f"--out: {path} is a folder, not a file")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"--out: cannot make the folder of {path}: "
-                         f"{exc.strerror or exc}") from None
-    try:
-        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".write-test-"):
-            pass
-    except OSError as exc:
-        raise ValueError(f"--out: cannot write in {path.parent}: "
-                         f"{exc.strerror or exc}") from None
-
-
 def cmd_eval(args: argparse.Namespace) -> int:
     import torch
 
@@ -98,6 +86,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from gnn.infer import GnnDetector
 
     _threads(torch, args.threads)
+    if args.json is not None:
+        out_file(args.json, None, "--json")     # before the evaluation, not after
     frames, _ = load_frames(_data_path(args, "test"))
     res = evaluate_all(GnnDetector.from_checkpoint(args.checkpoint), frames,
                        progress=not args.quiet)
@@ -113,6 +103,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     from gnn.infer import detect_objects
     from model.scene import check_ego_speed, default_ego_speed_mps
 
+    if args.json is not None:
+        out_file(args.json, None, "--json")     # before the work, not after
     # the ego speed defaults as in `radar detect --gnn`: the scene's (100 km/h for table1,
     # else 0), and for a point cloud JSON the ego_speed_mps that `radar detect` wrote in it
     if args.points is not None:

@@ -34,6 +34,7 @@ from radar.common import (
     count,
     detection_params,
     out_file,
+    port,
     progress,
     scene_of,
     warn,
@@ -91,6 +92,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     from host.udp import Impairments, UdpSender
 
     check(args.seed, "--seed", 0 <= args.seed < 2**63, "an integer in 0..2**63-1")
+    port(args.port, "--port", allow_zero=False)
     rate = args.rate_mbps
     check(rate, "--rate-mbps", rate == 0 or 1e-3 <= rate <= 1e6,
           "0 (unpaced) or a rate in [0.001, 1e6] Mbit/s")
@@ -119,6 +121,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     from host.udp import UdpReceiver, check_seconds
 
     out = out_file(args.json, ".json", "--json")
+    port(args.port, "--port")
     count(args.frames, "--frames", MAX_RECEIVE_FRAMES)
     count(args.packet_words, "--packet-words", 65535, lo=2)   # before listening
     try:

@@ -43,6 +43,7 @@ from radar.common import (
     count,
     detection_params,
     ego_speed_mps,
+    port,
 )
 from radar.sources import get_source
 from radar.view.feed import Feed
@@ -113,6 +114,8 @@ def build(args: argparse.Namespace, stop: threading.Event
     """Feed, health, the (not yet started) producer threads and a description of the
     source, from parsed ``radar view`` options. Raises CliError on bad input."""
     feed, health = Feed(), LinkHealth()
+    port(args.port, "--port")
+    port(args.udp_port, "--udp-port")
     check(args.fps, "--fps", args.fps == 0 or 1e-3 <= args.fps <= 1e4,
           "0 (as fast as possible) or a rate in [0.001, 1e4] frames/s")
     if not 0.0 <= args.loss <= 1.0:

@@ -1,0 +1,112 @@
+"""Issue 32, nothing lost: every output path is checked before the work starts (one-line
+error, exit status 2), an interrupted or failing run writes what it did, port options are
+checked."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+import radar.commands.detect as detect_cmd
+from radar.cli import main
+
+UNWRITABLE = "/proc/nothing-lost/x"      # a folder nobody can create files in
+
+
+def _one_line_error(capsys: pytest.CaptureFixture[str], option: str) -> None:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error" in err[0] and option in err[0], err
+    assert "Traceback" not in err[0]
+
+
+@pytest.mark.parametrize(("argv", "option"), [
+    (["receive", "--timeout", "30", "--json", UNWRITABLE + ".json"], "--json"),
+    (["detect", "--scene", "table1", "--frames", "50", "--json", UNWRITABLE + ".json"],
+     "--json"),
+    (["detect", "--scene", "table1", "--frames", "50", "--json", "{tmp}/a.json", "--plots",
+      UNWRITABLE], "--plots"),
+    (["demo", "--out", UNWRITABLE], "--out"),
+    (["capture", "--scene", "table1", "--out", UNWRITABLE + ".dmacap"], "--out"),
+    (["simulate", "--scene", "table1", "--out", UNWRITABLE + ".npy"], "--out"),
+    (["gnn", "eval", "--data", "{tmp}/none.npz", "--json", UNWRITABLE + ".json"], "--json"),
+    (["gnn", "detect", "--scene", "table1", "--json", UNWRITABLE + ".json"], "--json"),
+    (["gnn", "train", "--data", "{tmp}/none.npz", "--out", UNWRITABLE + ".pt"], "--out"),
+    (["gnn", "dataset", "--train", "1", "--test", "0", "--cache-dir", UNWRITABLE],
+     "--cache-dir"),
+])
+def test_output_path_checked_before_the_work(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                             argv: list[str], option: str) -> None:
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    _one_line_error(capsys, option)
+
+
+def test_existing_output_file_is_not_changed_by_the_check(tmp_path: Path) -> None:
+    from radar.common import out_file
+    p = tmp_path / "keep.json"
+    p.write_text("old")
+    assert out_file(str(p), ".json", "--json") == p and p.read_text() == "old"
+    assert out_file(str(tmp_path / "new.json"), ".json", "--json")
+    assert not (tmp_path / "new.json").exists()
+
+
+@pytest.mark.parametrize("n", ["-5", "-1"])
+def test_gnn_dataset_counts_are_not_negative(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                             n: str) -> None:
+    assert main(["gnn", "dataset", "--train", n, "--cache-dir", str(tmp_path)]) == 2
+    _one_line_error(capsys, "--train")
+
+
+def _stop_at(monkeypatch: pytest.MonkeyPatch, frame: int, exc: BaseException) -> None:
+    real = detect_cmd.simulate_scene
+
+    def simulate(scene, frame_index=0):  # noqa: ANN001, ANN202 - as model.simulate
+        if frame_index == frame:
+            raise exc
+        return real(scene, frame_index=frame_index)
+
+    monkeypatch.setattr(detect_cmd, "simulate_scene", simulate)
+
+
+def test_detect_ctrl_c_keeps_the_frames_processed(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    _stop_at(monkeypatch, 3, KeyboardInterrupt())
+    out = tmp_path / "pc.json"
+    assert main(["detect", "--scene", "table1", "--preset", "paper-fpga", "--backend", "float",
+                 "--frames", "50", "--json", str(out)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted: wrote the 3 of 50 frame(s) processed" in err and "Traceback" not in err
+    doc = json.loads(out.read_text())
+    assert doc["interrupted"] is True and doc["frames"] == 3 and doc["frames_requested"] == 50
+    assert [f["frame"] for f in doc["frame_info"]] == [0, 1, 2] and doc["points"]
+
+
+def test_detect_error_mid_run_writes_what_was_done(tmp_path: Path,
+                                                   monkeypatch: pytest.MonkeyPatch,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    _stop_at(monkeypatch, 2, ValueError("disk on fire"))
+    out = tmp_path / "pc.json"
+    assert main(["detect", "--scene", "table1", "--preset", "paper-fpga", "--backend", "float",
+                 "--frames", "5", "--json", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "disk on fire (after 2 of 5 frame(s)" in err
+    doc = json.loads(out.read_text())
+    assert doc["interrupted"] is False and doc["error"] == "disk on fire"
+    assert len(doc["frame_info"]) == 2
+
+
+@pytest.mark.parametrize("argv", [
+    ["view", "--port", "70000"], ["view", "--port", "-1"], ["view", "--udp-port", "70000"],
+    ["view", "--udp-port", "-1"], ["receive", "--port", "70000", "--json", "{tmp}/r.json"],
+    ["receive", "--port", "-1", "--json", "{tmp}/r.json"],
+    ["replay", "--capture", "{tmp}/c.dmacap", "--port", "70000"],
+    ["replay", "--capture", "{tmp}/c.dmacap", "--port", "0"],
+])
+def test_port_options_are_one_line_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                          argv: list[str]) -> None:
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    _one_line_error(capsys, "port")
