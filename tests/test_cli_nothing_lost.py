@@ -110,3 +110,23 @@ def test_port_options_are_one_line_errors(tmp_path: Path, capsys: pytest.Capture
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     assert main(argv) == 2
     _one_line_error(capsys, "port")
+
+
+CLIP = {"preset": "paper-fpga", "targets": [
+    {"range_m": 0.8, "azimuth_deg": 0, "radial_velocity_mps": 0, "rcs_m2": 10},
+    {"range_m": 30, "azimuth_deg": 0, "radial_velocity_mps": -3, "rcs_m2": 10}]}
+CLEAN = {"preset": "paper-fpga", "targets": [CLIP["targets"][1]]}
+
+
+@pytest.mark.parametrize(("scene", "clips"), [(CLIP, True), (CLEAN, False)])
+def test_clipped_frames_and_their_points_are_flagged(tmp_path: Path, scene: dict,
+                                                      clips: bool) -> None:
+    src, out = tmp_path / "scene.json", tmp_path / "pc.json"
+    src.write_text(json.dumps(scene))
+    assert main(["detect", "--scene", str(src), "--backend", "float", "--frames", "2",
+                 "--json", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    info = {f["frame"]: f for f in doc["frame_info"]}
+    assert all((f["clipped"] > 0) == clips and f["damaged"] is False for f in info.values())
+    assert all(f["clipped"] == f["adc_saturated"] for f in info.values())
+    assert doc["points"] and all(p.get("clipped", False) == clips for p in doc["points"])

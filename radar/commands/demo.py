@@ -121,8 +121,10 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
                                  f"{cfg.name}: Table I point cloud" + (
                                      " and GNN objects" if objects else ""),
                                  truth_xy(scene, "V"), object_boxes(objects), missed))
-    doc = cloud.to_json_dict(cfg.name, 1)
-    doc.update({"ego_speed_mps": ego, "objects": objects})
+    doc = cloud.to_json_dict(cfg.name, 1, [0] if adc.saturated else [])
+    doc.update({"ego_speed_mps": ego, "objects": objects,
+                "frame_info": [{"frame": 0, "points": len(cloud), "clipped": adc.saturated,
+                                "damaged": False}]})
     (out / "table1_points.json").write_text(json.dumps(doc, indent=1))
     print(f"figures in {out}/: " + ", ".join(p.name for p in figs)
           + f" ({time.perf_counter() - t0:.1f} s)")

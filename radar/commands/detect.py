@@ -111,11 +111,12 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 fc = frame_cloud(f, cfg, params, k, "detect")
                 cloud = fc.cloud
                 clouds.append(cloud)
-                per_frame.append({"frame": k, "points": len(cloud),
-                                  "adc_saturated": saturated[k] if k < len(saturated) else 0,
+                n_clip = saturated[k] if k < len(saturated) else 0
+                per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": n_clip,
                                   "records": len(f.records), "detections": f.detections,
                                   "truncated": f.truncated, "complete": f.complete,
-                                  "problems": f.problems + fc.problems})
+                                  "problems": f.problems + fc.problems,
+                                  "clipped": n_clip, "damaged": not f.complete})
                 if f.truncated:
                     warn([f"frame {k}: {f.detections} cells passed the CFAR, only "
                           f"--max-detections {dcfg.max_detections} were sent"], "detect")
@@ -128,7 +129,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 cloud = frame_cloud(cube, cfg, params, k, "detect").cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
-                                  "adc_saturated": saturated[k]})
+                                  "adc_saturated": saturated[k], "clipped": saturated[k],
+                                  "damaged": False})
                 if args.gnn:
                     objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
                 last_cube = cube
@@ -145,10 +147,11 @@ def cmd_detect(args: argparse.Namespace) -> int:
     clipped = [k for k, n in enumerate(saturated) if n]
     if clipped:
         warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
-              f"harmonics of the clipped echo can appear as false points"], "detect")
+              f"harmonics of the clipped echo can appear as false points (flagged "
+              f"\"clipped\" in the JSON)"], "detect")
     cloud = PointCloud.concat(clouds)
     done = len(per_frame) if stopped else args.frames
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "scene": scene.name,
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,

@@ -161,7 +161,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     try:
         for f in frames:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
-                                     "problems": f.problems}
+                                     "damaged": not f.complete, "problems": f.problems}
             if decoder and cfg and (f.complete or args.use_damaged):
                 fc = frame_cloud(f, cfg, params, f.frame_id, "receive")
                 if fc.problems:
