@@ -154,6 +154,12 @@ class PointTarget:
         return self.range_m * math.sin(math.radians(self.azimuth_deg))
 
 
+OBJECT_LABELS: tuple[str, ...] = ("car", "pedestrian", "pedestrian_group", "two_wheeler",
+                                  "large_vehicle")
+"""The labels an object may carry: the GNN's object classes (``gnn.classes``, in its index
+order: RadarScenes' road users)."""
+
+
 @dataclass(frozen=True)
 class ExtendedObject:
     """A rigid box-shaped object (vehicle, pedestrian, ...) made of point scatterers.
@@ -206,6 +212,9 @@ class ExtendedObject:
         label = d.get("label", "car")
         if not isinstance(label, str):
             raise ValueError(f"{where}.label: must be a string, got {label!r}")
+        if label not in OBJECT_LABELS:
+            raise ValueError(f"{where}.label: unknown class {label!r}; choose one of "
+                             f"{', '.join(OBJECT_LABELS)}")
         try:
             return cls(**vals, n_scatterers=n, label=label)
         except ValueError as exc:

@@ -179,5 +179,41 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,
                 description: str) -> argparse.ArgumentParser:
     """A ``radar`` subcommand's parser: ``summary`` in ``radar --help``, ``description`` (one
-    paragraph; its line breaks and indentation are re-wrapped) on the command's own page."""
-    return sub.add_parser(name, help=summary, description=" ".join(description.split()))
+    paragraph; its line breaks and indentation are re-wrapped) on the command's own page.
+    The parsed options keep the parser (``args.parser``) for :func:`refuse`."""
+    p = sub.add_parser(name, help=summary, description=" ".join(description.split()))
+    p.set_defaults(parser=p)
+    return p
+
+
+def given(args: argparse.Namespace, dest: str) -> bool:
+    """Whether option ``dest`` has a value other than its default (the user gave it)."""
+    parser: argparse.ArgumentParser | None = getattr(args, "parser", None)
+    default = parser.get_default(dest) if parser is not None else None
+    value = getattr(args, dest)
+    return (list(value) if isinstance(value, list | tuple) else value) != (
+        list(default) if isinstance(default, list | tuple) else default)
+
+
+DETECTION_OPTIONS = ("detector", "pfa", "guard", "train", "threshold_db", "max_speed")
+"""Destinations of :func:`add_detection_options`."""
+FPGA_OPTIONS = ("fpga_cfar", "max_detections")
+"""Destinations of the on-chip detector's options (``radar.commands.detect``)."""
+
+
+def refuse(args: argparse.Namespace, dests: Iterable[str], why: str) -> None:
+    """One-line CliError when any option of ``dests`` was given: it does not apply (``why``
+    says to what)."""
+    for dest in dests:
+        if given(args, dest):
+            raise CliError(f"--{dest.replace('_', '-')}: does not apply {why}")
+
+
+def refuse_detection_misfits(args: argparse.Namespace, fpga: bool) -> None:
+    """The detection options that do not apply: ``--fpga-cfar``/``--max-detections``
+    without ``--detect fpga``, ``--threshold-db`` without ``--detector paper``."""
+    if not fpga:
+        refuse(args, FPGA_OPTIONS, "without --detect fpga (the host runs the CFAR)")
+    if args.detector != "paper":
+        refuse(args, ("threshold_db",), "to --detector " + args.detector
+               + " (it is the paper detector's threshold)")

@@ -130,3 +130,92 @@ def test_clipped_frames_and_their_points_are_flagged(tmp_path: Path, scene: dict
     assert all((f["clipped"] > 0) == clips and f["damaged"] is False for f in info.values())
     assert all(f["clipped"] == f["adc_saturated"] for f in info.values())
     assert doc["points"] and all(p.get("clipped", False) == clips for p in doc["points"])
+
+
+MISFITS = [
+    (["capture", "--pfa", "1e-4"], "--pfa"), (["capture", "--detector", "os"], "--detector"),
+    (["capture", "--train", "2", "4"], "--train"), (["capture", "--guard", "1", "1"], "--guard"),
+    (["capture", "--fpga-cfar", "go"], "--fpga-cfar"),
+    (["capture", "--max-detections", "9"], "--max-detections"),
+    (["capture", "--detect", "fpga", "--threshold-db", "9"], "--threshold-db"),
+    (["capture", "--detect", "fpga", "--max-speed", "9"], "--max-speed"),
+    (["detect", "--fpga-cfar", "go"], "--fpga-cfar"),
+    (["detect", "--max-detections", "9"], "--max-detections"),
+    (["detect", "--threshold-db", "9"], "--threshold-db"),
+    (["receive", "--max-detections", "9"], "--max-detections"),
+    (["view", "--scene", "table1", "--no-loop"], "--no-loop"),
+    (["view", "--frames", "4"], "--frames"), (["view", "--backend", "model"], "--backend"),
+    (["view", "--fps", "5"], "--fps"), (["view", "--loss", "0.1"], "--loss"),
+    (["view", "--scene", "table1", "--udp-host", "127.0.0.2"], "--udp-host"),
+    (["view", "--scene", "table1", "--threshold-db", "9"], "--threshold-db"),
+]
+
+
+@pytest.mark.parametrize(("argv", "option"), MISFITS, ids=[" ".join(a) for a, _ in MISFITS])
+def test_options_that_do_not_apply_are_refused(tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str],
+                                               argv: list[str], option: str) -> None:
+    extra = {"capture": ["--scene", "table1", "--out", str(tmp_path / "c.dmacap")],
+             "detect": ["--scene", "table1", "--json", str(tmp_path / "d.json")],
+             "receive": ["--timeout", "30", "--json", str(tmp_path / "r.json")],
+             "view": ["--port", "0", "--duration", "30"]}[argv[0]]
+    assert main([argv[0], *extra, *argv[1:]]) == 2
+    _one_line_error(capsys, option)
+    assert not (tmp_path / "c.dmacap").exists()
+
+
+def test_paper_threshold_still_applies_to_the_paper_detector(tmp_path: Path) -> None:
+    assert main(["detect", "--scene", "table1", "--preset", "paper-fpga", "--backend", "float",
+                 "--detector", "paper", "--threshold-db", "12", "--json",
+                 str(tmp_path / "d.json")]) == 0
+
+
+def test_header_only_capture_is_refused(tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    from host.capture import CaptureInfo, write_capture
+    cap = tmp_path / "head.dmacap"
+    write_capture(cap, CaptureInfo(4, 4093, 3, 512, 128, 0), [])
+    assert main(["replay", "--capture", str(cap), "--port", "9"]) == 2
+    _one_line_error(capsys, "no packet")
+
+
+def test_unknown_object_label_is_refused(tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps({"preset": "paper-fpga", "objects": [
+        {"x_m": 20, "y_m": 0, "length_m": 4, "width_m": 2, "rcs_m2": 10,
+         "label": "spaceship"}]}))
+    assert main(["detect", "--scene", str(scene), "--json", str(tmp_path / "d.json")]) == 2
+    err = capsys.readouterr().err
+    assert "unknown class 'spaceship'" in err and "pedestrian" in err and err.count("\n") == 1
+
+
+def test_garbage_datagrams_are_counted(tmp_path: Path) -> None:
+    import socket
+    import threading
+    import time
+
+    from host.capture import read_capture
+    from tests.test_cli_honesty import _free_port
+
+    cap = tmp_path / "c.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "1",
+                 "--out", str(cap)]) == 0
+    port, out, rc = _free_port(), tmp_path / "r.json", {}
+    t = threading.Thread(target=lambda: rc.update(rc=main([
+        "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "30", "--json",
+        str(out)])))
+    t.start()
+    time.sleep(1.0)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for _ in range(3):                  # before the stream: nothing to learn from
+            s.sendto(b"garbage" * 10, ("127.0.0.1", port))
+        for i, p in enumerate(read_capture(cap)[1]):
+            s.sendto(p, ("127.0.0.1", port))
+            if i == 1:                      # inside the stream
+                s.sendto(b"xx" * 50, ("127.0.0.1", port))
+    t.join(timeout=60)
+    doc = json.loads(out.read_text())
+    assert rc["rc"] == 0 and doc["stats"]["garbage_packets"] == 4
+    assert doc["frame_info"][0]["damaged"] is False
+

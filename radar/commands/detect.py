@@ -37,6 +37,7 @@ from radar.common import (
     out_file,
     out_folder,
     progress,
+    refuse_detection_misfits,
     scene_of,
     warn,
 )
@@ -81,6 +82,7 @@ def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
 
 
 def cmd_detect(args: argparse.Namespace) -> int:
+    refuse_detection_misfits(args, args.detect == "fpga")
     scene = scene_of(args)
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
@@ -126,11 +128,14 @@ def cmd_detect(args: argparse.Namespace) -> int:
                     objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
         else:
             for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
-                cloud = frame_cloud(cube, cfg, params, k, "detect").cloud
+                fc = frame_cloud(cube, cfg, params, k, "detect")
+                cloud = fc.cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
                                   "adc_saturated": saturated[k], "clipped": saturated[k],
                                   "damaged": False})
+                if fc.problems:
+                    per_frame[-1]["problems"] = fc.problems
                 if args.gnn:
                     objects.extend({"frame": k, **o} for o in gnn_objects(cloud, ego))
                 last_cube = cube

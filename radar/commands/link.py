@@ -27,6 +27,8 @@ from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, detect_config_of, fpga_config
 from radar.common import (
+    DETECTION_OPTIONS,
+    FPGA_OPTIONS,
     CliError,
     add_command,
     add_detection_options,
@@ -36,6 +38,8 @@ from radar.common import (
     out_file,
     port,
     progress,
+    refuse,
+    refuse_detection_misfits,
     scene_of,
     warn,
 )
@@ -51,6 +55,12 @@ MAX_RECEIVE_FRAMES = 1_000_000
 def cmd_capture(args: argparse.Namespace) -> int:
     from host.udp import max_packet_words
 
+    if args.detect == "host":
+        refuse(args, (*DETECTION_OPTIONS, *FPGA_OPTIONS), "to a radar-cube capture (the "
+               "host detects after receiving it; use --detect fpga for a record capture)")
+    else:
+        refuse(args, ("threshold_db", "max_speed"), "to a record capture (host-side "
+               "options: give them to radar receive)")
     scene = scene_of(args)
     cfg = scene.config
     out = out_file(args.out, ".dmacap", "--out")
@@ -98,6 +108,10 @@ def cmd_replay(args: argparse.Namespace) -> int:
           "0 (unpaced) or a rate in [0.001, 1e6] Mbit/s")
     try:
         info, packets = read_capture(Path(args.capture))
+        packets = list(packets)
+        if not packets:
+            raise ValueError(f"{args.capture}: the capture has a header but no packet: "
+                             f"nothing to replay")
         cfg = info.config(PRESETS.values())
         imp = Impairments(loss=args.loss, duplicate=args.duplicate, reorder=args.reorder,
                           seed=args.seed)
@@ -122,6 +136,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
 
     out = out_file(args.json, ".json", "--json")
     port(args.port, "--port")
+    refuse_detection_misfits(args, args.detect == "fpga")
     count(args.frames, "--frames", MAX_RECEIVE_FRAMES)
     count(args.packet_words, "--packet-words", 65535, lo=2)   # before listening
     try:
@@ -181,7 +196,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 "datagrams": rx.datagrams, "interrupted": rx.interrupted,
                 "frame_info": frames_doc,
                 "stream_problems": (decoder.stream_problems if decoder else []) + rx.unusable,
-                "stats": vars(decoder.stats) if decoder else {}})
+                "stats": _stats(decoder, rx)})
     out.write_text(json.dumps(doc, indent=1))
     damaged = sum(not f.complete for f in frames)
     print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
@@ -202,6 +217,14 @@ def cmd_receive(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def _stats(decoder: Any, rx: Any) -> dict[str, Any]:
+    """The decoder's counters (``host.stream.StreamStats``) with the datagrams no decoder
+    could be learnt from counted as garbage (they are in ``stream_problems`` too)."""
+    stats: dict[str, Any] = dict(vars(decoder.stats)) if decoder else {}
+    stats["garbage_packets"] = stats.get("garbage_packets", 0) + len(rx.unusable)
+    return stats
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:

@@ -44,6 +44,7 @@ from radar.common import (
     detection_params,
     ego_speed_mps,
     port,
+    refuse,
 )
 from radar.sources import get_source
 from radar.view.feed import Feed
@@ -100,6 +101,21 @@ def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
     return kind
 
 
+def _refuse_misfits(args: argparse.Namespace) -> None:
+    """The options that do not apply to the chosen source: one-line CliError."""
+    if not args.replay:
+        refuse(args, ("no_loop",), "without --replay")
+    if not args.scene:
+        refuse(args, ("frames", "backend"), "without --scene")
+    if not (args.replay or args.scene):
+        refuse(args, ("fps", "loss", "seed"), "to a UDP stream (the sender sets its pace)")
+    else:
+        refuse(args, ("udp_host", "packet_words"), "without a UDP stream (--udp-port)")
+    if args.detector != "paper":
+        refuse(args, ("threshold_db",), "to --detector " + args.detector
+               + " (it is the paper detector's threshold)")
+
+
 def _gnn(args: argparse.Namespace) -> Callable[..., list[dict[str, Any]]] | None:
     if not args.gnn:
         return None
@@ -116,6 +132,7 @@ def build(args: argparse.Namespace, stop: threading.Event
     feed, health = Feed(), LinkHealth()
     port(args.port, "--port")
     port(args.udp_port, "--udp-port")
+    _refuse_misfits(args)
     check(args.fps, "--fps", args.fps == 0 or 1e-3 <= args.fps <= 1e4,
           "0 (as fast as possible) or a rate in [0.001, 1e4] frames/s")
     if not 0.0 <= args.loss <= 1.0:
