@@ -165,6 +165,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise CliError(f"--host {args.host} --port {args.port}: {exc}") from None
     print(f"listening on {args.host}:{rx.port}", flush=True)
+    warn([h for h in (rx.buffer_hint(),) if h], "receive")
     with rx:
         frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
                             total_timeout_s=args.timeout, make_decoder=receiver.learn)
@@ -196,7 +197,9 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 "datagrams": rx.datagrams, "interrupted": rx.interrupted,
                 "frame_info": frames_doc,
                 "stream_problems": (decoder.stream_problems if decoder else []) + rx.unusable,
-                "stats": _stats(decoder, rx)})
+                "stats": _stats(decoder, rx),
+                "link": {"socket_drops": rx.socket_drops, "rate_mbps": rx.rate_bps / 1e6,
+                         "rcvbuf_bytes": rx.rcvbuf_granted}})
     out.write_text(json.dumps(doc, indent=1))
     damaged = sum(not f.complete for f in frames)
     print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
@@ -205,6 +208,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     for f in frames:
         for p in f.problems[:5]:
             print(f"  {p}")
+    warn([h for h in (rx.loss_hint(),) if h], "receive")
     if rx.interrupted:
         warn(["interrupted: wrote what was received"], "receive")
         return 130
