@@ -81,15 +81,17 @@ def note_compile(command: str) -> None:
     """Once per process, right before the first records -> point cloud call: one
     ``radar <command>: ...`` line on stderr when the host's compiled kernels
     (``host.kernels``) are not cached yet (that call then takes 20-30 s longer, once
-    per checkout)."""
+    per checkout); the kernels only some data reaches are compiled right then, so the
+    note does not come back."""
     global _compile_noted
     if _compile_noted:
         return
     _compile_noted = True
-    from host.kernels import uncompiled_kernels  # numba: only where records are
-    if uncompiled_kernels():
+    from host import kernels  # numba: only where records are
+    if kernels.uncompiled_kernels():
         print(f"radar {command}: compiling the host kernels (numba; "
               "first run in this checkout, 20-30 s)", file=sys.stderr)
+        kernels.compile_data_dependent()    # then the next run finds every kernel cached
 
 
 def out_file(path: str, suffix: str | None, option: str) -> Path:
