@@ -219,3 +219,15 @@ def test_garbage_datagrams_are_counted(tmp_path: Path) -> None:
     assert rc["rc"] == 0 and doc["stats"]["garbage_packets"] == 4
     assert doc["frame_info"][0]["damaged"] is False
 
+
+
+def test_gnn_eval_messages_name_the_way_out(tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["gnn", "eval", "--cache-dir", str(tmp_path / "fresh")]) == 2
+    err = capsys.readouterr().err
+    assert "make gnn-dataset" in err and err.count("\n") == 1
+    text = tmp_path / "x.txt"
+    text.write_text("hello\n")
+    assert main(["gnn", "eval", "--data", str(text)]) == 2
+    err = capsys.readouterr().err
+    assert "not a numpy .npz archive" in err and "allow_pickle" not in err

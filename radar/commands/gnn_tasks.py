@@ -158,7 +158,12 @@ def _data_path(args: argparse.Namespace, split: str) -> Path:
         return Path(args.data)
     from gnn.dataset import split_path
 
-    return split_path(Path(args.cache_dir), split)
+    path = split_path(Path(args.cache_dir), split)
+    if not path.is_file():
+        raise ValueError(f"dataset: no {split} set at {path}: generate it first with "
+                         f"`make gnn-dataset` (or `radar gnn dataset --cache-dir "
+                         f"{args.cache_dir}`)")
+    return path
 
 
 def _jsonable(x: Any) -> Any:
