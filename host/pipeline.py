@@ -1,6 +1,6 @@
 """Host processing of one frame: radar cube -> detections -> angles -> point cloud.
 
-Steps (DESIGN.md section 1, host side):
+Steps (docs/design.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel

@@ -1,4 +1,4 @@
-"""Radar point cloud: one detection per row, the fields of DESIGN.md section 4 and more.
+"""Radar point cloud: one detection per row, the fields of docs/design.md 4.4 and more.
 
 A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per point:
 
@@ -13,7 +13,7 @@ A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per p
 - in the JSON only: ``clipped`` (true, present on the points of a frame whose ADC samples
   clipped; absent = false)
 
-JSON (``to_json_dict``, read back by ``from_json_dict``) follows DESIGN.md section 4:
+JSON (``to_json_dict``, read back by ``from_json_dict``) follows docs/design.md 4.4:
 ``{"preset", "frames", "points": [...]}`` with the required fields range_m, azimuth_deg,
 radial_velocity_mps, x_m, y_m, power_db, snr_db plus the extra ones.
 """
@@ -123,7 +123,7 @@ class PointCloud:
 
     @classmethod
     def from_json_dict(cls, doc: dict[str, Any]) -> PointCloud:
-        """A cloud from the DESIGN.md section 4 JSON object (``{"points": [...]}``, as
+        """A cloud from the docs/design.md 4.4 JSON object (``{"points": [...]}``, as
         written by :meth:`to_json_dict`). Each point needs range_m, azimuth_deg,
         radial_velocity_mps, power_db and snr_db; rcs_dbsm, range_bin, doppler_bin, frame
         and ambiguous default to 0/false; x, y, vx, vy are derived from the polar fields.

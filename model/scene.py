@@ -1,12 +1,12 @@
 """Radar scenes: point targets, extended objects (sets of scatterers) and the scene JSON.
 
-Conventions (DESIGN.md section 2): x forward (boresight), y left, azimuth positive towards +y
+Conventions (docs/design.md section 2): x forward (boresight), y left, azimuth positive towards +y
 (counter-clockwise), radial velocity positive = receding. Angles in degrees at interfaces.
 Kinematics are given at the **centre of the frame** (the middle of the coherent processing
 interval), so a target's measured range is its scene range even when it moves metres during
 a frame.
 
-Scene JSON (DESIGN.md section 4)::
+Scene JSON (docs/design.md 4.3)::
 
     {"preset": "full", "seed": 1, "tx_beamforming": true,
      "targets": [{"range_m": 40.0, "azimuth_deg": -10.0, "radial_velocity_mps": -12.5,

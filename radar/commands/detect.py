@@ -1,5 +1,5 @@
 """``radar detect``: frames of a scene through a frame source (model, float, rtl) and the
-host processing to the point cloud JSON of DESIGN.md section 4, optionally GNN objects and
+host processing to the point cloud JSON of docs/design.md 4.4, optionally GNN objects and
 figures.
 
 ``--detect host`` (default): the source gives radar cubes, the host runs the CFAR
@@ -197,7 +197,7 @@ def add_fpga_options(p: argparse.ArgumentParser) -> None:
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     d = add_command(sub, "detect", "scene -> point cloud JSON", """
         Simulate frames of a scene, run them through the FPGA chain (a model of it or the RTL) and
-        the host processing, and write the point cloud JSON of DESIGN.md section 4.""")
+        the host processing, and write the point cloud JSON of docs/design.md 4.4.""")
     d.add_argument("--scene", required=True, help="scene JSON file or built-in name (table1)")
     d.add_argument("--json", required=True, help="output point cloud .json")
     d.add_argument("--backend", choices=list(SOURCES), default="model",

@@ -88,7 +88,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
 
     p = subparsers.add_parser("detect", help="detect objects in one point cloud or scene")
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--points", default=None, help="point cloud JSON (DESIGN.md section 4)")
+    src.add_argument("--points", default=None, help="point cloud JSON (docs/design.md 4.4)")
     src.add_argument("--scene", default=None,
                      help="scene JSON or built-in name, simulated through the host chain")
     p.add_argument("--ego-speed", type=float, default=None,

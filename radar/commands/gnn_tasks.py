@@ -137,7 +137,7 @@ def _json_ego(path: Path) -> float:
 
 
 def read_points(path: Path) -> PointCloud:
-    """A point cloud from the DESIGN.md section 4 JSON file ``path``."""
+    """A point cloud from the docs/design.md 4.4 JSON file ``path``."""
     if not path.is_file():
         raise ValueError(f"points: no such file {str(path)!r}")
     try:
