@@ -96,7 +96,8 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     mask, p0 = paper_threshold(cube, params.paper_threshold_db)
     figs = [plot_detection_mask(p0, mask, cfg, out / "fig6_range_doppler_ch0.png",
                                 f"{cfg.name}: channel 0 and its threshold "
-                                f"({params.paper_threshold_db:g} dB over the median)", zoom),
+                                f"({params.paper_threshold_db:g} dB over the median)", zoom,
+                                truth_range_doppler(scene, "V")),
             plot_range_doppler(range_doppler_power(cube), cfg, out / "range_doppler_nci.png",
                                f"{cfg.name}: range-Doppler, {cfg.n_virtual} channels "
                                f"non-coherent", truth_range_doppler(scene, "V"), zoom)]
@@ -108,7 +109,8 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     figs.append(plot_range_azimuth_pair(
         [(ra_bf, "TX subarray beamforming (3 elements)"), (ra_nobf, "single TX element")],
         az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom,
-        note=alias_note(scene.targets, cfg)))
+        note=alias_note(scene.targets, cfg),
+        title=f"{cfg.name}: range-azimuth, {cfg.num_tx} TX x {cfg.num_rx} RX"))
     ego = default_ego_speed_mps(scene)  # the same default as radar detect / radar gnn detect
     objects = gnn.objects(cloud, ego) if gnn is not None else []
     if gnn is not None:
@@ -125,9 +127,10 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     doc.update({"ego_speed_mps": ego, "objects": objects,
                 "frame_info": [{"frame": 0, "points": len(cloud), "clipped": adc.saturated,
                                 "damaged": False}]})
-    (out / "table1_points.json").write_text(json.dumps(doc, indent=1))
+    points = out / "table1_points.json"
+    points.write_text(json.dumps(doc, indent=1))
     print(f"figures in {out}/: " + ", ".join(p.name for p in figs)
-          + f" ({time.perf_counter() - t0:.1f} s)")
+          + f"; the point cloud JSON: {points} ({time.perf_counter() - t0:.1f} s)")
     return 0
 
 
