@@ -231,3 +231,39 @@ def test_gnn_eval_messages_name_the_way_out(tmp_path: Path,
     assert main(["gnn", "eval", "--data", str(text)]) == 2
     err = capsys.readouterr().err
     assert "not a numpy .npz archive" in err and "allow_pickle" not in err
+
+
+def test_receive_error_mid_run_writes_the_frames_before(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str]
+                                                        ) -> None:
+    import threading
+    import time
+
+    import radar.commands.link as link
+    from tests.test_cli_honesty import _free_port
+
+    cap = tmp_path / "c.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "3",
+                 "--out", str(cap)]) == 0
+    real, calls = link.frame_cloud, []
+
+    def failing(*a, **k):  # noqa: ANN002, ANN003, ANN202 - as radar.frame_cloud
+        calls.append(1)
+        if len(calls) == 2:
+            raise ValueError("cube: contains NaN or infinite values")
+        return real(*a, **k)
+
+    monkeypatch.setattr(link, "frame_cloud", failing)
+    port, out, rc = _free_port(), tmp_path / "r.json", {}
+    t = threading.Thread(target=lambda: rc.update(rc=main([
+        "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "30", "--json",
+        str(out)])))
+    t.start()
+    time.sleep(1.0)
+    assert main(["replay", "--capture", str(cap), "--port", str(port)]) == 0
+    t.join(timeout=60)
+    assert rc["rc"] == 2
+    assert "frame 1: cube: contains NaN" in capsys.readouterr().err
+    doc = json.loads(out.read_text())
+    assert doc["error"].startswith("frame 1") and len(doc["frame_info"]) == 1

@@ -174,6 +174,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     if decoder and cfg:
         params = detection_params(args, cfg=cfg)  # CFAR window vs the learnt map
     clouds, frames_doc = [], []
+    error = None                    # a frame the host could not process: the rest is kept
     try:
         for f in frames:
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
@@ -190,6 +191,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
             frames_doc.append(entry)
     except KeyboardInterrupt:
         rx.interrupted = True
+    except ValueError as exc:
+        error = f"frame {len(frames_doc)}: {exc}"
     cloud = PointCloud.concat(clouds)
     doc = cloud.to_json_dict(cfg.name if cfg else "unknown", len(frames))
     doc.update({"backend": "udp", "detect": args.detect,
@@ -200,7 +203,11 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 "stats": _stats(decoder, rx),
                 "link": {"socket_drops": rx.socket_drops, "rate_mbps": rx.rate_bps / 1e6,
                          "rcvbuf_bytes": rx.rcvbuf_granted}})
+    if error:
+        doc["error"] = error
     out.write_text(json.dumps(doc, indent=1))
+    if error:
+        raise CliError(f"{error} (the {len(frames_doc)} frame(s) before it are in {out})")
     damaged = sum(not f.complete for f in frames)
     print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
           + (f" (preset {cfg.name}, {decoder.packet_words} payload words per packet learnt "
