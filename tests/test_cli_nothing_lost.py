@@ -267,3 +267,21 @@ def test_receive_error_mid_run_writes_the_frames_before(tmp_path: Path,
     assert "frame 1: cube: contains NaN" in capsys.readouterr().err
     doc = json.loads(out.read_text())
     assert doc["error"].startswith("frame 1") and len(doc["frame_info"]) == 1
+
+
+@pytest.mark.parametrize(("argv", "option"), [
+    (["gnn", "dataset", "--window-s", "1"], "--window-s"),
+    (["gnn", "dataset", "--radarscenes", "{tmp}/seq", "--train", "5"], "--train"),
+    (["gnn", "train", "--radius", "3"], "--radius"),
+    (["gnn", "train", "--graph", "radius", "--k", "5"], "--k"),
+    (["gnn", "train", "--epochs", "-5"], "epochs"),
+    (["gnn", "train", "--hidden", "-1"], "hidden"),
+])
+def test_gnn_options_checked_before_the_data(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str],
+                                             argv: list[str], option: str) -> None:
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    extra = (["--data", str(tmp_path / "none.npz"), "--out", str(tmp_path / "m.pt")]
+             if argv[1] == "train" else ["--cache-dir", str(tmp_path / "c")])
+    assert main([*argv, *extra]) == 2
+    _one_line_error(capsys, option)

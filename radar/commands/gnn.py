@@ -53,7 +53,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
                    "scenes.json) into CACHE_DIR/radarscenes-<name>.npz")
     p.add_argument("--window-s", type=float, default=0.5,
                    help="RadarScenes accumulation window, s (default 0.5, as RadarGNN)")
-    p.set_defaults(func=_guarded(tasks.cmd_dataset))
+    p.set_defaults(func=_guarded(tasks.cmd_dataset), parser=p)
 
     p = subparsers.add_parser("train", help="train the GNN, write a checkpoint",
                               description="Adam on weighted cross-entropy + Huber box loss.")
@@ -74,7 +74,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-residual", action="store_true", help="no residual updates")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--threads", type=int, default=1, help="torch CPU threads (default 1)")
-    p.set_defaults(func=_guarded(tasks.cmd_train))
+    p.set_defaults(func=_guarded(tasks.cmd_train), parser=p)
 
     p = subparsers.add_parser("eval", help="GNN vs DBSCAN baseline metrics",
                               description="mAP at point IoU 0.3 and box IoU 0.5, per-point "

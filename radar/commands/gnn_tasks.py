@@ -10,12 +10,17 @@ from pathlib import Path
 from typing import Any
 
 from host.pointcloud import PointCloud
-from radar.common import out_file, out_folder
+from radar.common import out_file, out_folder, refuse
 
 
 def cmd_dataset(args: argparse.Namespace) -> int:
     from gnn.dataset import build_split, save_frames
 
+    if args.radarscenes is None:
+        refuse(args, ("window_s",), "without --radarscenes")
+    else:
+        refuse(args, ("train", "val", "test", "backend", "workers"), "to --radarscenes "
+               "(it converts one recorded sequence)")
     for option in ("--train", "--val", "--test"):
         n = getattr(args, option[2:])
         if n < 0:
@@ -49,16 +54,18 @@ def cmd_train(args: argparse.Namespace) -> int:
 
     _threads(torch, args.threads)
     out_file(args.out, None, "--out")   # before training, not after
+    refuse(args, ("radius",) if args.graph == "knn" else ("k",),
+           f"to --graph {args.graph}")
+    gc = GraphConfig(kind=args.graph, k=args.k, radius_m=args.radius)   # checked first
+    mc = ModelConfig(hidden=args.hidden, layers=args.layers, auto_offset=not args.no_offset,
+                     residual=not args.no_residual)
+    tc = TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr,
+                     box_weight=args.box_weight, seed=args.seed)
     paths = [Path(d) for d in args.data] if args.data else [_data_path(args, "train")]
     frames, meta = [], {}
     for path in paths:
         more, meta = load_frames(path)
         frames.extend(more)
-    gc = GraphConfig(kind=args.graph, k=args.k, radius_m=args.radius)
-    mc = ModelConfig(hidden=args.hidden, layers=args.layers, auto_offset=not args.no_offset,
-                     residual=not args.no_residual)
-    tc = TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr,
-                     box_weight=args.box_weight, seed=args.seed)
     model, history = train(frames, tc, mc, gc, progress=not args.quiet)
     save_checkpoint(args.out, model, gc, {
         "train_frames": len(frames), "dataset_backend": meta.get("backend", "?"),
