@@ -219,6 +219,7 @@ def build(args: argparse.Namespace, stop: threading.Event
         except OSError as exc:     # an unknown or foreign --udp-host, a port in use
             raise CliError(f"--udp-host {args.udp_host} --udp-port {args.udp_port}: "
                            f"{exc}") from None
+        common.warn([h for h in (rx.buffer_hint(),) if h], "view")
         desc = f"UDP {args.udp_host}:{rx.port}"
         processor.source = desc
         threads.append(threading.Thread(target=udp_loop, name="view-udp", daemon=True,
