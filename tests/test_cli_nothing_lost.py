@@ -5,6 +5,8 @@ checked."""
 from __future__ import annotations
 
 import json
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -190,23 +192,31 @@ def test_unknown_object_label_is_refused(tmp_path: Path,
     assert "unknown class 'spaceship'" in err and "pedestrian" in err and err.count("\n") == 1
 
 
-def test_garbage_datagrams_are_counted(tmp_path: Path) -> None:
-    import socket
-    import threading
-    import time
-
-    from host.capture import read_capture
+def _capture_and_receive(tmp_path: Path, frames: int
+                         ) -> tuple[Path, int, Path, dict, threading.Thread]:
+    """A paper-fpga Table I capture of ``frames`` frames and a ``radar receive`` listening
+    (in a thread, exit status into the dict) on a free port: (capture, port, JSON, dict,
+    thread)."""
     from tests.test_cli_honesty import _free_port
 
     cap = tmp_path / "c.dmacap"
-    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "1",
-                 "--out", str(cap)]) == 0
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames",
+                 str(frames), "--out", str(cap)]) == 0
     port, out, rc = _free_port(), tmp_path / "r.json", {}
     t = threading.Thread(target=lambda: rc.update(rc=main([
         "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "30", "--json",
         str(out)])))
     t.start()
     time.sleep(1.0)
+    return cap, port, out, rc, t
+
+
+def test_garbage_datagrams_are_counted(tmp_path: Path) -> None:
+    import socket
+
+    from host.capture import read_capture
+
+    cap, port, out, rc, t = _capture_and_receive(tmp_path, 1)
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
         for _ in range(3):                  # before the stream: nothing to learn from
             s.sendto(b"garbage" * 10, ("127.0.0.1", port))
@@ -218,7 +228,6 @@ def test_garbage_datagrams_are_counted(tmp_path: Path) -> None:
     doc = json.loads(out.read_text())
     assert rc["rc"] == 0 and doc["stats"]["garbage_packets"] == 4
     assert doc["frame_info"][0]["damaged"] is False
-
 
 
 def test_gnn_eval_messages_name_the_way_out(tmp_path: Path,
@@ -237,15 +246,8 @@ def test_receive_error_mid_run_writes_the_frames_before(tmp_path: Path,
                                                         monkeypatch: pytest.MonkeyPatch,
                                                         capsys: pytest.CaptureFixture[str]
                                                         ) -> None:
-    import threading
-    import time
-
     import radar.commands.link as link
-    from tests.test_cli_honesty import _free_port
 
-    cap = tmp_path / "c.dmacap"
-    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "3",
-                 "--out", str(cap)]) == 0
     real, calls = link.frame_cloud, []
 
     def failing(*a, **k):  # noqa: ANN002, ANN003, ANN202 - as radar.frame_cloud
@@ -255,12 +257,7 @@ def test_receive_error_mid_run_writes_the_frames_before(tmp_path: Path,
         return real(*a, **k)
 
     monkeypatch.setattr(link, "frame_cloud", failing)
-    port, out, rc = _free_port(), tmp_path / "r.json", {}
-    t = threading.Thread(target=lambda: rc.update(rc=main([
-        "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "30", "--json",
-        str(out)])))
-    t.start()
-    time.sleep(1.0)
+    cap, port, out, rc, t = _capture_and_receive(tmp_path, 3)
     assert main(["replay", "--capture", str(cap), "--port", str(port)]) == 0
     t.join(timeout=60)
     assert rc["rc"] == 2
