@@ -7,10 +7,12 @@ RadarScenes "static": everything that is not a moving road user).
 
 from __future__ import annotations
 
-CLASSES: tuple[str, ...] = ("car", "pedestrian", "pedestrian_group", "two_wheeler",
-                            "large_vehicle", "background")
-"""Class names by index."""
-OBJECT_CLASSES: tuple[str, ...] = CLASSES[:-1]
+from model.scene import OBJECT_LABELS
+
+CLASSES: tuple[str, ...] = (*OBJECT_LABELS, "background")
+"""Class names by index (the scene's object labels, ``model.scene.OBJECT_LABELS``, then
+background)."""
+OBJECT_CLASSES: tuple[str, ...] = OBJECT_LABELS
 """The five object classes (everything except background)."""
 NUM_CLASSES = len(CLASSES)
 BACKGROUND = CLASSES.index("background")

@@ -100,7 +100,10 @@ def load_frames(path: Path) -> tuple[list[Frame], dict[str, str]]:
         pcls, pobj, boxes, bcls, ego = (z[k] for k in ("point_class", "point_object", "boxes",
                                                        "box_class", "ego_speed"))
     except (KeyError, OSError, ValueError, EOFError) as exc:
-        raise ValueError(f"dataset: {path} is not a gnn dataset file ({exc})") from None
+        # numpy's own advice for a non-archive (load it unsafely with allow_pickle) is not
+        # one to give about a dataset file
+        why = "not a numpy .npz archive" if "allow_pickle" in str(exc) else str(exc)
+        raise ValueError(f"dataset: {path} is not a gnn dataset file ({why})") from None
     frames = []
     for i in range(len(ego)):
         p, b = slice(po[i], po[i + 1]), slice(bo[i], bo[i + 1])

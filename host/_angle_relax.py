@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from host._angle_peaks import COARSE_FFT, SECOND_LOBE, _c128, _class_peaks, _tables
-from host.kernels import njit
+from host.kernels import njit, warm_up
 
 
 @njit(fastmath=True)
@@ -276,3 +276,11 @@ def relax_rows(x: np.ndarray, noise: np.ndarray, n_fft: int, max_targets: int,
                dynamic_range_db, n_fft, SECOND_LOBE, wr, wi, rank, dmr, dmi, oc, os_, s_c,
                a_c, count)
     return s_c, a_c, count
+
+
+@warm_up
+def _warm_up() -> None:
+    """RELAX and the steering rows (reached only by cells with several targets) on one row:
+    the argument types of ``host.angle`` and its default ``AngleParams``."""
+    steering_rows(np.zeros(1), 8)
+    relax_rows(np.zeros((1, 8), np.complex128), np.ones(1), 1024, 3, 2, 12.0, 20.0)

@@ -6,6 +6,10 @@ choose).
 :func:`njit` registers every kernel; :func:`uncompiled_kernels` names those without a
 compiled cache on disk (their first call compiles them: 20-30 s in all on a fresh checkout;
 numba caches them in ``__pycache__``, and the next process loads them in about 0.5 s).
+Some kernels run only on some data (RELAX: cells with several targets): a module registers
+a :func:`warm_up` that calls them on a tiny input, and :func:`compile_data_dependent` runs
+those, so that one run leaves every kernel cached (else the "compiling" note would come
+back on every run whose data never reached them).
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ COMPILED = numba is not None
 """Whether the kernels are compiled (numba importable)."""
 
 _KERNELS: dict[str, Any] = {}
+_WARM_UPS: list[Callable[[], None]] = []
 
 
 def njit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
@@ -50,6 +55,22 @@ def uncompiled_kernels() -> list[str]:
         if isinstance(index, str) and not os.path.exists(index):
             missing.append(name)
     return missing
+
+
+def warm_up(fn: Callable[[], None]) -> Callable[[], None]:
+    """Register ``fn``, which calls the module's data-dependent kernels on a tiny input
+    (with the argument types of the real calls), for :func:`compile_data_dependent`."""
+    _WARM_UPS.append(fn)
+    return fn
+
+
+def compile_data_dependent() -> None:
+    """Compile (or load from the cache) the kernels that only some data reaches, now."""
+    if not COMPILED:
+        return
+    _load_kernels()
+    for fn in _WARM_UPS:
+        fn()
 
 
 def _load_kernels() -> None:

@@ -1,6 +1,6 @@
 """Host processing of one frame: radar cube -> detections -> angles -> point cloud.
 
-Steps (DESIGN.md section 1, host side):
+Steps (docs/design.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel
@@ -105,6 +105,29 @@ def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     r, d = cells[:, 0], cells[:, 1]
     found = Cells(r, d, nci[r, d], noise, offsets, cube[:, r, d].T)
     return points_from_cells(found, cfg, params, frame), nci
+
+
+REAL_ONLY_ASYMMETRY = 0.2
+"""Largest :func:`hermitian_asymmetry` of a cube called real-only: complex data gives about
+2 (the mirrored cell is independent), real-only data 0 in float and about 0.04 after the
+fixed-point chain's rounding."""
+
+
+def hermitian_asymmetry(cube: np.ndarray) -> float:
+    """Energy of ``Y - conj(Y[-r, -d])`` over that of ``Y`` for channel 0 of ``cube``,
+    complex (n_virtual, n_range, n_doppler): 0 when the ADC samples were real (their
+    spectrum is Hermitian: every target has a mirror at range bin N - k, Doppler -d); nan
+    for an all-zero channel."""
+    y = np.asarray(cube[0])
+    mirror = np.conj(np.roll(np.flip(y, (0, 1)), 1, (0, 1)))
+    energy = float(np.sum(np.abs(y) ** 2))
+    return float(np.sum(np.abs(y - mirror) ** 2)) / energy if energy > 0 else float("nan")
+
+
+def real_only(cube: np.ndarray) -> bool:
+    """Whether ``cube`` (complex (n_virtual, n_range, n_doppler)) looks like real-only
+    samples in a complex profile (:data:`REAL_ONLY_ASYMMETRY`)."""
+    return bool(hermitian_asymmetry(cube) < REAL_ONLY_ASYMMETRY)
 
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,

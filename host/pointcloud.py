@@ -1,4 +1,4 @@
-"""Radar point cloud: one detection per row, the fields of DESIGN.md section 4 and more.
+"""Radar point cloud: one detection per row, the fields of docs/design.md 4.4 and more.
 
 A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per point:
 
@@ -10,14 +10,17 @@ A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per p
 - ``range_bin``, ``doppler_bin`` (signed, unfolded), ``ambiguous`` (bool: another velocity
   within the assumed maximum speed explains the measurement, or the velocity was unfolded by
   the TDM test; ``host.pipeline`` step 3)
+- in the JSON only: ``clipped`` (true, present on the points of a frame whose ADC samples
+  clipped; absent = false)
 
-JSON (``to_json_dict``, read back by ``from_json_dict``) follows DESIGN.md section 4:
+JSON (``to_json_dict``, read back by ``from_json_dict``) follows docs/design.md 4.4:
 ``{"preset", "frames", "points": [...]}`` with the required fields range_m, azimuth_deg,
 radial_velocity_mps, x_m, y_m, power_db, snr_db plus the extra ones.
 """
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -97,23 +100,30 @@ class PointCloud:
         """The points where ``mask`` (bool (n,) or index array) selects."""
         return PointCloud(**{f.name: getattr(self, f.name)[mask] for f in fields(self)})
 
-    def records(self) -> list[dict[str, Any]]:
-        """One JSON-ready dict per point (floats rounded to 4 decimals)."""
+    def records(self, clipped_frames: Collection[int] = ()) -> list[dict[str, Any]]:
+        """One JSON-ready dict per point (floats rounded to 4 decimals); a point of a frame
+        in ``clipped_frames`` (the ADC clipped) also gets ``"clipped": true``."""
         out = []
+        clipped = set(clipped_frames)
         for i in range(len(self)):
             rec: dict[str, Any] = {k: round(float(getattr(self, k)[i]), 4) for k in FLOAT_FIELDS}
             rec.update({k: int(getattr(self, k)[i]) for k in INT_FIELDS})
             rec["ambiguous"] = bool(self.ambiguous[i])
+            if rec["frame"] in clipped:
+                rec["clipped"] = True
             out.append(rec)
         return out
 
-    def to_json_dict(self, preset: str, frames: int) -> dict[str, Any]:
-        """The DESIGN.md section 4 point cloud JSON object."""
-        return {"preset": preset, "frames": int(frames), "points": self.records()}
+    def to_json_dict(self, preset: str, frames: int, clipped_frames: Collection[int] = ()
+                     ) -> dict[str, Any]:
+        """The point cloud JSON object; points of ``clipped_frames`` carry ``"clipped":
+        true`` (harmonics of a clipped echo can be false points)."""
+        return {"preset": preset, "frames": int(frames),
+                "points": self.records(clipped_frames)}
 
     @classmethod
     def from_json_dict(cls, doc: dict[str, Any]) -> PointCloud:
-        """A cloud from the DESIGN.md section 4 JSON object (``{"points": [...]}``, as
+        """A cloud from the docs/design.md 4.4 JSON object (``{"points": [...]}``, as
         written by :meth:`to_json_dict`). Each point needs range_m, azimuth_deg,
         radial_velocity_mps, power_db and snr_db; rcs_dbsm, range_bin, doppler_bin, frame
         and ambiguous default to 0/false; x, y, vx, vy are derived from the polar fields.

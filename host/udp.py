@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import random
 import socket
+import struct
+import sys
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -137,19 +139,88 @@ class UdpSender(_UdpSocket):
         return log
 
 
+RCVBUF_BYTES = 64 << 20
+"""Socket receive buffer asked for, bytes: more than three frames of ``full`` (17 MB each),
+so a receiver that pauses (another process on the core) for a second at 766 Mbit/s loses
+nothing. Linux grants at most ``net.core.rmem_max`` (privileged processes may go beyond
+it: SO_RCVBUFFORCE)."""
+_SO_RCVBUFFORCE = getattr(socket, "SO_RCVBUFFORCE", 33 if sys.platform == "linux" else None)
+_SO_RXQ_OVFL = getattr(socket, "SO_RXQ_OVFL", 40 if sys.platform == "linux" else None)
+"""Linux: each datagram carries the socket's count of datagrams dropped for want of buffer."""
+
+
+def set_receive_buffer(sock: socket.socket, asked: int) -> int:
+    """Raise ``sock``'s receive buffer towards ``asked`` bytes as far as the OS allows and
+    return what it granted, bytes (Linux reports twice the usable size: halved here)."""
+    for opt in (_SO_RCVBUFFORCE, socket.SO_RCVBUF):
+        if opt is None:
+            continue
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, opt, asked)
+            break
+        except OSError:                 # SO_RCVBUFFORCE needs CAP_NET_ADMIN
+            continue
+    got = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+    return got // 2 if sys.platform == "linux" else got
+
+
 class UdpReceiver(_UdpSocket):
-    """Bound UDP socket (port 0 = an ephemeral port, see :attr:`port`)."""
+    """Bound UDP socket (port 0 = an ephemeral port, see :attr:`port`) with its receive
+    buffer raised towards ``rcvbuf_bytes`` (:attr:`rcvbuf_granted`: what the OS gave).
+    :meth:`receive` measures the link: :attr:`socket_drops` (datagrams the kernel dropped
+    because the buffer was full: the receiver fell behind; Linux only, else 0) and
+    :attr:`rate_bps` (the arrival rate)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0,
-                 rcvbuf_bytes: int = 16 << 20) -> None:
+                 rcvbuf_bytes: int = RCVBUF_BYTES) -> None:
         check_port(port)
         self.interrupted = False
         self.decoder: PacketDecoder[Any] | None = None
         self.datagrams = 0
+        self.bytes = 0
+        self.socket_drops = 0
+        self.rate_bps = 0.0
         self.unusable: list[str] = []  # datagrams no decoder could be built from
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf_bytes)
+        self.rcvbuf_asked = rcvbuf_bytes
+        self.rcvbuf_granted = set_receive_buffer(self.sock, rcvbuf_bytes)
+        self._ovfl = False
+        if _SO_RXQ_OVFL is not None:
+            try:
+                self.sock.setsockopt(socket.SOL_SOCKET, _SO_RXQ_OVFL, 1)
+                self._ovfl = True
+            except OSError:
+                pass
         self.sock.bind((host, port))
+
+    def buffer_hint(self) -> str | None:
+        """A hint when the OS granted a smaller receive buffer than asked, else None."""
+        if self.rcvbuf_granted >= self.rcvbuf_asked:
+            return None
+        return (f"socket receive buffer {self.rcvbuf_granted / 2**20:.1f} MiB, asked "
+                f"{self.rcvbuf_asked / 2**20:.0f} MiB (the OS limit; Linux: sysctl -w "
+                f"net.core.rmem_max={self.rcvbuf_asked}): a fast stream may be dropped")
+
+    def loss_hint(self) -> str | None:
+        """A hint with the measured loss when the receiver fell behind, else None."""
+        if not self.socket_drops:
+            return None
+        total = self.datagrams + self.socket_drops
+        return (f"fell behind: the kernel dropped {self.socket_drops} of {total} datagrams "
+                f"({100 * self.socket_drops / total:.1f} %) because the socket receive "
+                f"buffer ({self.rcvbuf_granted / 2**20:.1f} MiB) was full at "
+                f"{self.rate_bps / 1e6:.0f} Mbit/s; lower the sender's rate (radar replay "
+                f"--rate-mbps) or raise the buffer (Linux: net.core.rmem_max)")
+
+    def _recv(self) -> bytes:
+        """One datagram; the kernel's drop count from its ancillary data (Linux)."""
+        if not self._ovfl:
+            return self.sock.recvfrom(UDP_MAX_PAYLOAD + 1)[0]
+        data, anc, _, _ = self.sock.recvmsg(UDP_MAX_PAYLOAD + 1, socket.CMSG_SPACE(4))
+        for level, kind, value in anc:
+            if level == socket.SOL_SOCKET and kind == _SO_RXQ_OVFL and len(value) >= 4:
+                self.socket_drops = struct.unpack("=I", value[:4])[0]
+        return data
 
     @property
     def port(self) -> int:
@@ -175,6 +246,7 @@ class UdpReceiver(_UdpSocket):
         self.decoder = decoder
         frames: list[Any] = []
         deadline = time.monotonic() + total_timeout_s
+        t_first = 0.0
 
         def emit(new: list[Any]) -> None:
             for f in new:
@@ -189,12 +261,18 @@ class UdpReceiver(_UdpSocket):
                     break
                 self.sock.settimeout(min(left, idle_timeout_s) if self.datagrams else left)
                 try:
-                    data, _ = self.sock.recvfrom(UDP_MAX_PAYLOAD + 1)
+                    data = self._recv()
                 except TimeoutError:
                     if self.datagrams:
                         break
                     continue
+                now = time.monotonic()
+                if not self.datagrams:
+                    t_first = now
                 self.datagrams += 1
+                self.bytes += len(data)
+                if now > t_first:
+                    self.rate_bps = 8 * self.bytes / (now - t_first)
                 if self.decoder is None:
                     assert make_decoder is not None
                     try:

@@ -6,7 +6,7 @@ bits; each lane is a complex sample ``{Q[31:16], I[15:0]}``. In numpy a sequence
 a ``uint32`` array of shape ``(n_words, num_rx)``; on the wire (host side) it is the
 little-endian bytes of that array (``words_to_bytes``).
 
-Frame payload order (DESIGN 3.2): for tx, for range bin r, for Doppler bin d: one word =
+Frame payload order (docs/design.md 3.2): for tx, for range bin r, for Doppler bin d: one word =
 ``num_rx`` lanes of bin ``(tx, r, d)``; ``frame_words = num_tx * n_range * n_doppler``.
 
 Each frame is cut into packets of ``packet_words`` payload words (the last one shorter when

@@ -1,10 +1,10 @@
-"""Radar configuration: the two presets of DESIGN.md section 2 and every derived quantity.
+"""Radar configuration: the two presets of docs/design.md section 2 and every derived quantity.
 
 A :class:`RadarConfig` is a frozen dataclass; all validation happens in ``__post_init__`` and
 raises :class:`ValueError` naming the offending field. Derived values are properties, so a
 configuration can never hold inconsistent numbers.
 
-Where the paper's numbers disagree (DESIGN.md section 2):
+Where the paper's numbers disagree (docs/design.md section 2):
 
 - The paper quotes 300 m maximum range, 3.5 m range resolution, 19.33 MSPS and 256 range
   samples; 256 samples at 19.33 MSPS with an 86.77 MHz sampled sweep give a 1.7275 m bin but a
@@ -46,7 +46,7 @@ BOLTZMANN = 1.380649e-23
 """Boltzmann constant, J/K."""
 
 FFT_MIN, FFT_MAX = 16, 4096
-"""Transform lengths the open FFT core supports (DESIGN.md 3.1)."""
+"""Transform lengths the open FFT core supports (docs/design.md 3.1)."""
 
 DC_GUARD_BINS = 1
 """Range bins 0..DC_GUARD_BINS-1 are never detections (DC offset, TX-RX leakage)."""
@@ -75,7 +75,7 @@ def _is_pow2(n: int) -> bool:
 class RadarConfig:
     """One FMCW TDM-MIMO radar configuration (waveform, array, front end, ADC).
 
-    Array geometry (DESIGN.md section 2): ``num_rx`` RX elements at lambda/2 along +y, and
+    Array geometry (docs/design.md section 2): ``num_rx`` RX elements at lambda/2 along +y, and
     ``num_tx`` TX subarrays whose phase centres are ``num_rx * lambda/2`` apart, so virtual
     channel ``v = tx * num_rx + rx`` sits at ``v * lambda/2``: a contiguous ULA.
 
@@ -470,7 +470,7 @@ PRESETS: dict[str, RadarConfig] = {
 
 
 DATA_W = 16
-"""Bits of I and of Q on every sample stream of the RTL (DESIGN.md section 3)."""
+"""Bits of I and of Q on every sample stream of the RTL (docs/design.md section 3)."""
 
 FPGA_CLOCK_HZ = 100e6
 """The fabric clock of the RTL (the paper's 100 MHz, Hz): ADC samples are paced against it,

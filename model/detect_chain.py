@@ -1,6 +1,6 @@
 """Bit-exact model of ``rtl/detect/detect_chain.sv``: Doppler-FFT words (mode-1 order) ->
 non-coherent integration -> 2-D CFAR -> detection records (``OUTPUT_MODE = 1``,
-DESIGN 3.4). The record stream then goes through ``axis_packetizer``
+docs/design.md 3.4). The record stream then goes through ``axis_packetizer``
 (``model/axis_packetizer.py``) like the cube does in mode 0.
 """
 

@@ -2,7 +2,7 @@
 output over the NUM_TX x NUM_RX virtual channels.
 
 Input words are uint32-style lane arrays of packed ``{Q, I}`` samples (``DATA_W`` bits each,
-two's complement; the DMA format has ``data_w = 16``). Input order (mode 1, DESIGN 3.4): for
+two's complement; the DMA format has ``data_w = 16``). Input order (mode 1, docs/design.md 3.4): for
 range bin r, for TX t, for Doppler bin d: ``(n_range * num_tx * n_doppler, num_rx)``.
 Output: the power map int64 ``(n_range, n_doppler)``, streamed for r, for d.
 

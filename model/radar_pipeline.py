@@ -7,7 +7,7 @@ the block models: ADC frame in, DMA packets out, identical to the RTL for loss-f
     -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
     -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.axis_packetizer
 
-``output_mode = 1`` (on-chip detection, DESIGN 3.4, docs/detect.md): the corner turn reads
+``output_mode = 1`` (on-chip detection, docs/design.md 3.4, docs/detect.md): the corner turn reads
 (r, t, d) (``read_order = 1``), the Doppler FFT output goes through the detector
 (``model.detect_chain``: NCI, 2-D CFAR, records) and the record stream, a fixed
 ``DetectConfig.frame_words`` per frame, through the same packetizer framing.

@@ -1,6 +1,6 @@
 """Float (float64) reference of the FPGA chain and of the plain host angle FFT.
 
-FPGA chain (DESIGN.md section 1): optional periodic-Hann window -> range FFT -> corner turn
+FPGA chain (docs/design.md section 1): optional periodic-Hann window -> range FFT -> corner turn
 -> optional window -> Doppler FFT. Each FFT is scaled by 1/N like the FPGA core's default
 schedule (``fft_axis``: output = DFT(x)/N), so reference and RTL outputs share units (LSB).
 
@@ -11,7 +11,7 @@ Axis conventions:
 - Radar cube: complex (n_virtual, n_range, n_doppler), virtual channel v = tx * num_rx + rx,
   range bin r in 0..n_range-1 (natural order), Doppler bin d in 0..n_doppler-1 in natural FFT
   order (bins >= n_doppler/2 are negative velocities; see :func:`signed_bins`).
-- DMA payload order (DESIGN.md 3.2): (num_tx, n_range, n_doppler, num_rx) -- for tx, for
+- DMA payload order (docs/design.md 3.2): (num_tx, n_range, n_doppler, num_rx) -- for tx, for
   range bin, for Doppler bin, one word of num_rx lanes; see :func:`cube_to_dma_order`.
 
 Angle (host side): virtual channel v at y = v lambda/2 sees phase exp(-j pi v sin(az)) (see

@@ -1,12 +1,12 @@
 """Radar scenes: point targets, extended objects (sets of scatterers) and the scene JSON.
 
-Conventions (DESIGN.md section 2): x forward (boresight), y left, azimuth positive towards +y
+Conventions (docs/design.md section 2): x forward (boresight), y left, azimuth positive towards +y
 (counter-clockwise), radial velocity positive = receding. Angles in degrees at interfaces.
 Kinematics are given at the **centre of the frame** (the middle of the coherent processing
 interval), so a target's measured range is its scene range even when it moves metres during
 a frame.
 
-Scene JSON (DESIGN.md section 4)::
+Scene JSON (docs/design.md 4.3)::
 
     {"preset": "full", "seed": 1, "tx_beamforming": true,
      "targets": [{"range_m": 40.0, "azimuth_deg": -10.0, "radial_velocity_mps": -12.5,
@@ -154,6 +154,12 @@ class PointTarget:
         return self.range_m * math.sin(math.radians(self.azimuth_deg))
 
 
+OBJECT_LABELS: tuple[str, ...] = ("car", "pedestrian", "pedestrian_group", "two_wheeler",
+                                  "large_vehicle")
+"""The labels an object may carry: the GNN's object classes (``gnn.classes``, in its index
+order: RadarScenes' road users)."""
+
+
 @dataclass(frozen=True)
 class ExtendedObject:
     """A rigid box-shaped object (vehicle, pedestrian, ...) made of point scatterers.
@@ -206,6 +212,9 @@ class ExtendedObject:
         label = d.get("label", "car")
         if not isinstance(label, str):
             raise ValueError(f"{where}.label: must be a string, got {label!r}")
+        if label not in OBJECT_LABELS:
+            raise ValueError(f"{where}.label: unknown class {label!r}; choose one of "
+                             f"{', '.join(OBJECT_LABELS)}")
         try:
             return cls(**vals, n_scatterers=n, label=label)
         except ValueError as exc:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import TypeVar
@@ -80,29 +81,70 @@ def note_compile(command: str) -> None:
     """Once per process, right before the first records -> point cloud call: one
     ``radar <command>: ...`` line on stderr when the host's compiled kernels
     (``host.kernels``) are not cached yet (that call then takes 20-30 s longer, once
-    per checkout)."""
+    per checkout); the kernels only some data reaches are compiled right then, so the
+    note does not come back."""
     global _compile_noted
     if _compile_noted:
         return
     _compile_noted = True
-    from host.kernels import uncompiled_kernels  # numba: only where records are
-    if uncompiled_kernels():
+    from host import kernels  # numba: only where records are
+    if kernels.uncompiled_kernels():
         print(f"radar {command}: compiling the host kernels (numba; "
               "first run in this checkout, 20-30 s)", file=sys.stderr)
+        kernels.compile_data_dependent()    # then the next run finds every kernel cached
 
 
-def out_file(path: str, suffix: str, option: str) -> Path:
-    """``path`` checked to end in ``suffix``, its folder created."""
+def out_file(path: str, suffix: str | None, option: str) -> Path:
+    """``path`` checked, before any work, to end in ``suffix`` (None: any name) and to be a
+    file this process can write (its folder created; an existing file is not changed)."""
     p = Path(path)
-    if p.suffix != suffix:
+    if suffix is not None and p.suffix != suffix:
         raise CliError(f"{option}: {p} must end in {suffix}")
     if p.is_dir():
         raise CliError(f"{option}: {p} is a folder, not a file")
+    _make_folder(p.parent, option)
     try:
-        p.parent.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise CliError(f"{option}: {p.parent} is a file, not a folder") from None
+        if p.exists():
+            with open(p, "ab"):          # writable? (append mode: the content stays)
+                pass
+        else:
+            with open(p, "xb"):
+                pass
+            p.unlink()
+    except OSError as exc:
+        raise CliError(f"{option}: cannot write {p}: {exc.strerror or exc}") from None
     return p
+
+
+def out_folder(path: str, option: str) -> Path:
+    """``path`` checked, before any work, to be a folder this process can write in (created
+    if missing)."""
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise CliError(f"{option}: {p} is a file, not a folder")
+    _make_folder(p, option)
+    try:
+        with tempfile.NamedTemporaryFile(dir=p, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise CliError(f"{option}: cannot write in {p}: {exc.strerror or exc}") from None
+    return p
+
+
+def _make_folder(p: Path, option: str) -> None:
+    """``p`` created with its parents (CliError naming ``option`` when it cannot be)."""
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise CliError(f"{option}: {p} is a file, not a folder") from None
+    except OSError as exc:
+        raise CliError(f"{option}: cannot make the folder {p}: {exc.strerror or exc}") from None
+
+
+def port(value: int, option: str, allow_zero: bool = True) -> int:
+    """A port option checked to be in 0..65535 (1..65535 without ``allow_zero``)."""
+    lo = 0 if allow_zero else 1
+    return check(value, option, lo <= value <= 65535, f"a port number in {lo}..65535")
 
 
 def ego_speed_mps(args: argparse.Namespace, scene: Scene | None) -> float:
@@ -143,5 +185,41 @@ def add_detection_options(p: argparse.ArgumentParser, max_speed_default: str | N
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,
                 description: str) -> argparse.ArgumentParser:
     """A ``radar`` subcommand's parser: ``summary`` in ``radar --help``, ``description`` (one
-    paragraph; its line breaks and indentation are re-wrapped) on the command's own page."""
-    return sub.add_parser(name, help=summary, description=" ".join(description.split()))
+    paragraph; its line breaks and indentation are re-wrapped) on the command's own page.
+    The parsed options keep the parser (``args.parser``) for :func:`refuse`."""
+    p = sub.add_parser(name, help=summary, description=" ".join(description.split()))
+    p.set_defaults(parser=p)
+    return p
+
+
+def given(args: argparse.Namespace, dest: str) -> bool:
+    """Whether option ``dest`` has a value other than its default (the user gave it)."""
+    parser: argparse.ArgumentParser | None = getattr(args, "parser", None)
+    default = parser.get_default(dest) if parser is not None else None
+    value = getattr(args, dest)
+    return (list(value) if isinstance(value, list | tuple) else value) != (
+        list(default) if isinstance(default, list | tuple) else default)
+
+
+DETECTION_OPTIONS = ("detector", "pfa", "guard", "train", "threshold_db", "max_speed")
+"""Destinations of :func:`add_detection_options`."""
+FPGA_OPTIONS = ("fpga_cfar", "max_detections")
+"""Destinations of the on-chip detector's options (``radar.commands.detect``)."""
+
+
+def refuse(args: argparse.Namespace, dests: Iterable[str], why: str) -> None:
+    """One-line CliError when any option of ``dests`` was given: it does not apply (``why``
+    says to what)."""
+    for dest in dests:
+        if given(args, dest):
+            raise CliError(f"--{dest.replace('_', '-')}: does not apply {why}")
+
+
+def refuse_detection_misfits(args: argparse.Namespace, fpga: bool) -> None:
+    """The detection options that do not apply: ``--fpga-cfar``/``--max-detections``
+    without ``--detect fpga``, ``--threshold-db`` without ``--detector paper``."""
+    if not fpga:
+        refuse(args, FPGA_OPTIONS, "without --detect fpga (the host runs the CFAR)")
+    if args.detector != "paper":
+        refuse(args, ("threshold_db",), "to --detector " + args.detector
+               + " (it is the paper detector's threshold)")

@@ -15,8 +15,10 @@ from model.scene import Scene
 
 
 def truth_xy(scene: Scene, prefix: str = "T") -> list[tuple[float, float, str]]:
-    """(x m, y m, label ``T<i>``) of each target, for the point-cloud figure."""
-    return [(t.x_m, t.y_m, f"{prefix}{i + 1}") for i, t in enumerate(scene.targets)]
+    """(x m, y m, label) of each target (``T<i>``) and of each object's centre (``O<i>
+    <class>``), for the point-cloud figure."""
+    return [(t.x_m, t.y_m, f"{prefix}{i + 1}") for i, t in enumerate(scene.targets)] + [
+        (o.x_m, o.y_m, f"O{i + 1} {o.label}") for i, o in enumerate(scene.objects)]
 
 
 def truth_range_doppler(scene: Scene, prefix: str = "T") -> list[tuple[float, float, str]]:

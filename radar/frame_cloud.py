@@ -10,12 +10,24 @@ from typing import Protocol
 
 import numpy as np
 
-from host.pipeline import DetectionParams, process_cube_nci
+from host.pipeline import DetectionParams, process_cube_nci, real_only
 from host.pointcloud import PointCloud
 from host.record_points import process_records
 from host.records import DetectionFrame, RecordArrays, inside_map, outside_problem
 from model.config import RadarConfig
-from radar.common import note_compile
+from radar.common import note_compile, warn
+
+REAL_ONLY = ("the cube is Hermitian (real-only samples in a complex profile?): every "
+             "target has a mirror ghost at range bin N - k, opposite Doppler")
+_real_only_noted = False
+
+
+def note_real_only(command: str, frame_id: int) -> None:
+    """Once per process: the one-line warning that a cube looks real-only."""
+    global _real_only_noted
+    if not _real_only_noted:
+        _real_only_noted = True
+        warn([f"frame {frame_id}: {REAL_ONLY}"], command)
 
 
 class CubeFrame(Protocol):
@@ -55,4 +67,8 @@ def frame_cloud(frame: np.ndarray | CubeFrame | DetectionFrame, cfg: RadarConfig
             outside_problem(frame_id, dropped, cfg)] if dropped else [])
     cube = frame if isinstance(frame, np.ndarray) else frame.cube()
     cloud, nci = process_cube_nci(cube, cfg, params, frame_id)
-    return FrameCloud(cloud, cube=cube, nci=nci)
+    problems = []
+    if real_only(cube):
+        problems.append(f"frame {frame_id}: {REAL_ONLY}")
+        note_real_only(command, frame_id)
+    return FrameCloud(cloud, cube=cube, nci=nci, problems=problems)

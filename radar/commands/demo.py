@@ -17,7 +17,7 @@ from host.pipeline import DetectionParams
 from model.reference import range_doppler_power
 from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
-from radar.common import add_command
+from radar.common import add_command, out_folder
 from radar.figures import truth_range_doppler, truth_xy
 from radar.frame_cloud import frame_cloud
 from radar.objects import gnn_objects, object_boxes
@@ -49,6 +49,7 @@ class GnnWorker:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
+    out_folder(args.out, "--out")               # before any work
     gnn = None if args.no_gnn else GnnWorker()
     try:
         return _demo(args, gnn)
@@ -67,7 +68,6 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     )
 
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     scene = table1_scene(args.preset)
     cfg = scene.config
     params = DetectionParams()
@@ -96,7 +96,8 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     mask, p0 = paper_threshold(cube, params.paper_threshold_db)
     figs = [plot_detection_mask(p0, mask, cfg, out / "fig6_range_doppler_ch0.png",
                                 f"{cfg.name}: channel 0 and its threshold "
-                                f"({params.paper_threshold_db:g} dB over the median)", zoom),
+                                f"({params.paper_threshold_db:g} dB over the median)", zoom,
+                                truth_range_doppler(scene, "V")),
             plot_range_doppler(range_doppler_power(cube), cfg, out / "range_doppler_nci.png",
                                f"{cfg.name}: range-Doppler, {cfg.n_virtual} channels "
                                f"non-coherent", truth_range_doppler(scene, "V"), zoom)]
@@ -108,7 +109,8 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     figs.append(plot_range_azimuth_pair(
         [(ra_bf, "TX subarray beamforming (3 elements)"), (ra_nobf, "single TX element")],
         az, cfg, out / "fig5_range_azimuth_bf_vs_nobf.png", zoom,
-        note=alias_note(scene.targets, cfg)))
+        note=alias_note(scene.targets, cfg),
+        title=f"{cfg.name}: range-azimuth, {cfg.num_tx} TX x {cfg.num_rx} RX"))
     ego = default_ego_speed_mps(scene)  # the same default as radar detect / radar gnn detect
     objects = gnn.objects(cloud, ego) if gnn is not None else []
     if gnn is not None:
@@ -121,11 +123,14 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
                                  f"{cfg.name}: Table I point cloud" + (
                                      " and GNN objects" if objects else ""),
                                  truth_xy(scene, "V"), object_boxes(objects), missed))
-    doc = cloud.to_json_dict(cfg.name, 1)
-    doc.update({"ego_speed_mps": ego, "objects": objects})
-    (out / "table1_points.json").write_text(json.dumps(doc, indent=1))
+    doc = cloud.to_json_dict(cfg.name, 1, [0] if adc.saturated else [])
+    doc.update({"ego_speed_mps": ego, "objects": objects,
+                "frame_info": [{"frame": 0, "points": len(cloud), "clipped": adc.saturated,
+                                "damaged": False}]})
+    points = out / "table1_points.json"
+    points.write_text(json.dumps(doc, indent=1))
     print(f"figures in {out}/: " + ", ".join(p.name for p in figs)
-          + f" ({time.perf_counter() - t0:.1f} s)")
+          + f"; the point cloud JSON: {points} ({time.perf_counter() - t0:.1f} s)")
     return 0
 
 

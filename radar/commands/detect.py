@@ -1,5 +1,5 @@
 """``radar detect``: frames of a scene through a frame source (model, float, rtl) and the
-host processing to the point cloud JSON of DESIGN.md section 4, optionally GNN objects and
+host processing to the point cloud JSON of docs/design.md 4.4, optionally GNN objects and
 figures.
 
 ``--detect host`` (default): the source gives radar cubes, the host runs the CFAR
@@ -14,7 +14,6 @@ import argparse
 import json
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,7 +36,9 @@ from radar.common import (
     detection_params,
     ego_speed_mps,
     out_file,
+    out_folder,
     progress,
+    refuse_detection_misfits,
     scene_of,
     warn,
 )
@@ -83,11 +84,11 @@ def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
 
 
 def cmd_detect(args: argparse.Namespace) -> int:
+    refuse_detection_misfits(args, args.detect == "fpga")
     scene = scene_of(args)
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
-    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
-        raise CliError(f"--plots: {args.plots} is a file, not a folder")
+    plots = out_folder(args.plots, "--plots") if args.plots else None
     cfg = scene.config
     params = detection_params(args, scene.tx_beamforming, cfg)
     clouds, per_frame, objects = [], [], []
@@ -115,6 +116,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
 
     dcfg = fpga_config(args, cfg, params) if args.detect == "fpga" else None
     rec = open_recording(args, cfg.frame_time_s)
+    stopped: str | None = None      # why the run ended early: what was done is written
     try:
         if dcfg is not None:
             frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
@@ -124,11 +126,12 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 fc = frame_cloud(f, cfg, params, k, "detect")
                 cloud = fc.cloud
                 clouds.append(cloud)
-                per_frame.append({"frame": k, "points": len(cloud),
-                                  "adc_saturated": saturated[k] if k < len(saturated) else 0,
+                n_clip = saturated[k] if k < len(saturated) else 0
+                per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": n_clip,
                                   "records": len(f.records), "detections": f.detections,
                                   "truncated": f.truncated, "complete": f.complete,
-                                  "problems": f.problems + fc.problems})
+                                  "problems": f.problems + fc.problems,
+                                  "clipped": n_clip, "damaged": not f.complete})
                 if f.truncated:
                     warn([f"frame {k}: {f.detections} cells passed the CFAR, only "
                           f"--max-detections {dcfg.max_detections} were sent"], "detect")
@@ -139,38 +142,59 @@ def cmd_detect(args: argparse.Namespace) -> int:
         else:
             for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
                 t_start = time.perf_counter()
-                cloud = frame_cloud(cube, cfg, params, k, "detect").cloud
+                fc = frame_cloud(cube, cfg, params, k, "detect")
+                cloud = fc.cloud
                 clouds.append(cloud)
                 per_frame.append({"frame": k, "points": len(cloud),
-                                  "adc_saturated": saturated[k]})
-                finish_frame(k, cloud, t_start)
+                                  "adc_saturated": saturated[k], "clipped": saturated[k],
+                                  "damaged": False})
+                if fc.problems:
+                    per_frame[-1]["problems"] = fc.problems
+                finish_frame(k, cloud, t_start, problems=fc.problems)
                 last_cube = cube
+    except KeyboardInterrupt:
+        stopped = "interrupted"
     except SourceError as exc:
-        raise CliError(f"--backend {args.backend}: {exc}") from None
+        stopped = f"--backend {args.backend}: {exc}"
     except ValueError as exc:  # a checkpoint that does not load, a bad ego speed
-        raise CliError(str(exc)) from None
+        stopped = str(exc)
     finally:
         close_recording(rec)
+    if stopped and not per_frame:
+        if stopped == "interrupted":
+            raise KeyboardInterrupt
+        raise CliError(stopped)
     clipped = [k for k, n in enumerate(saturated) if n]
     if clipped:
         warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
-              f"harmonics of the clipped echo can appear as false points"], "detect")
+              f"harmonics of the clipped echo can appear as false points (flagged "
+              f"\"clipped\" in the JSON)"], "detect")
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, args.frames)
+    done = len(per_frame) if stopped else args.frames
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "scene": scene.name,
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
                 "frame_info": per_frame, **report})
     if args.gnn:
         doc["objects"] = objects
+    if stopped:
+        doc.update({"interrupted": stopped == "interrupted", "error": stopped,
+                    "frames_requested": args.frames})
     out.write_text(json.dumps(doc, indent=1))
-    print(f"{len(cloud)} points in {args.frames} frame(s) ({time.perf_counter() - t0:.2f} s) "
+    print(f"{len(cloud)} points in {done} frame(s) ({time.perf_counter() - t0:.2f} s) "
           f"-> {out}")
     if args.gnn:
         print(f"GNN: {len(objects)} object(s): " + describe(objects))
-    if args.plots and last_cube is not None:
+    if stopped == "interrupted":
+        warn([f"interrupted: wrote the {done} of {args.frames} frame(s) processed"], "detect")
+        return 130
+    if stopped:
+        raise CliError(f"{stopped} (after {done} of {args.frames} frame(s): those are in "
+                       f"{out})")
+    if plots and last_cube is not None:
         last = [o for o in objects if o["frame"] == args.frames - 1]
-        detect_plots(Path(args.plots), cfg, scene, last_cube, clouds[-1], object_boxes(last))
+        detect_plots(plots, cfg, scene, last_cube, clouds[-1], object_boxes(last))
     return 0
 
 
@@ -188,7 +212,7 @@ def add_fpga_options(p: argparse.ArgumentParser) -> None:
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     d = add_command(sub, "detect", "scene -> point cloud JSON", """
         Simulate frames of a scene, run them through the FPGA chain (a model of it or the RTL) and
-        the host processing, and write the point cloud JSON of DESIGN.md section 4.""")
+        the host processing, and write the point cloud JSON of docs/design.md 4.4.""")
     d.add_argument("--scene", required=True, help="scene JSON file or built-in name (table1)")
     d.add_argument("--json", required=True, help="output point cloud .json")
     d.add_argument("--backend", choices=list(SOURCES), default="model",

@@ -10,15 +10,17 @@ import sys
 from collections.abc import Callable
 
 from radar.commands import gnn_tasks as tasks
+from radar.common import CliError
 
 
 def _guarded(cmd: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
-    """``cmd`` that turns a ValueError (bad input) into ``error: <reason>`` on stderr and
-    exit status 2, so callers (``radar gnn``) need no knowledge of our exceptions."""
+    """``cmd`` that turns a ValueError or CliError (bad input) into ``error: <reason>`` on
+    stderr and exit status 2, so callers (``radar gnn``) need no knowledge of our
+    exceptions."""
     def run(args: argparse.Namespace) -> int:
         try:
             return int(cmd(args))
-        except ValueError as exc:
+        except (ValueError, CliError) as exc:
             print(f"radar gnn: error: {exc}", file=sys.stderr)
             return 2
     return run
@@ -51,7 +53,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
                    "scenes.json) into CACHE_DIR/radarscenes-<name>.npz")
     p.add_argument("--window-s", type=float, default=0.5,
                    help="RadarScenes accumulation window, s (default 0.5, as RadarGNN)")
-    p.set_defaults(func=_guarded(tasks.cmd_dataset))
+    p.set_defaults(func=_guarded(tasks.cmd_dataset), parser=p)
 
     p = subparsers.add_parser("train", help="train the GNN, write a checkpoint",
                               description="Adam on weighted cross-entropy + Huber box loss.")
@@ -72,7 +74,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-residual", action="store_true", help="no residual updates")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--threads", type=int, default=1, help="torch CPU threads (default 1)")
-    p.set_defaults(func=_guarded(tasks.cmd_train))
+    p.set_defaults(func=_guarded(tasks.cmd_train), parser=p)
 
     p = subparsers.add_parser("eval", help="GNN vs DBSCAN baseline metrics",
                               description="mAP at point IoU 0.3 and box IoU 0.5, per-point "
@@ -86,7 +88,7 @@ def add_subcommands(subparsers: argparse._SubParsersAction) -> None:
 
     p = subparsers.add_parser("detect", help="detect objects in one point cloud or scene")
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--points", default=None, help="point cloud JSON (DESIGN.md section 4)")
+    src.add_argument("--points", default=None, help="point cloud JSON (docs/design.md 4.4)")
     src.add_argument("--scene", default=None,
                      help="scene JSON or built-in name, simulated through the host chain")
     p.add_argument("--ego-speed", type=float, default=None,

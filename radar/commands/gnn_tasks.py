@@ -6,15 +6,26 @@ from __future__ import annotations
 
 import argparse
 import json
-import tempfile
 from pathlib import Path
 from typing import Any
 
 from host.pointcloud import PointCloud
+from radar.common import out_file, out_folder, refuse
 
 
 def cmd_dataset(args: argparse.Namespace) -> int:
     from gnn.dataset import build_split, save_frames
+
+    if args.radarscenes is None:
+        refuse(args, ("window_s",), "without --radarscenes")
+    else:
+        refuse(args, ("train", "val", "test", "backend", "workers"), "to --radarscenes "
+               "(it converts one recorded sequence)")
+    for option in ("--train", "--val", "--test"):
+        n = getattr(args, option[2:])
+        if n < 0:
+            raise ValueError(f"{option}: must be a number of frames >= 0, got {n}")
+    out_folder(args.cache_dir, "--cache-dir")    # before rendering, not after
 
     if args.radarscenes is not None:
         from gnn.radarscenes import load_sequence
@@ -42,17 +53,19 @@ def cmd_train(args: argparse.Namespace) -> int:
     from gnn.train import TrainConfig, train
 
     _threads(torch, args.threads)
-    _writable(Path(args.out))           # before training, not after
+    out_file(args.out, None, "--out")   # before training, not after
+    refuse(args, ("radius",) if args.graph == "knn" else ("k",),
+           f"to --graph {args.graph}")
+    gc = GraphConfig(kind=args.graph, k=args.k, radius_m=args.radius)   # checked first
+    mc = ModelConfig(hidden=args.hidden, layers=args.layers, auto_offset=not args.no_offset,
+                     residual=not args.no_residual)
+    tc = TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr,
+                     box_weight=args.box_weight, seed=args.seed)
     paths = [Path(d) for d in args.data] if args.data else [_data_path(args, "train")]
     frames, meta = [], {}
     for path in paths:
         more, meta = load_frames(path)
         frames.extend(more)
-    gc = GraphConfig(kind=args.graph, k=args.k, radius_m=args.radius)
-    mc = ModelConfig(hidden=args.hidden, layers=args.layers, auto_offset=not args.no_offset,
-                     residual=not args.no_residual)
-    tc = TrainConfig(epochs=args.epochs, batch_size=args.batch_size, lr=args.lr,
-                     box_weight=args.box_weight, seed=args.seed)
     model, history = train(frames, tc, mc, gc, progress=not args.quiet)
     save_checkpoint(args.out, model, gc, {
         "train_frames": len(frames), "dataset_backend": meta.get("backend", "?"),
@@ -72,24 +85,6 @@ def _threads(torch: Any, threads: int) -> None:
     torch.set_num_threads(threads)
 
 
-def _writable(path: Path) -> None:
-    """ValueError unless a file can be written at ``path`` (its folder exists or can be
-    made, the path is not a folder)."""
-    if path.is_dir():
-        raise ValueError(f"--out: {path} is a folder, not a file")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"--out: cannot make the folder of {path}: "
-                         f"{exc.strerror or exc}") from None
-    try:
-        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".write-test-"):
-            pass
-    except OSError as exc:
-        raise ValueError(f"--out: cannot write in {path.parent}: "
-                         f"{exc.strerror or exc}") from None
-
-
 def cmd_eval(args: argparse.Namespace) -> int:
     import torch
 
@@ -98,6 +93,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     from gnn.infer import GnnDetector
 
     _threads(torch, args.threads)
+    if args.json is not None:
+        out_file(args.json, None, "--json")     # before the evaluation, not after
     frames, _ = load_frames(_data_path(args, "test"))
     res = evaluate_all(GnnDetector.from_checkpoint(args.checkpoint), frames,
                        progress=not args.quiet)
@@ -113,6 +110,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     from gnn.infer import detect_objects
     from model.scene import check_ego_speed, default_ego_speed_mps
 
+    if args.json is not None:
+        out_file(args.json, None, "--json")     # before the work, not after
     # the ego speed defaults as in `radar detect --gnn`: the scene's (100 km/h for table1,
     # else 0), and for a point cloud JSON the ego_speed_mps that `radar detect` wrote in it
     if args.points is not None:
@@ -145,7 +144,7 @@ def _json_ego(path: Path) -> float:
 
 
 def read_points(path: Path) -> PointCloud:
-    """A point cloud from the DESIGN.md section 4 JSON file ``path``."""
+    """A point cloud from the docs/design.md 4.4 JSON file ``path``."""
     if not path.is_file():
         raise ValueError(f"points: no such file {str(path)!r}")
     try:
@@ -166,7 +165,12 @@ def _data_path(args: argparse.Namespace, split: str) -> Path:
         return Path(args.data)
     from gnn.dataset import split_path
 
-    return split_path(Path(args.cache_dir), split)
+    path = split_path(Path(args.cache_dir), split)
+    if not path.is_file():
+        raise ValueError(f"dataset: no {split} set at {path}: generate it first with "
+                         f"`make gnn-dataset` (or `radar gnn dataset --cache-dir "
+                         f"{args.cache_dir}`)")
+    return path
 
 
 def _jsonable(x: Any) -> Any:

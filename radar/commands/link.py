@@ -29,6 +29,8 @@ from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, detect_config_of, fpga_config
 from radar.common import (
+    DETECTION_OPTIONS,
+    FPGA_OPTIONS,
     CliError,
     add_command,
     add_detection_options,
@@ -36,7 +38,10 @@ from radar.common import (
     count,
     detection_params,
     out_file,
+    port,
     progress,
+    refuse,
+    refuse_detection_misfits,
     scene_of,
     warn,
 )
@@ -53,6 +58,12 @@ MAX_RECEIVE_FRAMES = 1_000_000
 def cmd_capture(args: argparse.Namespace) -> int:
     from host.udp import max_packet_words
 
+    if args.detect == "host":
+        refuse(args, (*DETECTION_OPTIONS, *FPGA_OPTIONS), "to a radar-cube capture (the "
+               "host detects after receiving it; use --detect fpga for a record capture)")
+    else:
+        refuse(args, ("threshold_db", "max_speed"), "to a record capture (host-side "
+               "options: give them to radar receive)")
     scene = scene_of(args)
     cfg = scene.config
     out = out_file(args.out, ".dmacap", "--out")
@@ -94,11 +105,16 @@ def cmd_replay(args: argparse.Namespace) -> int:
     from host.udp import Impairments, UdpSender
 
     check(args.seed, "--seed", 0 <= args.seed < 2**63, "an integer in 0..2**63-1")
+    port(args.port, "--port", allow_zero=False)
     rate = args.rate_mbps
     check(rate, "--rate-mbps", rate == 0 or 1e-3 <= rate <= 1e6,
           "0 (unpaced) or a rate in [0.001, 1e6] Mbit/s")
     try:
         info, packets = read_capture(Path(args.capture))
+        packets = list(packets)
+        if not packets:
+            raise ValueError(f"{args.capture}: the capture has a header but no packet: "
+                             f"nothing to replay")
         cfg = info.config(PRESETS.values())
         imp = Impairments(loss=args.loss, duplicate=args.duplicate, reorder=args.reorder,
                           seed=args.seed)
@@ -122,6 +138,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
     from host.udp import UdpReceiver, check_seconds
 
     out = out_file(args.json, ".json", "--json")
+    port(args.port, "--port")
+    refuse_detection_misfits(args, args.detect == "fpga")
     count(args.frames, "--frames", MAX_RECEIVE_FRAMES)
     count(args.packet_words, "--packet-words", 65535, lo=2)   # before listening
     try:
@@ -155,6 +173,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
         rx.close()
         raise
     print(f"listening on {args.host}:{rx.port}", flush=True)
+    warn([h for h in (rx.buffer_hint(),) if h], "receive")
     try:
         with rx:
             frames = rx.receive(None, max_frames=args.frames, idle_timeout_s=args.idle_timeout,
@@ -169,11 +188,12 @@ def cmd_receive(args: argparse.Namespace) -> int:
     clouds, frames_doc = [], []
     if rec is not None and cfg:
         rec.frame_period_s = cfg.frame_time_s
+    error = None                    # a frame the host could not process: the rest is kept
     try:
         for f in frames:
             t_start = time.perf_counter()
             entry: dict[str, Any] = {"frame_id": f.frame_id, "complete": f.complete,
-                                     "problems": f.problems}
+                                     "damaged": not f.complete, "problems": f.problems}
             fc = None
             if decoder and cfg and (f.complete or args.use_damaged):
                 fc = frame_cloud(f, cfg, params, f.frame_id, "receive")
@@ -193,6 +213,8 @@ def cmd_receive(args: argparse.Namespace) -> int:
                     time.perf_counter() - t_start, entry["problems"]))
     except KeyboardInterrupt:
         rx.interrupted = True
+    except ValueError as exc:
+        error = f"frame {len(frames_doc)}: {exc}"
     finally:
         close_recording(rec)
     cloud = PointCloud.concat(clouds)
@@ -202,8 +224,14 @@ def cmd_receive(args: argparse.Namespace) -> int:
                 "datagrams": rx.datagrams, "interrupted": rx.interrupted,
                 "frame_info": frames_doc,
                 "stream_problems": (decoder.stream_problems if decoder else []) + rx.unusable,
-                "stats": vars(decoder.stats) if decoder else {}})
+                "stats": _stats(decoder, rx),
+                "link": {"socket_drops": rx.socket_drops, "rate_mbps": rx.rate_bps / 1e6,
+                         "rcvbuf_bytes": rx.rcvbuf_granted}})
+    if error:
+        doc["error"] = error
     out.write_text(json.dumps(doc, indent=1))
+    if error:
+        raise CliError(f"{error} (the {len(frames_doc)} frame(s) before it are in {out})")
     damaged = sum(not f.complete for f in frames)
     print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
           + (f" (preset {cfg.name}, {decoder.packet_words} payload words per packet learnt "
@@ -211,6 +239,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     for f in frames:
         for p in f.problems[:5]:
             print(f"  {p}")
+    warn([h for h in (rx.loss_hint(),) if h], "receive")
     if rx.interrupted:
         warn(["interrupted: wrote what was received"], "receive")
         return 130
@@ -223,6 +252,14 @@ def cmd_receive(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def _stats(decoder: Any, rx: Any) -> dict[str, Any]:
+    """The decoder's counters (``host.stream.StreamStats``) with the datagrams no decoder
+    could be learnt from counted as garbage (they are in ``stream_problems`` too)."""
+    stats: dict[str, Any] = dict(vars(decoder.stats)) if decoder else {}
+    stats["garbage_packets"] = stats.get("garbage_packets", 0) + len(rx.unusable)
+    return stats
 
 
 def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:

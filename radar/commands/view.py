@@ -44,6 +44,8 @@ from radar.common import (
     count,
     detection_params,
     ego_speed_mps,
+    port,
+    refuse,
 )
 from radar.sources import get_source
 from radar.view.feed import Feed
@@ -102,6 +104,21 @@ def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
     return kind
 
 
+def _refuse_misfits(args: argparse.Namespace) -> None:
+    """The options that do not apply to the chosen source: one-line CliError."""
+    if not args.replay:
+        refuse(args, ("no_loop",), "without --replay")
+    if not args.scene:
+        refuse(args, ("frames", "backend"), "without --scene")
+    if not (args.replay or args.scene):
+        refuse(args, ("fps", "loss", "seed"), "to a UDP stream (the sender sets its pace)")
+    else:
+        refuse(args, ("udp_host", "packet_words"), "without a UDP stream (--udp-port)")
+    if args.detector != "paper":
+        refuse(args, ("threshold_db",), "to --detector " + args.detector
+               + " (it is the paper detector's threshold)")
+
+
 def _gnn(args: argparse.Namespace) -> Callable[..., list[dict[str, Any]]] | None:
     if not args.gnn:
         return None
@@ -116,6 +133,9 @@ def build(args: argparse.Namespace, stop: threading.Event
     """Feed, health, the (not yet started) producer threads and a description of the
     source, from parsed ``radar view`` options. Raises CliError on bad input."""
     feed, health = Feed(), LinkHealth()
+    port(args.port, "--port")
+    port(args.udp_port, "--udp-port")
+    _refuse_misfits(args)
     check(args.fps, "--fps", args.fps == 0 or 1e-3 <= args.fps <= 1e4,
           "0 (as fast as possible) or a rate in [0.001, 1e4] frames/s")
     if not 0.0 <= args.loss <= 1.0:
@@ -202,6 +222,7 @@ def build(args: argparse.Namespace, stop: threading.Event
         except OSError as exc:     # an unknown or foreign --udp-host, a port in use
             raise CliError(f"--udp-host {args.udp_host} --udp-port {args.udp_port}: "
                            f"{exc}") from None
+        common.warn([h for h in (rx.buffer_hint(),) if h], "view")
         desc = f"UDP {args.udp_host}:{rx.port}"
         processor.source = desc
         threads.append(threading.Thread(target=udp_loop, name="view-udp", daemon=True,

@@ -2,7 +2,7 @@
 
 A :class:`ViewFrame` is source-neutral: a cube stream fills ``cube`` (channel maps) and
 ``nci`` (integrated map) and the processed ``cloud``; a detection-record stream (on-chip
-detection, DESIGN.md section 3.4) fills ``cloud`` and ``records`` (no cube, no maps): the
+detection, docs/design.md section 3.4) fills ``cloud`` and ``records`` (no cube, no maps): the
 page draws the records in the range-Doppler plane and over range instead. Sources call
 :meth:`Feed.publish`; the server's clients read :meth:`Feed.latest`. There is never more
 than one frame waiting: a newer one replaces it (frames faster than the browsers draw are

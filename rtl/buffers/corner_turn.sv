@@ -24,7 +24,7 @@ module corner_turn #(
   parameter int N_DOPPLER = 256,
   // Bits of I and of Q per lane, 8..32.
   parameter int DATA_W = 16,
-  // Output order. 0: for TX t, for range bin r (the radar cube, DESIGN 3.2);
+  // Output order. 0: for TX t, for range bin r (the radar cube, docs/design.md 3.2);
   // 1: for range bin r, for TX t (on-chip detection, docs/detect.md: all TX of a range bin
   // together). The Doppler vector is the same; with NUM_TX = 1 both orders are equal.
   parameter int READ_ORDER = 0

@@ -3,7 +3,7 @@
 // (range, Doppler) cell of the Doppler-FFT output, one input word per clock, exact (no
 // rounding, no saturation).
 //
-// Input order (DESIGN 3.4, mode 1): for range bin r, for TX t, for Doppler bin d: one word of
+// Input order (docs/design.md 3.4, mode 1): for range bin r, for TX t, for Doppler bin d: one word of
 // NUM_RX {Q,I} lanes (the corner turn reads (r, t) in mode 1; with NUM_TX = 1 this is the
 // mode-0 order). The partial sums of TX 0..NUM_TX-2 wait in an N_DOPPLER-deep accumulator
 // RAM; the word of the last TX completes the cell. Output order: for r, for d.

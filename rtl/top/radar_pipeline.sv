@@ -12,7 +12,7 @@
 // carry the DAMAGED header flag, the counters say how many chirps were lost and filled, and
 // the next frame is clean.
 //
-// OUTPUT_MODE = 1 (on-chip detection, DESIGN 3.4, docs/detect.md): the corner turn reads
+// OUTPUT_MODE = 1 (on-chip detection, docs/design.md 3.4, docs/detect.md): the corner turn reads
 // (r, t, d), the Doppler FFT output goes through detect_chain (NCI, 2-D CFAR, records) and
 // the fixed-length record stream through the same packetizer (header, sequence numbers,
 // DAMAGED/OVERFLOW flags). With FRAME_STORE = 1 the external store reads (r, t, d) too
@@ -59,7 +59,7 @@ module radar_pipeline #(
   /* verilator lint_on WIDTHEXPAND */
   // Range bins per strip of the external layout (frame_store_axi TILE_R).
   parameter int FS_TILE_R = 16,
-  // 0: the radar cube to the DMA (DESIGN 3.2); 1: detection records (DESIGN 3.4).
+  // 0: the radar cube to the DMA (docs/design.md 3.2); 1: detection records (docs/design.md 3.4).
   parameter int OUTPUT_MODE = 0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
   // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,

@@ -1,5 +1,5 @@
 """End-to-end cocotb regression of ``radar_pipeline`` with ``OUTPUT_MODE = 1`` (on-chip
-detection, DESIGN 3.4): ADC frames in, detection-record packets out, bit-exact against
+detection, docs/design.md 3.4): ADC frames in, detection-record packets out, bit-exact against
 ``model.radar_pipeline.dma_packets`` (the corner turn's (r, t, d) read order, NCI, 2-D CFAR,
 records, packet framing), with random ADC gaps and DMA backpressure, frames back to back, a
 frame with more detections than MAX_DETECTIONS (sticky ``truncated``) and a mid-stream reset.
