@@ -72,7 +72,7 @@ FRAME_RATE_HZ = 111.0
 """The radar's frame rate (the paper's 111 frames/s)."""
 LINK_MBPS = 766.0
 """The paper's measured Gigabit Ethernet throughput, Mbit/s."""
-UDP_PACKET_WORDS = {"full": 1022, "paper-fpga": 4093}
+UDP_PACKET_WORDS = {"full": 1021, "paper-fpga": 4092}
 """PACKET_WORDS that fill one UDP datagram (``host.udp.max_packet_words``)."""
 
 

@@ -10,6 +10,10 @@ Ethernet link) via :meth:`StreamDecoder.push_packet`, or as a raw byte stream wi
 boundaries (a DMA dump) via :meth:`StreamDecoder.push_bytes`, which splits packets by their
 header and resynchronises on the header magic after garbage.
 
+Every packet's CRC word is checked first (``model.axis_packetizer.crc_error``): a packet that
+fails is counted (``StreamStats.crc_errors``) and never used, its frame (named by the header,
+when that frame is open) is marked damaged, and a frame missing it is damaged anyway.
+
 Nothing here raises on bad data: every problem ends up in a frame's ``problems`` (frame
 damaged: lost, repeated, truncated, reordered or corrupt packets) or in the decoder's
 ``stream_problems`` (bytes that belong to no frame, late packets, hardware sticky flags).
@@ -25,7 +29,9 @@ import numpy as np
 
 from model.axis_packetizer import (
     MAGIC,
+    PacketHeader,
     check_geometry,
+    crc_error,
     depacketize,
     packets_per_frame,
     parse_header,
@@ -45,8 +51,8 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
                          frame_words_of: Callable[[RadarConfig], int] = cube_frame_words
                          ) -> tuple[RadarConfig, int]:
     """The radar configuration and PACKET_WORDS a DMA packet belongs to, from its header
-    alone: the datagram length and header lane 1 (payload words) give the word width, hence
-    num_rx; lane 3 gives the packets per frame, which with the payload length fixes
+    alone (its CRC checked at each candidate word width): the datagram length and header lane
+    1 (payload words) give the word width, hence num_rx; lane 3 gives the packets per frame, which with the payload length fixes
     PACKET_WORDS for a preset's frame size (``frame_words_of(cfg)``: the cube's by default,
     a record stream's for ``host.records``). ValueError when no configuration fits."""
     tried = []
@@ -62,7 +68,8 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
             tried.append(cfg.name)
             continue
         frame_words = frame_words_of(cfg)
-        if hdr.length != len(words) - 1 or not hdr.n_packets:
+        if (hdr.length != len(words) - 2 or not hdr.n_packets
+                or crc_error(data, wb) is not None):
             tried.append(cfg.name)
             continue
         n = hdr.n_packets
@@ -149,6 +156,8 @@ class StreamStats:
     frames_damaged: int = 0
     reordered_packets: int = 0
     duplicate_packets: int = 0
+    crc_errors: int = 0
+    """Packets whose CRC word did not match (corrupt on the way: not used)."""
     hw_overflow_seen: bool = False
     hw_framing_seen: bool = False
 
@@ -158,6 +167,7 @@ class _Open:
     packets: list[np.ndarray] = field(default_factory=list)
     seqs: set[int] = field(default_factory=set)
     full_id: int = 0
+    corrupt: list[str] = field(default_factory=list)  # CRC failures naming this frame
 
 
 class PacketDecoder(Generic[FrameT]):
@@ -212,8 +222,8 @@ class PacketDecoder(Generic[FrameT]):
 
     # ---- packet input ---------------------------------------------------------------------
     def push_packet(self, data: bytes) -> list[FrameT]:
-        """One DMA packet (header word + payload, little-endian lanes). Returns the frames
-        this packet completed or pushed out of the reorder window."""
+        """One DMA packet (header word, payload, CRC word; little-endian lanes). Returns the
+        frames this packet completed or pushed out of the reorder window."""
         self.stats.packets += 1
         self.stats.bytes += len(data)
         if len(data) < self.word_bytes:
@@ -231,6 +241,10 @@ class PacketDecoder(Generic[FrameT]):
         except ValueError as exc:
             self.stats.garbage_packets += 1
             self._problem(f"packet dropped: {exc}")
+            return []
+        bad = crc_error(data, self.word_bytes)
+        if bad is not None:
+            self._corrupt(hdr, bad)
             return []
         if hdr.overflow and not self.stats.hw_overflow_seen:
             self.stats.hw_overflow_seen = True
@@ -256,20 +270,32 @@ class PacketDecoder(Generic[FrameT]):
             out.append(self._close(fid))
         return out
 
+    def _corrupt(self, hdr: PacketHeader, why: str) -> None:
+        """A packet that failed its CRC: counted, not used; its frame (as its possibly
+        corrupt header names it) is marked damaged if that frame is open."""
+        self.stats.crc_errors += 1
+        entry = self._open.get(hdr.frame_id)
+        if entry is not None:
+            entry.corrupt.append(f"frame {hdr.frame_id}: packet {hdr.seq} failed its CRC "
+                                 f"({why}), not used")
+        self._problem(f"packet {hdr.seq} of frame {hdr.frame_id} dropped: {why}")
+
     def _close(self, fid: int) -> FrameT:
         entry = self._open.pop(fid)
         self._closed.append(fid)
         del self._closed[:-4 * self.reorder_window]
         packets = self._in_order(entry.packets)
         # depacketize reports what is still wrong: gaps, conflicting repeats, bad lengths
-        decoded = depacketize(packets, self.frame_words, self.packet_words, self.num_rx)
+        # (every packet here passed its CRC in push_packet)
+        decoded = depacketize(packets, self.frame_words, self.packet_words, self.num_rx,
+                              crc_checked=True)
         if len(decoded) != 1:  # cannot happen: all packets carry the same frame id
             problems = [f"frame {fid}: packets split into {len(decoded)} groups"]
             words = np.zeros((self.frame_words, self.num_rx), np.uint32)
             valid = np.zeros(self.frame_words, bool)
         else:
             problems, words, valid = decoded[0].errors, decoded[0].words, decoded[0].valid
-        frame = self._make_frame(fid, words, valid, list(problems))
+        frame = self._make_frame(fid, words, valid, entry.corrupt + list(problems))
         if frame.complete:
             self.stats.frames_complete += 1
         else:
@@ -305,9 +331,11 @@ class PacketDecoder(Generic[FrameT]):
     # ---- raw byte stream input ------------------------------------------------------------
     def push_bytes(self, data: bytes) -> list[FrameT]:
         """Raw stream bytes (no packet boundaries): packets are cut by their header's
-        payload length (lane 1, or the nominal length for num_rx < 2). After garbage the
-        decoder resynchronises byte by byte on a plausible header (magic, sequence number
-        and length consistent with the frame geometry); skipped bytes are counted."""
+        payload length (lane 1, or the nominal length for num_rx < 2) plus the CRC word.
+        After garbage, and after a packet that fails its CRC (its length may be what was
+        corrupted), the decoder resynchronises byte by byte on a plausible header (magic,
+        sequence number and length consistent with the frame geometry); skipped bytes are
+        counted."""
         self._buf.extend(data)
         out: list[FrameT] = []
         wb = self.word_bytes
@@ -316,12 +344,14 @@ class PacketDecoder(Generic[FrameT]):
             if length is None:
                 self._resync()
                 continue
-            need = (1 + length) * wb
+            need = (2 + length) * wb
             if len(self._buf) < need:
                 break
             packet = bytes(self._buf[:need])
-            del self._buf[:need]
+            corrupt = self.stats.crc_errors
             out.extend(self.push_packet(packet))
+            # a corrupt packet: resynchronise from its second word, else take it whole
+            del self._buf[:wb if self.stats.crc_errors > corrupt else need]
         return out
 
     def _header_length(self, word: bytes) -> int | None:

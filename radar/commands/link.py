@@ -62,7 +62,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
     if pw > fit:
-        raise CliError(f"--packet-words: {pw} words + header = {(pw + 1) * 4 * cfg.num_rx} "
+        raise CliError(f"--packet-words: {pw} words + header + CRC = {(pw + 2) * 4 * cfg.num_rx} "
                        f"bytes per packet does not fit a UDP datagram (at most {fit} for "
                        f"{cfg.num_rx} lanes), so radar replay could not send it")
     packets: list[bytes] = []
@@ -213,8 +213,8 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help=f"frames, 1..{MAX_CAPTURE_FRAMES} (default 3)")
     c.add_argument("--packet-words", type=int, default=None,
                    help="payload words per packet, PACKET_WORDS (default: the most that fit "
-                        "one UDP datagram of 65507 bytes with the header word: 1022 for the "
-                        "16 lanes of full, 4093 for the 4 of paper-fpga)")
+                        "one UDP datagram of 65507 bytes with the header and CRC words: 1021 for "
+                        "the 16 lanes of full, 4092 for the 4 of paper-fpga)")
     c.add_argument("--preset", choices=presets, default=None, help="override the preset")
     c.add_argument("--detect", choices=("host", "fpga"), default="host",
                    help="host: capture the radar cube stream (default); fpga: the on-chip "
