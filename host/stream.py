@@ -51,10 +51,11 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
                          frame_words_of: Callable[[RadarConfig], int] = cube_frame_words
                          ) -> tuple[RadarConfig, int]:
     """The radar configuration and PACKET_WORDS a DMA packet belongs to, from its header
-    alone (its CRC checked at each candidate word width): the datagram length and header lane
-    1 (payload words) give the word width, hence num_rx; lane 3 gives the packets per frame, which with the payload length fixes
-    PACKET_WORDS for a preset's frame size (``frame_words_of(cfg)``: the cube's by default,
-    a record stream's for ``host.records``). ValueError when no configuration fits."""
+    alone (its CRC checked at each candidate word width): the datagram length and header
+    lane 1 (payload words) give the word width, hence num_rx; lane 3 gives the packets per
+    frame, which with the payload length fixes PACKET_WORDS for a preset's frame size
+    (``frame_words_of(cfg)``: the cube's by default, a record stream's for ``host.records``).
+    ValueError when no configuration fits."""
     tried = []
     for cfg in configs:
         wb = 4 * cfg.num_rx

@@ -313,7 +313,8 @@ async def fft_overflow_and_framing_counters(dut) -> None:
 async def throughput_latency(dut) -> None:
     """ADC at one sample per clock with no gaps, DMA always ready: the steady-state frame
     period is the frame's DMA words (payload + a header and a CRC word per packet), i.e. the
-    chain moves one sample per clock per lane; measures latency and simulation speed (RP_BENCH_JSON)."""
+    chain moves one sample per clock per lane; measures latency and simulation speed
+    (RP_BENCH_JSON)."""
     import time
 
     tb = PipelineTB(dut)
