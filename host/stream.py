@@ -198,6 +198,8 @@ class PacketDecoder(Generic[FrameT]):
         self.stream_problems: list[str] = []
         self._open: dict[int, _Open] = {}
         self._closed: list[int] = []  # recently closed ids, to recognise late packets
+        # CRC failures naming a frame not open yet (its first packets were the corrupt ones)
+        self._corrupt_pending: dict[int, list[str]] = {}
         self._buf = bytearray()
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
@@ -263,7 +265,9 @@ class PacketDecoder(Generic[FrameT]):
         for old in sorted(self._open, key=lambda k: self._newer(k, fid)):
             if self._newer(fid, old) >= self.reorder_window:
                 out.append(self._close(old))
-        entry = self._open.setdefault(fid, _Open(full_id=fid))
+        if fid not in self._open:
+            self._open[fid] = _Open(full_id=fid, corrupt=self._corrupt_pending.pop(fid, []))
+        entry = self._open[fid]
         entry.packets.append(words)
         if hdr.seq < self.n_packets:
             entry.seqs.add(hdr.seq)
@@ -273,12 +277,16 @@ class PacketDecoder(Generic[FrameT]):
 
     def _corrupt(self, hdr: PacketHeader, why: str) -> None:
         """A packet that failed its CRC: counted, not used; its frame (as its possibly
-        corrupt header names it) is marked damaged if that frame is open."""
+        corrupt header names it) is marked damaged, now if it is open, else when it opens."""
         self.stats.crc_errors += 1
+        msg = f"frame {hdr.frame_id}: packet {hdr.seq} failed its CRC ({why}), not used"
         entry = self._open.get(hdr.frame_id)
         if entry is not None:
-            entry.corrupt.append(f"frame {hdr.frame_id}: packet {hdr.seq} failed its CRC "
-                                 f"({why}), not used")
+            entry.corrupt.append(msg)
+        elif hdr.frame_id not in self._closed:
+            self._corrupt_pending.setdefault(hdr.frame_id, []).append(msg)
+            while len(self._corrupt_pending) > 4 * self.reorder_window:
+                del self._corrupt_pending[next(iter(self._corrupt_pending))]
         self._problem(f"packet {hdr.seq} of frame {hdr.frame_id} dropped: {why}")
 
     def _close(self, fid: int) -> FrameT:
