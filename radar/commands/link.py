@@ -205,7 +205,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     c = add_command(
         sub, "capture", "write the DMA packets of simulated frames to a capture file", """
         Simulate frames, run them through the bit-accurate model of the FPGA chain and write its
-        DMA packets (header word + payload, exactly as the packetizer sends them) to a .dmacap
+        DMA packets (header, payload, CRC word, exactly as the packetizer sends them) to a .dmacap
         file for `radar replay`.""")
     c.add_argument("--scene", required=True, help="scene JSON file or built-in name")
     c.add_argument("--out", required=True, help="output .dmacap file")
