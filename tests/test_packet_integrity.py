@@ -243,3 +243,46 @@ def test_decoders_never_raise_on_corrupted_bytes(kind: str, raw: bool,
         if f.complete:
             assert np.array_equal(_payload(f), clean[f.frame_id])
     assert dec.stats.frames_complete + dec.stats.frames_damaged == len(frames)
+
+
+def test_corrupted_capture_replayed_and_received(tmp_path: Path) -> None:
+    """The reported case: 200 bytes inverted inside frame 1 of a 3-frame capture, then
+    ``radar replay`` -> ``radar receive``: frame 1 is damaged and gives no points, its packet
+    is counted in the JSON's stats.crc_errors, frames 0 and 2 are intact."""
+    import json
+    import socket
+    import threading
+    import time
+
+    from radar.cli import main
+
+    cap = tmp_path / "t.dmacap"
+    assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "3",
+                 "--out", str(cap)]) == 0
+    info, it = read_capture(cap)
+    sizes = [len(p) for p in it]
+    per_frame = len(sizes) // 3
+    image = bytearray(cap.read_bytes())
+    head = len(image) - sum(4 + n for n in sizes)
+    at = head + sum(4 + n for n in sizes[:per_frame + 1]) - 1000   # inside frame 1
+    image[at:at + 200] = bytes(b ^ 0xFF for b in image[at:at + 200])
+    cap.write_bytes(bytes(image))
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    out, rc = tmp_path / "rx.json", {}
+    t = threading.Thread(target=lambda: rc.update(rc=main([
+        "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "60",
+        "--json", str(out)])))
+    t.start()
+    time.sleep(0.5)
+    assert main(["replay", "--capture", str(cap), "--port", str(port)]) == 0
+    t.join(timeout=90)
+    assert rc["rc"] == 0 and info.packet_words == 4092
+    doc = json.loads(out.read_text())
+    info_by_id = sorted(doc["frame_info"], key=lambda f: f["frame_id"])  # damaged: late
+    assert [f["complete"] for f in info_by_id] == [True, False, True]
+    assert doc["stats"]["crc_errors"] == 1
+    assert any("failed its CRC" in p for p in info_by_id[1]["problems"])
+    assert "points" not in info_by_id[1] and not any(
+        p["frame"] == 1 for p in doc["points"])
