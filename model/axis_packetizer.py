@@ -109,6 +109,13 @@ def crc_word(packet: np.ndarray) -> np.ndarray:
     return word
 
 
+def seal(body: np.ndarray) -> np.ndarray:
+    """A packet as sent: ``body`` (uint32 ``(n_words, num_rx)``, header and payload words)
+    followed by its CRC word."""
+    body = np.asarray(body, dtype=np.uint32)
+    return np.vstack([body, crc_word(body)[None, :]])
+
+
 def crc_error(data: bytes | memoryview, word_bytes: int) -> str | None:
     """Why a packet's wire bytes (header, payload, CRC word; ``word_bytes`` = 4 * num_rx a
     word) fail their CRC, or None when intact. Never raises."""
@@ -168,9 +175,8 @@ def packetize(frame: np.ndarray, packet_words: int, frame_id: int = 0, header: b
         if header:
             hdr = PacketHeader(frame_id=frame_id, seq=seq, last=seq == n_packets - 1,
                                overflow=overflow, framing=framing, damaged=damaged)
-            body = np.vstack([header_word(hdr, num_rx, n_packets, len(payload))[None, :],
-                              payload])
-            out.append(np.vstack([body, crc_word(body)[None, :]]))
+            out.append(seal(np.vstack([header_word(hdr, num_rx, n_packets,
+                                                   len(payload))[None, :], payload])))
         else:
             out.append(payload.copy())
     return out

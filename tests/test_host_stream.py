@@ -86,13 +86,13 @@ def test_reordered_and_duplicated_packets_are_reassembled(fault):
 def test_conflicting_repeat_is_reported():
     """Two different packets with the same sequence number, both with a valid CRC:
     something is wrong."""
-    from model.axis_packetizer import bytes_to_words, crc_word, words_to_bytes
+    from model.axis_packetizer import bytes_to_words, seal, words_to_bytes
 
     frames = cubes(SMALL, 2)
     pk = stream(SMALL, frames)
     body = bytes_to_words(pk[4], SMALL.num_rx)[:-1].copy()
     body[-1, 0] ^= 0x55
-    pk.insert(5, words_to_bytes(np.vstack([body, crc_word(body)[None, :]])))
+    pk.insert(5, words_to_bytes(seal(body)))
     out, dec = decode(pk)
     assert not out[0].complete and any("repeated" in p for p in out[0].problems)
     assert out[1].complete and dec.stats.crc_errors == 0
