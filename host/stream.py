@@ -10,9 +10,11 @@ Ethernet link) via :meth:`StreamDecoder.push_packet`, or as a raw byte stream wi
 boundaries (a DMA dump) via :meth:`StreamDecoder.push_bytes`, which splits packets by their
 header and resynchronises on the header magic after garbage.
 
-Every packet's CRC word is checked first (``model.axis_packetizer.crc_error``): a packet that
-fails is counted (``StreamStats.crc_errors``) and never used, its frame (named by the header,
-when that frame is open) is marked damaged, and a frame missing it is damaged anyway.
+Every packet's CRC word is checked before its payload is used
+(``model.axis_packetizer.crc_error``): a packet that fails is counted
+(``StreamStats.crc_errors``) and never used, so its frame misses it and is damaged (with the
+CRC failure among its problems); an intact copy of the same packet (a duplicated datagram)
+still completes the frame.
 
 Nothing here raises on bad data: every problem ends up in a frame's ``problems`` (frame
 damaged: lost, repeated, truncated, reordered or corrupt packets) or in the decoder's
@@ -168,7 +170,8 @@ class _Open:
     packets: list[np.ndarray] = field(default_factory=list)
     seqs: set[int] = field(default_factory=set)
     full_id: int = 0
-    corrupt: list[str] = field(default_factory=list)  # CRC failures naming this frame
+    # (seq, message) of the packets that failed their CRC naming this frame
+    corrupt: list[tuple[int, str]] = field(default_factory=list)
 
 
 class PacketDecoder(Generic[FrameT]):
@@ -199,7 +202,7 @@ class PacketDecoder(Generic[FrameT]):
         self._open: dict[int, _Open] = {}
         self._closed: list[int] = []  # recently closed ids, to recognise late packets
         # CRC failures naming a frame not open yet (its first packets were the corrupt ones)
-        self._corrupt_pending: dict[int, list[str]] = {}
+        self._corrupt_pending: dict[int, list[tuple[int, str]]] = {}
         self._buf = bytearray()
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
@@ -276,15 +279,17 @@ class PacketDecoder(Generic[FrameT]):
         return out
 
     def _corrupt(self, hdr: PacketHeader, why: str) -> None:
-        """A packet that failed its CRC: counted, not used; its frame (as its possibly
-        corrupt header names it) is marked damaged, now if it is open, else when it opens."""
+        """A packet that failed its CRC: counted, never used. Its frame is damaged by the
+        packet's absence; the frame its (untrusted) header names gets the CRC message when
+        it closes without an intact packet of that number (so a corrupt header never
+        damages another frame, and an intact duplicate still completes the frame)."""
         self.stats.crc_errors += 1
         msg = f"frame {hdr.frame_id}: packet {hdr.seq} failed its CRC ({why}), not used"
         entry = self._open.get(hdr.frame_id)
         if entry is not None:
-            entry.corrupt.append(msg)
+            entry.corrupt.append((hdr.seq, msg))
         elif hdr.frame_id not in self._closed:
-            self._corrupt_pending.setdefault(hdr.frame_id, []).append(msg)
+            self._corrupt_pending.setdefault(hdr.frame_id, []).append((hdr.seq, msg))
             while len(self._corrupt_pending) > 4 * self.reorder_window:
                 del self._corrupt_pending[next(iter(self._corrupt_pending))]
         self._problem(f"packet {hdr.seq} of frame {hdr.frame_id} dropped: {why}")
@@ -304,7 +309,9 @@ class PacketDecoder(Generic[FrameT]):
             valid = np.zeros(self.frame_words, bool)
         else:
             problems, words, valid = decoded[0].errors, decoded[0].words, decoded[0].valid
-        frame = self._make_frame(fid, words, valid, entry.corrupt + list(problems))
+        if problems:  # CRC failures that explain packets this frame misses
+            problems = [m for seq, m in entry.corrupt if seq not in entry.seqs] + problems
+        frame = self._make_frame(fid, words, valid, list(problems))
         if frame.complete:
             self.stats.frames_complete += 1
         else:

@@ -98,18 +98,22 @@ def test_conflicting_repeat_is_reported():
     assert out[1].complete and dec.stats.crc_errors == 0
 
 
-def test_corrupt_copy_fails_its_crc():
-    """A corrupt copy of a packet (its intact original also arrived) fails its CRC: counted,
-    not used, its frame marked damaged."""
+def test_corrupt_packet_fails_its_crc():
+    """A corrupt packet fails its CRC: counted, never used, its frame damaged with the CRC
+    failure among its problems; a corrupt copy whose intact original also arrived costs
+    nothing (the frame is exactly what was sent)."""
     frames = cubes(SMALL, 2)
     pk = stream(SMALL, frames)
     bad = bytearray(pk[4])
     bad[-20] ^= 0x55
-    pk.insert(5, bytes(bad))
-    out, dec = decode(pk)
+    out, dec = decode(pk[:4] + [bytes(bad)] + pk[5:])
     assert dec.stats.crc_errors == 1 and dec.stats.frames_damaged == 1
-    assert not out[0].complete and any("failed its CRC" in p for p in out[0].problems)
-    assert out[1].complete
+    assert not out[0].complete and out[1].complete
+    assert any("packet 4 failed its CRC" in p for p in out[0].problems)
+    assert any("missing packets [4]" in p for p in out[0].problems)
+    out, dec = decode(pk[:5] + [bytes(bad)] + pk[5:])
+    assert dec.stats.crc_errors == 1 and dec.stats.frames_damaged == 0
+    assert out[0].complete and np.array_equal(out[0].cube, frames[0])
 
 
 def test_truncated_packet():

@@ -115,7 +115,7 @@ def test_every_flip_is_detected(kind: str, burst: bool, raw: bool) -> None:
     assert all(f.complete for f in ref) and len(ref) == N_FRAMES
     clean = {f.frame_id: _payload(f) for f in ref}
     per_frame = len(packets) // N_FRAMES
-    rng = np.random.default_rng(hash((kind, burst, raw)) % 2**32)
+    rng = np.random.default_rng([kind == "cube", burst, raw])   # the same flips every run
     false_accepts = crc_caught = 0
     for _ in range(FLIPS_PER_CASE):
         i = per_frame + int(rng.integers(0, per_frame))     # a packet of frame 1
