@@ -214,19 +214,20 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
     """Reassemble frames from header-carrying packets (uint32 ``(n, num_rx)`` each: header,
     payload, CRC word).
 
-    Detects and reports, never raises on, CRC mismatches (the packet is not used; its message
-    goes to the current frame unless its header names another, then to the next frame),
-    bad magic, lost/repeated/reordered packets, packets with dropped words (DROP flag), wrong
-    lengths and truncated frames. A packet's payload is placed by its sequence number, so
-    intact packets of a damaged frame are still usable. ``crc_checked``: the caller has
-    already dropped the packets that fail their CRC (``host.stream``), skip the check.
+    Detects and reports, never raises on, CRC mismatches and bad magic (the packet is not
+    used, so its frame misses it; the message goes to the damaged frame that misses the
+    packet its untrusted header names), lost/repeated/reordered packets, packets with dropped
+    words (DROP flag), wrong lengths and truncated frames. A packet's payload is placed by
+    its sequence number, so intact packets of a damaged frame are still usable.
+    ``crc_checked``: the caller has already dropped the packets that fail their CRC
+    (``host.stream``), skip the check.
     """
     n_packets = packets_per_frame(frame_words, packet_words)
     frames: list[DecodedFrame] = []
     cur: DecodedFrame | None = None
     seen: set[int] = set()
     expect_seq = 0
-    pending: list[str] = []  # CRC failures not yet attributed to a frame
+    unused: list[tuple[int | None, int | None, str]] = []  # (frame id, seq, why) as named
 
     def close() -> None:
         if cur is not None:
@@ -234,6 +235,11 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
                 missing = sorted(set(range(n_packets)) - seen)
                 cur.errors.append(f"frame {cur.frame_id}: missing packets {missing[:8]}"
                                   f"{'...' if len(missing) > 8 else ''}")
+            if cur.errors:  # the unused packets that explain what this frame misses
+                mine = [u for u in unused if u[0] in (None, cur.frame_id)
+                        and u[1] not in seen]
+                cur.errors[:0] = [m for _, _, m in mine]
+                unused[:] = [u for u in unused if u not in mine]
             frames.append(cur)
 
     for i, pkt in enumerate(packets):
@@ -247,11 +253,8 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
             bad = bad or str(exc)
             hdr = None
         if bad is not None:
-            msg = f"packet {i}: {bad}, not used"
-            if cur is not None and (hdr is None or hdr.frame_id == cur.frame_id):
-                cur.errors.append(msg)
-            else:
-                pending.append(msg)
+            named = (None, None) if hdr is None else (hdr.frame_id, hdr.seq)
+            unused.append((*named, f"packet {i}: {bad}, not used"))
             continue
         assert hdr is not None
         fid = hdr.frame_id
@@ -259,8 +262,7 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
                 num_rx > 2 and fid != cur.frame_id):
             close()
             cur = DecodedFrame(fid, np.zeros((frame_words, num_rx), np.uint32),
-                               np.zeros(frame_words, bool), pending)
-            pending = []
+                               np.zeros(frame_words, bool))
             seen = set()
             expect_seq = 0
         payload = pkt[1:-1]
@@ -291,8 +293,6 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
         cur.words[start:start + nominal] = payload
         cur.valid[start:start + nominal] = True
         seen.add(hdr.seq)
-    if cur is not None:
-        cur.errors.extend(pending)
     close()
     return frames
 

@@ -20,7 +20,14 @@ from host.capture import CaptureInfo, frame_packets, read_capture, write_capture
 from host.receiver import RECORDS, Receiver
 from host.records import RecordDecoder
 from host.stream import PacketDecoder, StreamDecoder
-from model.axis_packetizer import crc_error, pack_iq, packetize_stream, words_to_bytes
+from model.axis_packetizer import (
+    bytes_to_words,
+    crc_error,
+    depacketize,
+    pack_iq,
+    packetize_stream,
+    words_to_bytes,
+)
 from model.config import RadarConfig, get_preset
 from model.detect_chain import DetectConfig, detect_stream
 from model.radar_pipeline import PipelineParams
@@ -201,6 +208,27 @@ def test_live_link_counts_and_marks_corrupt_packets(kind: str) -> None:
     assert [f.complete for f in sorted(frames, key=lambda f: f.frame_id)] == [True, False, True]
     assert dec.stats.crc_errors == 1 and dec.stats.frames_damaged == 1
     assert any("failed its CRC" in p for f in frames for p in f.problems)
+
+
+def test_model_depacketize_drops_corrupt_packets() -> None:
+    """The model's decoder (``model.axis_packetizer.depacketize``, used by the testbenches)
+    applies the same check: a flipped packet is not used, its frame is damaged (and names
+    the CRC failure unless the flip hit the header it would be named by), the other frames
+    are complete."""
+    packets = [bytes_to_words(p, CUBE_CFG.num_rx) for p in STREAMS["cube"]]
+    per_frame = len(packets) // N_FRAMES
+    fw = CUBE_CFG.num_tx * CUBE_CFG.n_range * CUBE_CFG.n_doppler
+    rng = np.random.default_rng(11)
+    for t in range(300):
+        i = per_frame + int(rng.integers(0, per_frame))
+        bad = list(packets)
+        bad[i] = bytes_to_words(_flip(words_to_bytes(packets[i]), rng, burst=bool(t % 2)),
+                                CUBE_CFG.num_rx)
+        frames = depacketize(bad, fw, CUBE_PW, CUBE_CFG.num_rx)
+        assert [f.complete for f in frames] == [True, False, True], [f.errors for f in frames]
+        assert any("missing packets" in e for e in frames[1].errors)
+        flipped_header = not np.array_equal(bad[i][0], packets[i][0])
+        assert flipped_header or any("not used" in e for e in frames[1].errors)
 
 
 def test_crc_error_names_what_is_wrong() -> None:
