@@ -24,46 +24,22 @@ from model.axis_packetizer import (
     bytes_to_words,
     crc_error,
     depacketize,
-    pack_iq,
     packetize_stream,
     words_to_bytes,
 )
-from model.config import RadarConfig, get_preset
-from model.detect_chain import DetectConfig, detect_stream
+from model.config import get_preset
+from model.detect_chain import detect_stream
 from model.radar_pipeline import PipelineParams
+from tests.test_host_stream import PW as CUBE_PW
+from tests.test_host_stream import SMALL as CUBE_CFG
+from tests.test_host_stream import cubes, stream
+from tests.test_records import DCFG, _frames, _packets
+from tests.test_records import PW as REC_PW
 
-CUBE_CFG = RadarConfig(name="small", num_tx=2, num_rx=4, n_range=16, n_doppler=16,
-                       sample_rate_hz=2e6, chirp_period_s=20e-6, design_max_range_m=20.0)
-CUBE_PW = 64                       # 8 packets of 64 words per frame
-DCFG = DetectConfig(num_tx=2, num_rx=4, n_range=32, n_doppler=32, guard=(1, 1),
-                    train=(2, 4), max_detections=8)
-REC_PW = 16
 FLIPS_PER_CASE = 1250              # x 2 kinds x 2 flip shapes x 2 input paths = 10 000
 N_FRAMES = 3                       # flips go into the middle frame (id 1)
-
-
-def _cube_packets() -> list[bytes]:
-    rng = np.random.default_rng(0)
-    shape = (CUBE_CFG.n_virtual, CUBE_CFG.n_range, CUBE_CFG.n_doppler)
-    return [p for k in range(N_FRAMES) for p in frame_packets(
-        rng.integers(-32768, 32768, shape) + 1j * rng.integers(-32768, 32768, shape),
-        CUBE_CFG, CUBE_PW, k)]
-
-
-def _record_packets() -> list[bytes]:
-    rng = np.random.default_rng(1)
-    frames = []
-    for _ in range(N_FRAMES):
-        x = rng.normal(0, 30, (DCFG.n_range, DCFG.num_tx, DCFG.n_doppler, DCFG.num_rx, 2))
-        for _ in range(4):
-            r, d = rng.integers(4, DCFG.n_range - 4), rng.integers(0, DCFG.n_doppler)
-            x[r, :, d] += rng.normal(0, 3000, (DCFG.num_tx, DCFG.num_rx, 2))
-        c = np.round(x[..., 0]) + 1j * np.round(x[..., 1])
-        frames.append(pack_iq(c.reshape(-1, DCFG.num_rx)))
-    return [words_to_bytes(p) for p in packetize_stream(detect_stream(frames, DCFG), REC_PW)]
-
-
-STREAMS = {"cube": _cube_packets(), "records": _record_packets()}
+STREAMS = {"cube": stream(CUBE_CFG, cubes(CUBE_CFG, N_FRAMES)),   # 8 packets a frame
+           "records": _packets(_frames(N_FRAMES, seed=1, targets=4))}
 
 
 def _decoder(kind: str) -> PacketDecoder:
