@@ -21,7 +21,8 @@ help:
 	@echo "make test            whole regression (pytest -n $(JOBS))"
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
-	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv, fft_*_rom.sv) and check it"
+	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv, fft_*_rom.sv,"
+	@echo "                     rtl/buffers/packet_crc32.sv) and check it"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
@@ -73,7 +74,8 @@ lint: $(STAMP)
 # Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
 gen: $(STAMP)
 	$(RUN) python -m model.fft_rom
-	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py -k up_to_date
+	$(RUN) python -m model.packet_crc
+	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py tests/test_packet_crc.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_simulate

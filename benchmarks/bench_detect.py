@@ -72,7 +72,7 @@ FRAME_RATE_HZ = 111.0
 """The radar's frame rate (the paper's 111 frames/s)."""
 LINK_MBPS = 766.0
 """The paper's measured Gigabit Ethernet throughput, Mbit/s."""
-UDP_PACKET_WORDS = {"full": 1022, "paper-fpga": 4093}
+UDP_PACKET_WORDS = {"full": 1021, "paper-fpga": 4092}
 """PACKET_WORDS that fill one UDP datagram (``host.udp.max_packet_words``)."""
 
 
@@ -197,7 +197,7 @@ def link_rows(preset: str, counts: tuple[int, ...]) -> list[tuple[str, int, floa
     wb = 4 * cfg.num_rx
     frame_words = cfg.num_tx * cfg.n_range * cfg.n_doppler
     n_pk = -(-frame_words // pw)
-    cube_bytes = (frame_words + n_pk) * wb       # every packet carries one header word
+    cube_bytes = (frame_words + 2 * n_pk) * wb   # every packet: a header and a CRC word
     rows = [("radar cube (mode 0)", cube_bytes, cube_bytes * 8 * FRAME_RATE_HZ / 1e6)]
     for n in counts:
         frame = encode_frame(synthetic_records(cfg, n), n, cfg.num_tx, cfg.num_rx, n)

@@ -2,16 +2,17 @@
 
 File layout (little-endian)::
 
-    bytes 0..7   b"RDMACAP1"
+    bytes 0..7   b"RDMACAP2"
     u32          num_rx (lanes per word)
     u32          packet_words (payload words per packet)
     u32          num_tx, u32 n_range, u32 n_doppler   (frame geometry)
-    then per packet: u32 length in bytes, the packet's bytes (header word + payload)
+    then per packet: u32 length in bytes, the packet's bytes (header word, payload, CRC word)
 
 A capture of the detection-record stream (``OUTPUT_MODE = 1``, ``host.records``) starts with
-b"RDMAREC2" instead and has one more u32 after n_doppler: MAX_DETECTIONS (which fixes the
-record frame's length); the packets follow as above. (b"RDMAREC1" captures hold the record
-format before the neighbour powers, 8 header lanes instead of 16: refused with a message.)
+b"RDMAREC3" instead and has one more u32 after n_doppler: MAX_DETECTIONS (which fixes the
+record frame's length); the packets follow as above. Older captures are refused with a
+one-line message naming their version: b"RDMACAP1" / b"RDMAREC2" hold packets without the
+CRC word, b"RDMAREC1" the record format before the neighbour powers (8 header lanes).
 
 ``radar replay`` sends a capture over UDP one packet per datagram; ``radar receive`` decodes
 datagrams with :class:`host.stream.StreamDecoder`.
@@ -30,10 +31,14 @@ from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import RadarConfig
 from model.reference import cube_to_dma_order
 
-MAGIC = b"RDMACAP1"
-MAGIC_RECORDS = b"RDMAREC2"
-MAGIC_RECORDS_V1 = b"RDMAREC1"
-"""Record captures of the 8-lane header format (no neighbour powers), no longer read."""
+MAGIC = b"RDMACAP2"
+MAGIC_RECORDS = b"RDMAREC3"
+OLD_VERSIONS = {
+    b"RDMACAP1": "cube capture of packets without the CRC word",
+    b"RDMAREC2": "record capture of packets without the CRC word",
+    b"RDMAREC1": "record capture of 8-lane record headers without the neighbour powers",
+}
+"""Capture versions no longer read, and why."""
 _HEAD = struct.Struct("<8s5I")
 _MAX_DET = struct.Struct("<I")
 
@@ -100,11 +105,11 @@ def read_capture(path: Path) -> tuple[CaptureInfo, Iterator[bytes]]:
     raising ValueError."""
     f = open(path, "rb")  # noqa: SIM115 - closed by the generator
     head = f.read(_HEAD.size)
-    if head[:8] == MAGIC_RECORDS_V1:
+    if head[:8] in OLD_VERSIONS:
         f.close()
-        raise ValueError(f"{path}: record capture of the old format ({MAGIC_RECORDS_V1!r}: "
-                         f"8-lane record headers without the neighbour powers); capture it "
-                         f"again")
+        raise ValueError(f"{path}: capture version {head[:8].decode()} ("
+                         f"{OLD_VERSIONS[head[:8]]}) is no longer read; this version reads "
+                         f"{MAGIC.decode()} and {MAGIC_RECORDS.decode()}: capture it again")
     if len(head) < _HEAD.size or head[:8] not in (MAGIC, MAGIC_RECORDS):
         f.close()
         raise ValueError(f"{path}: not a DMA capture (missing {MAGIC!r} or {MAGIC_RECORDS!r} "

@@ -10,6 +10,12 @@ Ethernet link) via :meth:`StreamDecoder.push_packet`, or as a raw byte stream wi
 boundaries (a DMA dump) via :meth:`StreamDecoder.push_bytes`, which splits packets by their
 header and resynchronises on the header magic after garbage.
 
+Every packet's CRC word is checked before its payload is used
+(``model.axis_packetizer.crc_error``): a packet that fails is counted
+(``StreamStats.crc_errors``) and never used, so its frame misses it and is damaged (with the
+CRC failure among its problems); an intact copy of the same packet (a duplicated datagram)
+still completes the frame.
+
 Nothing here raises on bad data: every problem ends up in a frame's ``problems`` (frame
 damaged: lost, repeated, truncated, reordered or corrupt packets) or in the decoder's
 ``stream_problems`` (bytes that belong to no frame, late packets, hardware sticky flags).
@@ -25,7 +31,9 @@ import numpy as np
 
 from model.axis_packetizer import (
     MAGIC,
+    PacketHeader,
     check_geometry,
+    crc_error,
     depacketize,
     packets_per_frame,
     parse_header,
@@ -45,10 +53,11 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
                          frame_words_of: Callable[[RadarConfig], int] = cube_frame_words
                          ) -> tuple[RadarConfig, int]:
     """The radar configuration and PACKET_WORDS a DMA packet belongs to, from its header
-    alone: the datagram length and header lane 1 (payload words) give the word width, hence
-    num_rx; lane 3 gives the packets per frame, which with the payload length fixes
-    PACKET_WORDS for a preset's frame size (``frame_words_of(cfg)``: the cube's by default,
-    a record stream's for ``host.records``). ValueError when no configuration fits."""
+    alone (its CRC checked at each candidate word width): the datagram length and header
+    lane 1 (payload words) give the word width, hence num_rx; lane 3 gives the packets per
+    frame, which with the payload length fixes PACKET_WORDS for a preset's frame size
+    (``frame_words_of(cfg)``: the cube's by default, a record stream's for ``host.records``).
+    ValueError when no configuration fits."""
     tried = []
     for cfg in configs:
         wb = 4 * cfg.num_rx
@@ -62,7 +71,8 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
             tried.append(cfg.name)
             continue
         frame_words = frame_words_of(cfg)
-        if hdr.length != len(words) - 1 or not hdr.n_packets:
+        if (hdr.length != len(words) - 2 or not hdr.n_packets
+                or crc_error(data, wb) is not None):
             tried.append(cfg.name)
             continue
         n = hdr.n_packets
@@ -149,6 +159,8 @@ class StreamStats:
     frames_damaged: int = 0
     reordered_packets: int = 0
     duplicate_packets: int = 0
+    crc_errors: int = 0
+    """Packets whose CRC word did not match (corrupt on the way: not used)."""
     hw_overflow_seen: bool = False
     hw_framing_seen: bool = False
 
@@ -158,6 +170,8 @@ class _Open:
     packets: list[np.ndarray] = field(default_factory=list)
     seqs: set[int] = field(default_factory=set)
     full_id: int = 0
+    # (seq, message) of the packets that failed their CRC naming this frame
+    corrupt: list[tuple[int, str]] = field(default_factory=list)
 
 
 class PacketDecoder(Generic[FrameT]):
@@ -187,6 +201,8 @@ class PacketDecoder(Generic[FrameT]):
         self.stream_problems: list[str] = []
         self._open: dict[int, _Open] = {}
         self._closed: list[int] = []  # recently closed ids, to recognise late packets
+        # CRC failures naming a frame not open yet (its first packets were the corrupt ones)
+        self._corrupt_pending: dict[int, list[tuple[int, str]]] = {}
         self._buf = bytearray()
 
     def _make_frame(self, fid: int, words: np.ndarray, valid: np.ndarray,
@@ -212,8 +228,8 @@ class PacketDecoder(Generic[FrameT]):
 
     # ---- packet input ---------------------------------------------------------------------
     def push_packet(self, data: bytes) -> list[FrameT]:
-        """One DMA packet (header word + payload, little-endian lanes). Returns the frames
-        this packet completed or pushed out of the reorder window."""
+        """One DMA packet (header word, payload, CRC word; little-endian lanes). Returns the
+        frames this packet completed or pushed out of the reorder window."""
         self.stats.packets += 1
         self.stats.bytes += len(data)
         if len(data) < self.word_bytes:
@@ -232,6 +248,10 @@ class PacketDecoder(Generic[FrameT]):
             self.stats.garbage_packets += 1
             self._problem(f"packet dropped: {exc}")
             return []
+        bad = crc_error(data, self.word_bytes)
+        if bad is not None:
+            self._corrupt(hdr, bad)
+            return []
         if hdr.overflow and not self.stats.hw_overflow_seen:
             self.stats.hw_overflow_seen = True
             self._problem(f"hardware OVERFLOW flag set (sticky) from frame {hdr.frame_id}")
@@ -248,7 +268,9 @@ class PacketDecoder(Generic[FrameT]):
         for old in sorted(self._open, key=lambda k: self._newer(k, fid)):
             if self._newer(fid, old) >= self.reorder_window:
                 out.append(self._close(old))
-        entry = self._open.setdefault(fid, _Open(full_id=fid))
+        if fid not in self._open:
+            self._open[fid] = _Open(full_id=fid, corrupt=self._corrupt_pending.pop(fid, []))
+        entry = self._open[fid]
         entry.packets.append(words)
         if hdr.seq < self.n_packets:
             entry.seqs.add(hdr.seq)
@@ -256,19 +278,39 @@ class PacketDecoder(Generic[FrameT]):
             out.append(self._close(fid))
         return out
 
+    def _corrupt(self, hdr: PacketHeader, why: str) -> None:
+        """A packet that failed its CRC: counted, never used. Its frame is damaged by the
+        packet's absence; the frame its (untrusted) header names gets the CRC message when
+        it closes without an intact packet of that number (so a corrupt header never
+        damages another frame, and an intact duplicate still completes the frame)."""
+        self.stats.crc_errors += 1
+        msg = f"frame {hdr.frame_id}: packet {hdr.seq} failed its CRC ({why}), not used"
+        entry = self._open.get(hdr.frame_id)
+        if entry is not None:
+            entry.corrupt.append((hdr.seq, msg))
+        elif hdr.frame_id not in self._closed:
+            self._corrupt_pending.setdefault(hdr.frame_id, []).append((hdr.seq, msg))
+            while len(self._corrupt_pending) > 4 * self.reorder_window:
+                del self._corrupt_pending[next(iter(self._corrupt_pending))]
+        self._problem(f"packet {hdr.seq} of frame {hdr.frame_id} dropped: {why}")
+
     def _close(self, fid: int) -> FrameT:
         entry = self._open.pop(fid)
         self._closed.append(fid)
         del self._closed[:-4 * self.reorder_window]
         packets = self._in_order(entry.packets)
         # depacketize reports what is still wrong: gaps, conflicting repeats, bad lengths
-        decoded = depacketize(packets, self.frame_words, self.packet_words, self.num_rx)
+        # (every packet here passed its CRC in push_packet)
+        decoded = depacketize(packets, self.frame_words, self.packet_words, self.num_rx,
+                              crc_checked=True)
         if len(decoded) != 1:  # cannot happen: all packets carry the same frame id
             problems = [f"frame {fid}: packets split into {len(decoded)} groups"]
             words = np.zeros((self.frame_words, self.num_rx), np.uint32)
             valid = np.zeros(self.frame_words, bool)
         else:
             problems, words, valid = decoded[0].errors, decoded[0].words, decoded[0].valid
+        if problems:  # CRC failures that explain packets this frame misses
+            problems = [m for seq, m in entry.corrupt if seq not in entry.seqs] + problems
         frame = self._make_frame(fid, words, valid, list(problems))
         if frame.complete:
             self.stats.frames_complete += 1
@@ -305,9 +347,11 @@ class PacketDecoder(Generic[FrameT]):
     # ---- raw byte stream input ------------------------------------------------------------
     def push_bytes(self, data: bytes) -> list[FrameT]:
         """Raw stream bytes (no packet boundaries): packets are cut by their header's
-        payload length (lane 1, or the nominal length for num_rx < 2). After garbage the
-        decoder resynchronises byte by byte on a plausible header (magic, sequence number
-        and length consistent with the frame geometry); skipped bytes are counted."""
+        payload length (lane 1, or the nominal length for num_rx < 2) plus the CRC word.
+        After garbage, and after a packet that fails its CRC (its length may be what was
+        corrupted), the decoder resynchronises byte by byte on a plausible header (magic,
+        sequence number and length consistent with the frame geometry); skipped bytes are
+        counted."""
         self._buf.extend(data)
         out: list[FrameT] = []
         wb = self.word_bytes
@@ -316,12 +360,14 @@ class PacketDecoder(Generic[FrameT]):
             if length is None:
                 self._resync()
                 continue
-            need = (1 + length) * wb
+            need = (2 + length) * wb
             if len(self._buf) < need:
                 break
             packet = bytes(self._buf[:need])
-            del self._buf[:need]
+            corrupt = self.stats.crc_errors
             out.extend(self.push_packet(packet))
+            # a corrupt packet: resynchronise from its second word, else take it whole
+            del self._buf[:wb if self.stats.crc_errors > corrupt else need]
         return out
 
     def _header_length(self, word: bytes) -> int | None:

@@ -24,9 +24,10 @@ UDP_MAX_PAYLOAD = 65507
 
 
 def max_packet_words(num_rx: int) -> int:
-    """Largest PACKET_WORDS whose packet (header word + payload, 4 * num_rx bytes a word)
-    fits one UDP datagram: 1022 for 16 lanes, 4093 for 4 (capped at the header's 65535)."""
-    return min(UDP_MAX_PAYLOAD // (4 * num_rx) - 1, 65535)
+    """Largest PACKET_WORDS whose packet (header word + payload + CRC word, 4 * num_rx bytes
+    a word) fits one UDP datagram: 1021 for 16 lanes, 4092 for 4 (capped at the header's
+    65535)."""
+    return min(UDP_MAX_PAYLOAD // (4 * num_rx) - 2, 65535)
 
 
 def check_port(port: int, allow_zero: bool = True) -> int:

@@ -11,7 +11,9 @@ Frame payload order (docs/design.md 3.2): for tx, for range bin r, for Doppler b
 
 Each frame is cut into packets of ``packet_words`` payload words (the last one shorter when
 ``packet_words`` does not divide ``frame_words``). With ``header=True`` every packet starts
-with one header word (layout below, docs/buffers.md), and TLAST closes every packet.
+with one header word (layout below, docs/buffers.md) and ends with one CRC word (lane 0: the
+CRC-32 of the header and payload wire bytes, ``model.packet_crc``; other lanes zero), and
+TLAST closes every packet.
 
 Header lane 0 (always present, meaningful at ``num_rx == 1``)::
 
@@ -37,6 +39,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from model.packet_crc import packet_crc
 
 MAGIC = 0xA5
 FLAG_LAST = 1 << 0
@@ -96,6 +100,36 @@ def header_word(hdr: PacketHeader, num_rx: int, n_packets: int, length: int,
     return lanes[:num_rx].copy()
 
 
+def crc_word(packet: np.ndarray) -> np.ndarray:
+    """The CRC word that closes a packet: uint32 lanes ``(num_rx,)``, lane 0 the CRC-32 of
+    ``packet`` (uint32 ``(n_words, num_rx)``: header and payload words), other lanes 0."""
+    packet = np.asarray(packet, dtype=np.uint32)
+    word = np.zeros(packet.shape[1], np.uint32)
+    word[0] = packet_crc(words_to_bytes(packet))
+    return word
+
+
+def seal(body: np.ndarray) -> np.ndarray:
+    """A packet as sent: ``body`` (uint32 ``(n_words, num_rx)``, header and payload words)
+    followed by its CRC word."""
+    body = np.asarray(body, dtype=np.uint32)
+    return np.vstack([body, crc_word(body)[None, :]])
+
+
+def crc_error(data: bytes | memoryview, word_bytes: int) -> str | None:
+    """Why a packet's wire bytes (header, payload, CRC word; ``word_bytes`` = 4 * num_rx a
+    word) fail their CRC, or None when intact. Never raises."""
+    view = memoryview(data)
+    if len(view) < 2 * word_bytes or len(view) % word_bytes:
+        return f"{len(view)} bytes are not a header, payload and CRC word"
+    trailer = view[len(view) - word_bytes:]
+    if any(trailer[4:]):
+        return "CRC word's lanes 1.. are not zero"
+    sent = int.from_bytes(trailer[:4], "little")
+    got = packet_crc(view[:len(view) - word_bytes])
+    return None if got == sent else f"CRC mismatch (sent 0x{sent:08x}, computed 0x{got:08x})"
+
+
 def parse_header(word: np.ndarray) -> PacketHeader:
     """Decode a header word (uint32 lanes ``(num_rx,)``); ValueError if the magic is wrong."""
     lanes = np.asarray(word, dtype=np.uint32).reshape(-1)
@@ -125,7 +159,8 @@ def packetize(frame: np.ndarray, packet_words: int, frame_id: int = 0, header: b
     """Packets of one loss-free frame, exactly as the RTL sends them.
 
     frame: uint32 ``(frame_words, num_rx)`` payload words. Returns a list of uint32 arrays
-    ``(n_words, num_rx)``, one per TLAST-closed packet, header word first if ``header``.
+    ``(n_words, num_rx)``, one per TLAST-closed packet: header word, payload, CRC word if
+    ``header``, else the payload alone.
     ``overflow``/``framing`` are the sticky flags to stamp in every header of this frame.
     """
     frame = np.asarray(frame, dtype=np.uint32)
@@ -140,8 +175,8 @@ def packetize(frame: np.ndarray, packet_words: int, frame_id: int = 0, header: b
         if header:
             hdr = PacketHeader(frame_id=frame_id, seq=seq, last=seq == n_packets - 1,
                                overflow=overflow, framing=framing, damaged=damaged)
-            hw = header_word(hdr, num_rx, n_packets, len(payload))
-            out.append(np.vstack([hw[None, :], payload]))
+            out.append(seal(np.vstack([header_word(hdr, num_rx, n_packets,
+                                                   len(payload))[None, :], payload])))
         else:
             out.append(payload.copy())
     return out
@@ -175,18 +210,24 @@ class DecodedFrame:
 
 
 def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: int,
-                num_rx: int) -> list[DecodedFrame]:
-    """Reassemble frames from header-carrying packets (uint32 ``(n, num_rx)`` each).
+                num_rx: int, crc_checked: bool = False) -> list[DecodedFrame]:
+    """Reassemble frames from header-carrying packets (uint32 ``(n, num_rx)`` each: header,
+    payload, CRC word).
 
-    Detects and reports, never raises on, bad magic, lost/repeated/reordered packets, packets
-    with dropped words (DROP flag), wrong lengths and truncated frames. A packet's payload is
-    placed by its sequence number, so intact packets of a damaged frame are still usable.
+    Detects and reports, never raises on, CRC mismatches and bad magic (the packet is not
+    used, so its frame misses it; the message goes to the damaged frame that misses the
+    packet its untrusted header names), lost/repeated/reordered packets, packets with dropped
+    words (DROP flag), wrong lengths and truncated frames. A packet's payload is placed by
+    its sequence number, so intact packets of a damaged frame are still usable.
+    ``crc_checked``: the caller has already dropped the packets that fail their CRC
+    (``host.stream``), skip the check.
     """
     n_packets = packets_per_frame(frame_words, packet_words)
     frames: list[DecodedFrame] = []
     cur: DecodedFrame | None = None
     seen: set[int] = set()
     expect_seq = 0
+    unused: list[tuple[int | None, int | None, str]] = []  # (frame id, seq, why) as named
 
     def close() -> None:
         if cur is not None:
@@ -194,18 +235,28 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
                 missing = sorted(set(range(n_packets)) - seen)
                 cur.errors.append(f"frame {cur.frame_id}: missing packets {missing[:8]}"
                                   f"{'...' if len(missing) > 8 else ''}")
+            if cur.errors:  # the unused packets that explain what this frame misses
+                mine = [u for u in unused if u[0] in (None, cur.frame_id)
+                        and u[1] not in seen]
+                cur.errors[:0] = [m for _, _, m in mine]
+                unused[:] = [u for u in unused if u not in mine]
             frames.append(cur)
 
     for i, pkt in enumerate(packets):
         pkt = np.asarray(pkt, dtype=np.uint32).reshape(-1, num_rx)
         if pkt.shape[0] == 0:
             continue
+        bad = None if crc_checked else crc_error(words_to_bytes(pkt), 4 * num_rx)
         try:
             hdr = parse_header(pkt[0])
         except ValueError as exc:
-            if cur is not None:
-                cur.errors.append(f"packet {i}: {exc}")
+            bad = bad or str(exc)
+            hdr = None
+        if bad is not None:
+            named = (None, None) if hdr is None else (hdr.frame_id, hdr.seq)
+            unused.append((*named, f"packet {i}: {bad}, not used"))
             continue
+        assert hdr is not None
         fid = hdr.frame_id
         if cur is None or (fid & 0xFF) != (cur.frame_id & 0xFF) or (
                 num_rx > 2 and fid != cur.frame_id):
@@ -214,7 +265,7 @@ def depacketize(packets: Sequence[np.ndarray], frame_words: int, packet_words: i
                                np.zeros(frame_words, bool))
             seen = set()
             expect_seq = 0
-        payload = pkt[1:]
+        payload = pkt[1:-1]
         if hdr.seq != expect_seq:
             cur.errors.append(f"frame {fid}: packet seq {hdr.seq}, expected {expect_seq}")
         expect_seq = hdr.seq + 1

@@ -5,7 +5,7 @@ the block models: ADC frame in, DMA packets out, identical to the RTL for loss-f
     -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_axis
     -> corner turn (chirp order -> Doppler vectors)                      model.corner_turn
     -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
-    -> packetizer (header word + PACKET_WORDS payload words, TLAST)      model.axis_packetizer
+    -> packetizer (header, PACKET_WORDS payload words, CRC word, TLAST)  model.axis_packetizer
 
 ``output_mode = 1`` (on-chip detection, docs/design.md 3.4, docs/detect.md): the corner turn reads
 (r, t, d) (``read_order = 1``), the Doppler FFT output goes through the detector

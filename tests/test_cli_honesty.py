@@ -84,7 +84,7 @@ def test_capture_replay_receive_with_defaults(tmp_path, faults):
     t.join(timeout=60)
     assert rc["rc"] == 0
     doc = json.loads(out.read_text())
-    assert doc["preset"] == "paper-fpga" and doc["packet_words"] == 4093
+    assert doc["preset"] == "paper-fpga" and doc["packet_words"] == 4092
     assert [f["complete"] for f in doc["frame_info"]] == [True, True]
     assert sum(p["frame"] == 0 for p in doc["points"]) >= 3
 

@@ -84,24 +84,46 @@ def test_reordered_and_duplicated_packets_are_reassembled(fault):
 
 
 def test_conflicting_repeat_is_reported():
-    """Two different packets with the same sequence number: something is wrong."""
+    """Two different packets with the same sequence number, both with a valid CRC:
+    something is wrong."""
+    from model.axis_packetizer import bytes_to_words, seal, words_to_bytes
+
+    frames = cubes(SMALL, 2)
+    pk = stream(SMALL, frames)
+    body = bytes_to_words(pk[4], SMALL.num_rx)[:-1].copy()
+    body[-1, 0] ^= 0x55
+    pk.insert(5, words_to_bytes(seal(body)))
+    out, dec = decode(pk)
+    assert not out[0].complete and any("repeated" in p for p in out[0].problems)
+    assert out[1].complete and dec.stats.crc_errors == 0
+
+
+def test_corrupt_packet_fails_its_crc():
+    """A corrupt packet fails its CRC: counted, never used, its frame damaged with the CRC
+    failure among its problems; a corrupt copy whose intact original also arrived costs
+    nothing (the frame is exactly what was sent)."""
     frames = cubes(SMALL, 2)
     pk = stream(SMALL, frames)
     bad = bytearray(pk[4])
-    bad[-1] ^= 0x55
-    pk.insert(5, bytes(bad))
-    out, _ = decode(pk)
-    assert not out[0].complete and any("repeated" in p for p in out[0].problems)
-    assert out[1].complete
+    bad[-20] ^= 0x55
+    out, dec = decode(pk[:4] + [bytes(bad)] + pk[5:])
+    assert dec.stats.crc_errors == 1 and dec.stats.frames_damaged == 1
+    assert not out[0].complete and out[1].complete
+    assert any("packet 4 failed its CRC" in p for p in out[0].problems)
+    assert any("missing packets [4]" in p for p in out[0].problems)
+    out, dec = decode(pk[:5] + [bytes(bad)] + pk[5:])
+    assert dec.stats.crc_errors == 1 and dec.stats.frames_damaged == 0
+    assert out[0].complete and np.array_equal(out[0].cube, frames[0])
 
 
 def test_truncated_packet():
     frames = cubes(SMALL, 1)
     pk = stream(SMALL, frames)
-    pk[2] = pk[2][:-16 * 3 - 5]  # lose 3 words and a partial one
+    pk[2] = pk[2][:-16 * 3 - 5]  # lose 3 words and a partial one: its CRC fails
     out, dec = decode(pk)
-    assert not out[0].complete
-    assert any("packet 2 has" in p for p in out[0].problems)
+    assert not out[0].complete and dec.stats.crc_errors == 1
+    assert any("packet 2 failed its CRC" in p for p in out[0].problems)
+    assert any("missing packets [2]" in p for p in out[0].problems)
     assert any("truncated" in p for p in dec.stream_problems)
 
 
@@ -240,8 +262,12 @@ def test_capture_round_trip(tmp_path):
     with pytest.raises(ValueError, match="not a DMA capture"):
         read_capture(tmp_path / "bad.dmacap")
     (tmp_path / "old.dmacap").write_bytes(b"RDMAREC1" + bytes(24))
-    with pytest.raises(ValueError, match="old format.*neighbour powers"):
+    with pytest.raises(ValueError, match="version RDMAREC1 .*neighbour powers"):
         read_capture(tmp_path / "old.dmacap")
+    for old in (b"RDMACAP1", b"RDMAREC2"):   # packets without the CRC word
+        (tmp_path / "old.dmacap").write_bytes(old + bytes(24))
+        with pytest.raises(ValueError, match=f"version {old.decode()} .*without the CRC word"):
+            read_capture(tmp_path / "old.dmacap")
 
 
 @pytest.mark.parametrize("preset", ["paper-fpga", "full"])

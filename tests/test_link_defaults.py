@@ -28,7 +28,7 @@ def _cube(cfg, seed=0):
 def test_default_packets_fit_udp_and_geometry_is_learnt(preset):
     cfg = get_preset(preset)
     pw = max_packet_words(cfg.num_rx)
-    assert (pw + 1) * 4 * cfg.num_rx <= UDP_MAX_PAYLOAD < (pw + 2) * 4 * cfg.num_rx
+    assert (pw + 2) * 4 * cfg.num_rx <= UDP_MAX_PAYLOAD < (pw + 3) * 4 * cfg.num_rx
     pk = frame_packets(_cube(cfg), cfg, pw, 7)
     assert max(len(p) for p in pk) <= UDP_MAX_PAYLOAD
     for p in (pk[0], pk[len(pk) // 2], pk[-1]):  # any packet, the last (short) one too
@@ -75,7 +75,7 @@ def test_idle_timeout_starts_after_the_first_datagram():
 def test_nothing_arrives_returns_no_frames_within_the_total_timeout():
     with UdpReceiver() as rx:
         t0 = time.monotonic()
-        frames = rx.receive(StreamDecoder(get_preset("paper-fpga"), 4093),
+        frames = rx.receive(StreamDecoder(get_preset("paper-fpga"), 4092),
                             idle_timeout_s=0.1, total_timeout_s=0.6)
     assert frames == [] and rx.datagrams == 0 and 0.5 < time.monotonic() - t0 < 3.0
 
@@ -99,7 +99,7 @@ def test_ctrl_c_keeps_what_was_received(sigint_raises):
                                 {"total_timeout_s": 0.0}, {"max_frames": 0}])
 def test_receive_bad_arguments(kw):
     with UdpReceiver() as rx, pytest.raises(ValueError):
-        rx.receive(StreamDecoder(get_preset("paper-fpga"), 4093), **kw)
+        rx.receive(StreamDecoder(get_preset("paper-fpga"), 4092), **kw)
 
 
 @pytest.mark.parametrize("port", [-1, 65536, 10**9])

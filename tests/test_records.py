@@ -85,10 +85,12 @@ def test_lost_repeated_reordered_cut_packets():
     assert any("missing packets" in p for p in bad.problems) and bad.trailer is None
     assert bad.usable_records <= len(bad.records)
     assert dec.stats.frames_damaged == 1
-    # a packet cut short and garbage bytes: reported, never raised
+    # a packet cut short (its CRC fails: not used) and garbage bytes: reported, never raised
     decoded, dec = _decode([packets[0][:-5], b"\x00" * 7] + packets[1:])
+    decoded.sort(key=lambda f: f.frame_id)   # a damaged frame closes late
     assert not decoded[0].complete and all(f.complete for f in decoded[1:])
-    assert dec.stream_problems
+    assert dec.stream_problems and dec.stats.crc_errors == 1
+    assert any("packet 0 failed its CRC" in p for p in decoded[0].problems)
     # a raw byte stream with garbage in front resynchronises
     dec = RecordDecoder(DCFG, PW)
     got = dec.push_bytes(b"\x11" * 13 + b"".join(packets)) + dec.finish()

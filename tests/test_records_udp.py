@@ -9,6 +9,7 @@ import threading
 import time
 
 from host.capture import read_capture, write_capture
+from model.axis_packetizer import bytes_to_words, seal, words_to_bytes
 from model.detect_records import TAG_RECORD, frame_words
 from radar.cli import main
 
@@ -64,21 +65,21 @@ def test_record_capture_replay_receive(tmp_path, capsys):
 
 
 def test_receive_drops_records_outside_the_map(tmp_path):
-    """A record whose bins lie outside the map (corrupt words that still carry the record
-    tag: the packets have no checksum) is dropped and named in the frame's problems; the
-    other records still become points (process_records refuses such records: tests in
-    test_records_fast.py)."""
+    """A record whose bins lie outside the map (corrupt at the source: words that still
+    carry the record tag in a packet with a valid CRC) is dropped and named in the frame's
+    problems; the other records still become points (process_records refuses such records:
+    tests in test_records_fast.py)."""
     cap = tmp_path / "r.dmacap"
     assert main(["capture", "--scene", "table1", "--preset", "paper-fpga", "--frames", "1",
                  "--packet-words", "64", "--detect", "fpga", "--out", str(cap)]) == 0
     info, packets = read_capture(cap)
-    packets = [bytearray(p) for p in packets]
-    wb = 4 * info.num_rx                  # the packet header word, then record 0's header
-    first = int.from_bytes(packets[0][wb:wb + 4], "little")
-    assert first >> 24 == TAG_RECORD
-    packets[0][wb:wb + 4] = (first | 0xFFF << 12).to_bytes(4, "little")   # range bin 4095
+    packets = list(packets)
+    body = bytes_to_words(packets[0], info.num_rx)[:-1].copy()   # without its CRC word
+    assert body[1, 0] >> 24 == TAG_RECORD  # the packet header word, then record 0's header
+    body[1, 0] |= 0xFFF << 12                                      # range bin 4095
+    packets[0] = words_to_bytes(seal(body))
     bad = tmp_path / "bad.dmacap"
-    write_capture(bad, info, (bytes(p) for p in packets))
+    write_capture(bad, info, packets)
     rc, out = _round_trip(tmp_path, bad, ["--detect", "fpga"])
     assert rc == 0
     f0 = json.loads(out.read_text())["frame_info"][0]

@@ -14,6 +14,7 @@ import pytest
 from host.capture import CaptureInfo, write_capture
 from host.receiver import CUBE, RECORDS, Receiver
 from host.records import DetectionFrame
+from model.axis_packetizer import seal, words_to_bytes
 from model.config import PRESETS, get_preset
 from model.detect_records import TAG_RECORD, hdr_words
 from model.radar_pipeline import PipelineParams, chain_gain
@@ -149,19 +150,20 @@ def test_wrong_max_detections_is_said(streams):
 
 
 def _corrupt_record_tag(packet: bytes) -> bytes:
-    """The packet with its first record's tag byte destroyed (header word stays valid)."""
-    words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx).copy()
+    """The packet with its first record's tag byte destroyed (header word and CRC valid:
+    corrupt at the source)."""
+    words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx)[:-1].copy()
     assert words[1, 0] >> 24 == TAG_RECORD
     words[1 + hdr_words(CFG.num_rx) + CFG.num_tx, 0] ^= 0x5A000000  # second record's tag
-    return words.tobytes()
+    return words_to_bytes(seal(words))
 
 
 def _record_off_the_map(packet: bytes) -> bytes:
-    """The packet with its first record's range bin set to 4095 (tag and packet intact: the
-    frame decodes as complete, the record lies outside the map)."""
-    words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx).copy()
+    """The packet with its first record's range bin set to 4095 (tag and packet intact, CRC
+    valid: the frame decodes as complete, the record lies outside the map)."""
+    words = np.frombuffer(packet, "<u4").reshape(-1, CFG.num_rx)[:-1].copy()
     words[1, 0] |= 0xFFF << 12
-    return words.tobytes()
+    return words_to_bytes(seal(words))
 
 
 def test_malformed_record_datagrams_are_counted_never_raised(streams):
@@ -176,14 +178,14 @@ def test_malformed_record_datagrams_are_counted_never_raised(streams):
             good[0][0][:-5], bytes(np.random.default_rng(1).integers(0, 256, 4096, np.uint8))]
     for j in junk:
         ingest.push(j)
-    ingest.restart()  # the cut-short packet's frame closes damaged
+    ingest.restart()  # the cut-short packet fails its CRC: malformed, opens no frame
     s = health.snapshot()
-    assert s["malformed"] >= 5 and s["frames_damaged"] == 1, s
+    assert s["malformed"] == len(junk) and s["frames_damaged"] == 0, s
     # a frame whose records are corrupt inside intact packets: damaged, records kept up to it
     corrupt = [_corrupt_record_tag(good[0][0])] + good[0][1:]
     _push(ingest, [corrupt])
     s = health.snapshot()
-    assert s["frames_damaged"] == 2, s
+    assert s["frames_damaged"] == 1, s
     assert any("bad record tag" in p for p in s["problems"]), s["problems"]
     _push(ingest, good)
     s = health.snapshot()

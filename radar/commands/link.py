@@ -76,7 +76,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise CliError(f"--packet-words: {exc}") from None
     if pw > fit:
-        raise CliError(f"--packet-words: {pw} words + header = {(pw + 1) * 4 * cfg.num_rx} "
+        raise CliError(f"--packet-words: {pw} words + header + CRC = {(pw + 2) * 4 * cfg.num_rx} "
                        f"bytes per packet does not fit a UDP datagram (at most {fit} for "
                        f"{cfg.num_rx} lanes), so radar replay could not send it")
     packets: list[bytes] = []
@@ -266,7 +266,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     c = add_command(
         sub, "capture", "write the DMA packets of simulated frames to a capture file", """
         Simulate frames, run them through the bit-accurate model of the FPGA chain and write its
-        DMA packets (header word + payload, exactly as the packetizer sends them) to a .dmacap
+        DMA packets (header, payload, CRC word, exactly as the packetizer sends them) to a .dmacap
         file for `radar replay`.""")
     c.add_argument("--scene", required=True, help="scene JSON file or built-in name")
     c.add_argument("--out", required=True, help="output .dmacap file")
@@ -274,8 +274,8 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help=f"frames, 1..{MAX_CAPTURE_FRAMES} (default 3)")
     c.add_argument("--packet-words", type=int, default=None,
                    help="payload words per packet, PACKET_WORDS (default: the most that fit "
-                        "one UDP datagram of 65507 bytes with the header word: 1022 for the "
-                        "16 lanes of full, 4093 for the 4 of paper-fpga)")
+                        "one UDP datagram of 65507 bytes with the header and CRC words: 1021 for "
+                        "the 16 lanes of full, 4092 for the 4 of paper-fpga)")
     c.add_argument("--preset", choices=presets, default=None, help="override the preset")
     c.add_argument("--detect", choices=("host", "fpga"), default="host",
                    help="host: capture the radar cube stream (default); fpga: the on-chip "

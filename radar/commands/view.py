@@ -7,7 +7,7 @@ capture or a scene.
     ... [--host 127.0.0.1] [--port 8050] [--gnn] [--foxglove [PORT]]
 
 The stream is the radar cube or, with on-chip detection (``OUTPUT_MODE = 1``), the
-detector's records: a capture says which in its header (``RDMAREC2``), a UDP stream is
+detector's records: a capture says which in its header (``RDMAREC3``), a UDP stream is
 recognised by its frame length (records need the sender's ``--max-detections``), a scene
 sends records with ``--detect fpga`` (bit-accurate model of the chain).
 
@@ -95,7 +95,7 @@ def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
     info = capture_info(path)
     kind = RECORDS if info.records else CUBE
     if args.detect == "host" and kind == RECORDS:
-        raise CliError(f"--detect host: {path} is a detection-record capture (RDMAREC2, "
+        raise CliError(f"--detect host: {path} is a detection-record capture (RDMAREC3, "
                        f"MAX_DETECTIONS {info.max_detections}); leave --detect out")
     if args.detect == "fpga" and kind == CUBE:
         raise CliError(f"--detect fpga: {path} is a radar-cube capture, not records")

@@ -50,6 +50,7 @@ class LinkHealth:
     datagrams: int = 0
     bytes: int = 0
     malformed: int = 0
+    """Datagrams that are no DMA packet or fail their CRC."""
     late_packets: int = 0
     packets_lost: int = 0
     frames_complete: int = 0
@@ -91,7 +92,8 @@ class LinkHealth:
         decoders retired by a restart) and its newest problem messages."""
         with self.lock:
             b = self._base
-            self.malformed = b.garbage_packets + stats.garbage_packets
+            self.malformed = (b.garbage_packets + stats.garbage_packets + b.crc_errors
+                              + stats.crc_errors)
             self.late_packets = b.late_packets + stats.late_packets
             self.hw_overflow |= stats.hw_overflow_seen
             self.hw_framing |= stats.hw_framing_seen
@@ -102,6 +104,7 @@ class LinkHealth:
         """A decoder is replaced (sender restarted): keep its counters."""
         with self.lock:
             self._base.garbage_packets += stats.garbage_packets
+            self._base.crc_errors += stats.crc_errors
             self._base.late_packets += stats.late_packets
             self.stream_restarts += 1
 

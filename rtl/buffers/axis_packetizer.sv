@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // DMA packetizer: a ring of packet banks (double buffer by default) that decouples the
-// Doppler FFT from a stalling DMA sink, cuts each frame into TLAST-closed packets and
-// prepends a header word to each packet.
+// Doppler FFT from a stalling DMA sink, cuts each frame into TLAST-closed packets, prepends
+// a header word to each packet and appends a CRC word (CRC-32 of header and payload).
 //
-// Packet and header format: docs/buffers.md and model/packetizer.py (the host shares it).
+// Packet and header format: docs/buffers.md and model/axis_packetizer.py (the host shares
+// it); the CRC: model/packet_crc.py, which generates packet_crc32.sv.
 // Frame boundaries come from counting FRAME_WORDS input words after reset; s_axis_tlast is
 // only checked (every TLAST_PERIOD words) and a mismatch raises the framing error flag.
 // Store and forward: a packet is sent only once it is complete in its bank, so its header
@@ -23,7 +24,8 @@ module axis_packetizer #(
   // buffer; more banks absorb longer DMA stalls and short frame-final packets when the
   // input cannot be stalled.
   parameter int NUM_BANKS = 2,
-  // 1: one header word before every packet's payload; 0: payload only.
+  // 1: one header word before every packet's payload and one CRC word after it (lane 0 =
+  //    CRC-32 of the header and payload wire bytes, other lanes 0); 0: payload only.
   parameter bit HEADER = 1'b1,
   // 1: s_axis_tready deasserts while the bank to write is full (no loss; a stalled DMA
   //    then stalls the pipeline back to the ADC ping-pong, which flags the loss there);
@@ -44,7 +46,8 @@ module axis_packetizer #(
   // 1 on words of a frame damaged upstream (zero-filled chirps): sets DAMAGED in the
   // header of every packet holding such a word (tie to 0 when unused)
   input  wire logic [0:0]               s_axis_tuser,
-  // DMA stream: [header] payload, TLAST on the last word of every packet
+  // DMA stream: [header payload CRC] or payload only (HEADER=0), TLAST on the last word of
+  // every packet
   output logic      [NUM_RX*32-1:0]     m_axis_tdata,
   output logic                          m_axis_tvalid,
   input  wire logic                     m_axis_tready,
@@ -160,19 +163,26 @@ module axis_packetizer #(
   assign ram_wr_addr = {wr_bank_q, wr_cnt_q[POS_W-1:0]};
 
   // ---------------------------------------------------------------------------------------
-  // Output side: header (if any) then the payload of bank rd_bank_q
+  // Output side: header (if any), the payload of bank rd_bank_q, then (with the header) the
+  // CRC word. The bank is released after its last payload read; the CRC word is issued the
+  // next clock from crc_q, which by the time it enters the FIFO has taken in every word of
+  // the packet (a word enters the FIFO the clock after its issue).
   logic [BANK_W-1:0] rd_bank_q;
   logic [POS_W-1:0] rd_idx_q;
   logic             hdr_sent_q;
-  logic             can_issue, issue, issue_hdr, issue_data, rd_last;
-  logic             p_hdr_q, p_last_q;   // sideband of the read issued last clock
-  logic [WORD_W-1:0] hdr_word, p_hdr_word_q;
+  logic             crc_due_q;           // payload issued, the CRC word comes next
+  logic             can_issue, issue, issue_hdr, issue_data, issue_crc, rd_last;
+  logic             p_hdr_q, p_data_q, p_crc_q, p_last_q;  // sideband of last clock's issue
+  logic [WORD_W-1:0] hdr_word, p_hdr_word_q, push_word;
+  logic [31:0]      crc_q, crc_next;     // CRC-32 state (not inverted) of the packet so far
+  logic [31:0]      crc_sent;            // the CRC word's lane 0: the final state inverted
   desc_t            rd_desc;
 
   assign rd_desc    = desc_q[rd_bank_q];
-  assign issue      = full_q[rd_bank_q] && can_issue;
-  assign issue_hdr  = issue && HEADER && !hdr_sent_q;
-  assign issue_data = issue && !issue_hdr;
+  assign issue      = (full_q[rd_bank_q] || crc_due_q) && can_issue;
+  assign issue_crc  = issue && crc_due_q;
+  assign issue_hdr  = issue && !crc_due_q && HEADER && !hdr_sent_q;
+  assign issue_data = issue && !crc_due_q && !issue_hdr;
   assign rd_last    = (LEN_W'(rd_idx_q) == rd_desc.len - 1'b1);
   assign ram_rd_en   = issue_data;
   assign ram_rd_addr = {rd_bank_q, rd_idx_q};
@@ -195,6 +205,15 @@ module axis_packetizer #(
   end
   assign hdr_word = hdr_full[WORD_W-1:0];
 
+  // CRC-32 at line rate: one word per clock, the header word starting from all ones
+  assign push_word = p_hdr_q ? p_hdr_word_q : ram_rd_data;
+  assign crc_sent  = ~crc_q;
+  packet_crc32 #(.LANES(NUM_RX)) u_crc (
+    .crc_in  (p_hdr_q ? 32'hFFFF_FFFF : crc_q),
+    .data    (push_word),
+    .crc_out (crc_next)
+  );
+
   logic [WORD_W:0] fifo_tdata;
 
   buf_out_fifo #(.WIDTH(WORD_W + 1), .DEPTH(4)) u_out (
@@ -202,7 +221,7 @@ module axis_packetizer #(
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (issue),
-    .in_data       ({p_last_q, p_hdr_q ? p_hdr_word_q : ram_rd_data}),
+    .in_data       ({p_last_q, p_crc_q ? WORD_W'(crc_sent) : push_word}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
@@ -228,8 +247,11 @@ module axis_packetizer #(
   // Registers
   always_ff @(posedge clk) begin
     p_hdr_q      <= issue_hdr;
-    p_last_q     <= issue_data && rd_last;
+    p_data_q     <= issue_data;
+    p_crc_q      <= issue_crc;
+    p_last_q     <= HEADER ? issue_crc : (issue_data && rd_last);
     p_hdr_word_q <= hdr_word;
+    if (p_hdr_q || p_data_q) crc_q <= crc_next;
     if (beat && pkt_end && cnt_next != '0) desc_q[wr_bank_q] <= new_desc;
   end
 
@@ -253,6 +275,7 @@ module axis_packetizer #(
       rd_bank_q     <= '0;
       rd_idx_q      <= '0;
       hdr_sent_q    <= 1'b0;
+      crc_due_q     <= 1'b0;
     end else begin
       // input side
       if (beat) begin
@@ -288,10 +311,12 @@ module axis_packetizer #(
       end
       // output side (never clears the bank the input side sets: that one is not full)
       if (issue_hdr) hdr_sent_q <= 1'b1;
+      if (issue_crc) crc_due_q <= 1'b0;
       if (issue_data) begin
         if (rd_last) begin
           rd_idx_q          <= '0;
           hdr_sent_q        <= 1'b0;
+          crc_due_q         <= HEADER;
           full_q[rd_bank_q] <= 1'b0;
           rd_bank_q         <= rd_bank_q + 1'b1;
           packet_cnt_q      <= packet_cnt_q + 1'b1;
@@ -316,8 +341,8 @@ module axis_packetizer #(
   // sequence number < NPKT, LAST exactly on the frame's last packet, and (no drops) the
   // planned length; consecutive full banks hold consecutive sequence numbers; a bank under
   // input is never read; sticky flags. bmc adds the output framing: each packet is
-  // HEADER + its planned length words closed by TLAST, its header carries MAGIC and the
-  // expected sequence number.
+  // HEADER + its planned length + HEADER (the CRC word) words closed by TLAST, its header
+  // carries MAGIC and the expected sequence number.
   logic                  f_past = 1'b0;
   logic [SEQ_W-1:0]      f_out_seq = '0;
   logic [LEN_W:0]        f_out_pos = '0;
@@ -354,6 +379,7 @@ module axis_packetizer #(
       assert ((BANK_W+1)'(BANK_W'(wr_bank_q - rd_bank_q)) == f_nfull ||
               (wr_bank_q == rd_bank_q && f_nfull == (BANK_W+1)'(NUM_BANKS)));
       if (!full_q[rd_bank_q]) assert (rd_idx_q == '0 && !hdr_sent_q);
+      if (crc_due_q) assert (HEADER && rd_idx_q == '0 && !hdr_sent_q);
       for (int i = 0; i < NUM_BANKS; i++) begin
         f_b  = rd_bank_q + BANK_W'(i);
         f_nb = f_b + 1'b1;
@@ -383,7 +409,7 @@ module axis_packetizer #(
           assert (!m_axis_tlast);
         end
         if (INPUT_BACKPRESSURE)
-          assert (m_axis_tlast == (f_out_pos == (LEN_W+1)'(HEADER) - 1'b1 +
+          assert (m_axis_tlast == (f_out_pos == (LEN_W+1)'(2 * HEADER) - 1'b1 +
                    ((f_out_seq == SEQ_W'(NPKT - 1)) ? (LEN_W+1)'(LAST_LEN) :
                                                        (LEN_W+1)'(PACKET_WORDS))));
       end

@@ -52,7 +52,19 @@ class TB(AxisTB):
             out.extend(pk.packetize(f, self.packet_words, first_id + k, self.header, **flags))
         return out
 
+    def check_crc(self, got: list[np.ndarray]) -> None:
+        """Every packet's CRC word (RTL) is the model's CRC of the header and payload the RTL
+        sent (``model.packet_crc``), lanes 1.. zero."""
+        if not self.header:
+            return
+        for i, g in enumerate(got):
+            want = pk.crc_word(g[:-1])
+            assert np.array_equal(g[-1], want), (
+                f"packet {i}: CRC word {[hex(v) for v in g[-1]]}, model {hex(int(want[0]))}")
+
     def compare(self, got: list[np.ndarray], exp: list[np.ndarray]) -> None:
+        """Packets bit-exact against the model's (header, payload and CRC word)."""
+        self.check_crc(got)
         assert len(got) == len(exp), f"{len(got)} packets, expected {len(exp)}"
         for i, (g, e) in enumerate(zip(got, exp, strict=True)):
             if not np.array_equal(g, e):
@@ -70,11 +82,11 @@ async def test_throughput(dut):
     await tb.reset()
     nfr = 2 if tb.frame_words > 4096 else 3
     frames = [tb.random_frame() for _ in range(nfr)]
-    # Headers cost one output clock per packet; without input backpressure the producer must
-    # leave that one idle clock per packet, which is exactly the header's share.
+    # The header and CRC words cost two output clocks per packet; without input backpressure
+    # the producer must leave two idle clocks per packet, exactly their share.
     if tb.header and not tb.backpressure:
         p = tb.packet_words
-        tb.set_idle_generator(itertools.cycle([False] * p + [True]))
+        tb.set_idle_generator(itertools.cycle([False] * p + [True, True]))
     else:
         tb.set_idle_generator(no_pause())
     tb.set_backpressure_generator(no_pause())
@@ -136,6 +148,7 @@ async def test_overflow(dut):
     for f in frames:
         await tb.send_frame(f)
     got = await tb.drain()
+    tb.check_crc(got)   # DROP packets too: CRC over their short payload
     st = tb.status()
     exp = {(k, s): p for k in range(nfr)
            for s, p in enumerate(pk.packetize(frames[k], tb.packet_words, k, True))}
@@ -147,14 +160,14 @@ async def test_overflow(dut):
         prev = key
         seen.add(key)
         e = exp[key]
-        nominal = len(e) - 1
+        nominal = len(e) - 2   # header and CRC word
         assert h.last == (h.seq == tb.n_packets - 1)
         assert h.overflow >= ovf_seen, "sticky overflow flag cleared"
         ovf_seen = h.overflow
         if h.drop:
             assert h.overflow
-            payload = [tuple(w) for w in pkt[1:]]
-            ref = [tuple(w) for w in e[1:]]
+            payload = [tuple(w) for w in pkt[1:-1]]
+            ref = [tuple(w) for w in e[1:-1]]
             it = iter(ref)
             assert all(w in it for w in payload), "payload of a DROP packet is not a subsequence"
             dropped = nominal - len(payload)
@@ -163,12 +176,12 @@ async def test_overflow(dut):
                 assert h.dropped == dropped and h.length == len(payload)
             lost += dropped
         else:
-            assert np.array_equal(pkt[1:], e[1:]), f"intact packet {key} differs"
+            assert np.array_equal(pkt[1:-1], e[1:-1]), f"intact packet {key} differs"
             if h.length is not None:
                 assert h.length == nominal and h.dropped == 0
     for key, e in exp.items():
         if key not in seen:
-            lost += len(e) - 1
+            lost += len(e) - 2
     tb.log.info("overflow: %d packets received of %d, %d words dropped (drop_count %d)",
                 len(got), len(exp), lost, st["drop_count"])
     assert st["drop_count"] == lost and lost > 0, (lost, st)
@@ -200,8 +213,9 @@ async def test_framing_error(dut):
     got = await tb.drain()
     st = tb.status()
     assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
+    tb.check_crc(got)
     hdrs = [pk.parse_header(p[0]) for p in got]
-    payload = np.vstack([p[1:] for p in got])
+    payload = np.vstack([p[1:-1] for p in got])
     assert np.array_equal(payload, np.vstack(frames)), "payload must continue by word count"
     assert not any(h.framing for h in hdrs[:tb.n_packets])
     assert hdrs[-1].framing and hdrs[-1].frame_id == 1
@@ -228,8 +242,9 @@ async def test_framing_error_on_packet_closing_word(dut):
     got = await tb.drain()
     st = tb.status()
     assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
+    tb.check_crc(got)
     hdrs = [pk.parse_header(p[0]) for p in got]
-    assert np.array_equal(np.vstack([p[1:] for p in got]), frame)
+    assert np.array_equal(np.vstack([p[1:-1] for p in got]), frame)
     assert all(h.framing for h in hdrs), [h.framing for h in hdrs]
 
 

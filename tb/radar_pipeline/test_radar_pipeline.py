@@ -312,8 +312,9 @@ async def fft_overflow_and_framing_counters(dut) -> None:
 @cocotb.test()
 async def throughput_latency(dut) -> None:
     """ADC at one sample per clock with no gaps, DMA always ready: the steady-state frame
-    period is the frame's DMA words (payload + one header per packet), i.e. the chain moves
-    one sample per clock per lane; measures latency and simulation speed (RP_BENCH_JSON)."""
+    period is the frame's DMA words (payload + a header and a CRC word per packet), i.e. the
+    chain moves one sample per clock per lane; measures latency and simulation speed
+    (RP_BENCH_JSON)."""
     import time
 
     tb = PipelineTB(dut)
@@ -349,7 +350,7 @@ async def throughput_latency(dut) -> None:
     await RisingEdge(d.clk)
     assert_packets_equal(got, dma_packets(frames, cfg, chain), f"{name} full rate")
     period = marks["out_last"][2] - marks["out_last"][1]
-    dma_words = chain.frame_words(cfg) + (tb.packets_per_frame if chain.header else 0)
+    dma_words = chain.frame_words(cfg) + (2 * tb.packets_per_frame if chain.header else 0)
     latency = [o - i for i, o in zip(marks["in_last"], marks["out_last"], strict=True)]
     assert period <= dma_words + 8, (period, dma_words)
     result = {"name": name, "frame_samples": frame_samples, "dma_words": dma_words,
