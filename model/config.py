@@ -150,7 +150,7 @@ class RadarConfig:
     """ADC kind: ``complex`` (I/Q) or ``real``."""
     tx_positions: tuple[tuple[float, float], ...] | None = None
     """(horizontal, vertical) phase centre of each TX in half-wavelengths at fc_hz
-    (None: TX k at (k * num_rx, 0), the contiguous virtual ULA of DESIGN section 2)."""
+    (None: TX k at (k * num_rx, 0), the contiguous virtual ULA of docs/design.md section 2)."""
     rx_positions: tuple[tuple[float, float], ...] | None = None
     """(horizontal, vertical) position of each RX in half-wavelengths (None: RX r at (r, 0))."""
     frame_period_s: float | None = None
