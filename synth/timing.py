@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
-from synth.jobs import ROOT, Job, files_for, job_sets, rtl_files
+from synth.jobs import ROOT, Job, files_for, job_sets, rtl_files, select
 from synth.timing_report import Row, job_row, write_report
 from synth.timing_run import DEVICE, Settings, run_job
 
@@ -59,8 +59,7 @@ def main(argv: list[str] | None = None) -> int:
 
     jobs = sets[args.set]
     if args.only:
-        keys = [k for k in args.only.split(",") if k]
-        jobs = [j for j in jobs if any(k in j.name for k in keys)]
+        jobs = select(jobs, args.only)
         if not jobs:
             print(f"timing: --only {args.only} matches no job of set {args.set}",
                   file=sys.stderr)

