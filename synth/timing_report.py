@@ -19,9 +19,9 @@ _XCARRY = {"CARRY4", "CARRY8"}
 @dataclass
 class Row:
     """One job's line of the table. ``lut4`` counts nextpnr's TRELLIS_COMB cells (a LUT4 each;
-    a CCU2C carry takes two, a distributed-RAM slice's LUTs count too), ``levels`` the logic
-    cells with a delay on the ECP5 critical path (LUT4, carry, PFUMX/L6MUX; not the
-    0 ns hop into a distributed-RAM write port), ``xlut``/``xcarry`` the
+    a CCU2C carry takes two, a distributed-RAM slice's LUTs count too), ``levels`` the LUT4
+    and PFUMX/L6MUX cells with a delay on the ECP5 critical path (not the 0 ns hop into a
+    distributed-RAM write port), ``carry`` the CCU2C carry cells on it, ``xlut``/``xcarry`` the
     LUT6 (+ MUXF) levels and carry cells of the longest xcup register-to-register path."""
 
     name: str
@@ -34,6 +34,7 @@ class Row:
     start: str = ""
     end: str = ""
     levels: int = 0
+    carry: int = 0
     xlut: int | None = None
     xcarry: int | None = None
     xstart: str = ""
@@ -52,20 +53,23 @@ def short_cell(name: str) -> str:
 
 
 def parse_nextpnr(report: dict) -> dict:
-    """Resources, Fmax of ``clk`` (MHz) and the critical path (start and end cell, logic
-    cells on it) of a nextpnr ``--report`` JSON."""
+    """Resources, Fmax of ``clk`` (MHz) and the critical path (start and end cell, LUT levels
+    and carry cells on it) of a nextpnr ``--report`` JSON."""
     used = {k: v["used"] for k, v in report["utilization"].items()}
     fmax = report.get("fmax", {})
     clk = fmax.get("clk") or next(iter(fmax.values()), {"achieved": 0.0})
     out = {"lut4": used.get("TRELLIS_COMB", 0), "ff": used.get("TRELLIS_FF", 0),
            "ebr": used.get("DP16KD", 0), "mult18": used.get("MULT18X18D", 0),
-           "fmax_mhz": float(clk["achieved"]), "start": "", "end": "", "levels": 0}
+           "fmax_mhz": float(clk["achieved"]), "start": "", "end": "", "levels": 0,
+           "carry": 0}
     paths = [p for p in report.get("critical_paths", []) if p.get("path")]
     if paths:
         path = paths[0]["path"]
         out["start"] = short_cell(path[0]["from"]["cell"])
         out["end"] = short_cell(path[-1]["to"]["cell"])
-        out["levels"] = sum(1 for s in path if s["type"] == "logic" and s["delay"] > 0)
+        logic = [s["to"]["cell"] for s in path if s["type"] == "logic" and s["delay"] > 0]
+        out["levels"] = sum(1 for c in logic if "$CCU2_COMB" not in c)
+        out["carry"] = len({c.split("$")[0] for c in logic if "$CCU2_COMB" in c})
     return out
 
 
@@ -161,8 +165,8 @@ def markdown(rows: list[Row], freq_mhz: float, header: str) -> str:
     """The ``make timing`` table: one line per job, failed jobs with their error."""
     lines = [header, "",
              "| job | parameters | LUT4 | FF | EBR | MULT18 | ECP5 Fmax MHz | "
-             f">= {freq_mhz:g} | critical path (start -> end) | levels | xcup LUT6 levels "
-             "(+carry) | xcup path | s |",
+             f">= {freq_mhz:g} | critical path (start -> end) | LUT4 levels (+carry) | "
+             "xcup LUT6 levels (+carry) | xcup path | s |",
              "|---|---|---:|---:|---:|---:|---:|---|---|---:|---:|---|---:|"]
     for r in rows:
         if r.error:
@@ -171,10 +175,12 @@ def markdown(rows: list[Row], freq_mhz: float, header: str) -> str:
             continue
         ok = "yes" if r.fmax_mhz >= freq_mhz else "**no**"
         x = "" if r.xlut is None else f"{r.xlut} (+{r.xcarry})"
+        xp = "" if r.xlut is None else f"`{r.xstart}` -> `{r.xend}`"
         lines.append(
             f"| {r.name} | {r.label} | {r.lut4} | {r.ff} | {r.ebr} | {r.mult18} | "
-            f"{r.fmax_mhz:.1f} | {ok} | `{r.start}` -> `{r.end}` | {r.levels} | {x} | "
-            f"`{r.xstart}` -> `{r.xend}` | {r.seconds:.0f} |")
+            f"{r.fmax_mhz:.1f} | {ok} | `{r.start}` -> `{r.end}` | {r.levels} (+{r.carry}) | "
+            f"{x} | "
+            f"{xp} | {r.seconds:.0f} |")
     return "\n".join(lines) + "\n"
 
 

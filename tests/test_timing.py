@@ -68,7 +68,7 @@ def test_parse_nextpnr_report() -> None:
     r = parse_nextpnr(report)
     assert (r["lut4"], r["ff"], r["ebr"], r["mult18"]) == (10, 7, 1, 2)
     assert r["fmax_mhz"] == pytest.approx(123.4)
-    assert (r["start"], r["end"], r["levels"]) == ("u_bf.sum_q", "y_q", 2)
+    assert (r["start"], r["end"], r["levels"], r["carry"]) == ("u_bf.sum_q", "y_q", 2, 0)
     assert short_cell("dut.a.b_CCU2C_S0") == "a.b"
     assert short_cell("dut.u_out.mem_q.0.31$RAMW_SLICE") == "u_out.mem_q.0.31"
 
@@ -122,7 +122,8 @@ def test_ci_job_through_the_whole_flow(tmp_path: Path) -> None:
         float(cols[6])
     assert 5 < lut4 < 500 and 10 < ff < 500 and ebr == 0 and mult == 0
     assert fmax > 100.0 and cols[7] == "yes"
-    assert re.fullmatch(r"`\S+` -> `\S+`", cols[8]) and int(cols[9]) >= 1
+    assert re.fullmatch(r"`\S+` -> `\S+`", cols[8])
+    assert re.fullmatch(r"\d+ \(\+\d+\)", cols[9]) and int(cols[9].split()[0]) >= 1
     assert re.fullmatch(r"\d+ \(\+\d+\)", cols[10]) and int(cols[10].split()[0]) >= 1
     job = tmp_path / "jobs" / "ci__mark_fifo"
     assert (job / "report.json").exists() and (job / "pnr.log").exists()
