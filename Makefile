@@ -31,6 +31,7 @@ help:
 	@echo "make test-detect-long  detector blocks and the mode-1 top at every parameter set"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
+	@echo "make timing          ECP5-85 place and route + xcup LUT depth per block -> $(OUT)/timing/"
 	@echo "make gnn-dataset     synthetic labelled dataset (700/500/200 frames, ~25 min)"
 	@echo "make gnn-train       train the GNN on it (~7 min on 2 cores)"
 	@echo "make gnn-eval        GNN vs DBSCAN baseline on the 200 test frames -> out/gnn_eval.json"

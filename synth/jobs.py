@@ -154,6 +154,13 @@ def job_sets() -> dict[str, list[Job]]:
             "all": paper + full}
 
 
+def select(jobs: list[Job], only: str) -> list[Job]:
+    """The jobs whose name contains one of the comma-separated substrings ``only`` (all of
+    them when ``only`` is empty)."""
+    keys = [k for k in only.split(",") if k]
+    return [j for j in jobs if not keys or any(k in j.name for k in keys)]
+
+
 def rtl_files(rtl: Path = RTL) -> list[Path]:
     """The plain file list every tool reads: every ``rtl/**/*.sv``, packages (``*_pkg.sv``)
     first, each group sorted by path. Absolute paths, so any working directory works."""

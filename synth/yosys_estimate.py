@@ -26,7 +26,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from synth.jobs import ROOT, files_for, job_sets, rtl_files
+from synth.jobs import ROOT, files_for, job_sets, rtl_files, select
 from synth.yosys_report import Result, merge_reports, result_line, write_report
 from synth.yosys_run import run_job, yosys_command, yosys_version
 
@@ -63,8 +63,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     jobs = sets[args.set]
     if args.only:
-        keys = [k for k in args.only.split(",") if k]
-        jobs = [j for j in jobs if any(k in j.name for k in keys)]
+        jobs = select(jobs, args.only)
         if not jobs:
             print(f"synth-estimate: --only {args.only} matches no job of set {args.set}",
                   file=sys.stderr)
