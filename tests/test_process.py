@@ -52,7 +52,8 @@ def test_real_capture_to_json(tmp_path, capsys):
     assert code == 0 and "1 frame(s)" in capsys.readouterr().out
     cfg = OPENRADAR.config
     assert doc["preset"] == cfg.name and doc["frames"] == 1 and doc["backend"] == "float"
-    assert doc["frame_info"] == [{"frame": 0, "points": len(doc["points"])}]
+    assert doc["frame_info"] == [{"frame": 0, "points": len(doc["points"]), "clipped": 0,
+                                  "damaged": False}]
     # no --max-speed: the profile's unambiguous speed, so no point of a 6 m radar is ambiguous
     assert doc["max_speed_mps"] == pytest.approx(cfg.max_velocity_mps)
     assert len(doc["points"]) > 10 and not any(p["ambiguous"] for p in doc["points"])
@@ -196,7 +197,7 @@ def test_real_frame_with_and_without_remove_static(tmp_path):
     code, clean = process(tmp_path, "--remove-static")
     assert code == 0 and clean["remove_static"] is True
     pts = clean["points"]
-    assert clean["frame_info"] == [{"frame": 0, "points": len(pts)}]
+    assert clean["frame_info"] == [{"frame": 0, "points": len(pts), "clipped": 0, "damaged": False}]
     assert 10 <= len(pts) < len(plain["points"]) / 2
     assert not any(p["doppler_bin"] == 0 or p["ambiguous"] for p in pts)
     assert min(p["range_m"] for p in pts) > 2.5                  # no leakage, no clutter
@@ -204,3 +205,40 @@ def test_real_frame_with_and_without_remove_static(tmp_path):
     assert ((rng > 2.85) & (rng < 3.05)).sum() >= 4 and ((rng > 3.4) & (rng < 3.6)).sum() >= 3
     best = max(pts, key=lambda p: p["snr_db"])
     assert abs(best["range_m"] - 2.93) < 0.03 and 0.5 < best["radial_velocity_mps"] < 0.7
+
+
+def test_process_records_mcap_and_flags_clipped_frames(tmp_path):
+    """--mcap records the frames as ROS 2 messages (read back: one cloud per frame); a frame
+    whose ADC values reach full scale is flagged clipped, its points too."""
+    from host.ros.summary import summarize
+    frame = open_capture(BIN_FILE, OPENRADAR).frame(0)
+    loud = frame.copy()
+    loud[0, 0, :4] = 32767 + 0j
+    path = tmp_path / "frames.npy"
+    write_npy(path, iter([frame, loud]), 2, OPENRADAR.config)
+    rec = tmp_path / "run.mcap"
+    code, doc = process(tmp_path, "--mcap", str(rec), capture=str(path))
+    assert code == 0
+    assert [f["clipped"] for f in doc["frame_info"]] == [0, 4]
+    assert all(p.get("clipped", False) == (p["frame"] == 1) for p in doc["points"])
+    assert any(p["frame"] == 1 for p in doc["points"])
+    info = summarize(rec)
+    assert info.frames == 2
+
+
+def test_process_ctrl_c_keeps_the_frames_processed(tmp_path, monkeypatch, capsys):
+    import radar.commands.process as process_cmd
+    real = process_cmd.frame_cloud
+    calls = []
+
+    def stop_third(*a, **k):  # noqa: ANN002, ANN003, ANN202 - as radar.frame_cloud
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(process_cmd, "frame_cloud", stop_third)
+    code, doc = process(tmp_path, capture=str(real_frames(tmp_path, 5)))
+    assert code == 130
+    assert "interrupted: wrote the 2 of 5 frame(s) processed" in capsys.readouterr().err
+    assert doc["interrupted"] is True and doc["frames"] == 2 and doc["frames_requested"] == 5

@@ -13,12 +13,14 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from host.adc_capture import open_capture
 from host.params import default_max_speed_mps
 from host.pointcloud import PointCloud
+from host.ros.messages import FrameStatus
 from model.profile import Profile, load_profile
 from model.reference import radar_cube
 from radar.common import (
@@ -27,11 +29,13 @@ from radar.common import (
     add_detection_options,
     detection_params,
     out_file,
+    out_folder,
     progress,
     warn,
 )
 from radar.figures import process_plots
 from radar.frame_cloud import frame_cloud
+from radar.recording import add_mcap_options, close_recording, open_recording
 
 BACKENDS = ("float",)
 """Frame sources ``radar process`` runs: the float reference only (the bit-accurate model
@@ -67,10 +71,20 @@ def profile_of(spec: str) -> Profile:
     return profile
 
 
+def clipped_samples(frame: np.ndarray, full_scale: int) -> int:
+    """ADC values (I and Q counted apart) of a frame, complex or real integer codes, at or
+    beyond full scale (+full_scale or -full_scale - 1): clipped, so the echo's harmonics
+    can be false points."""
+    lim = full_scale
+    if np.iscomplexobj(frame):
+        return int(np.count_nonzero(np.abs(frame.real) >= lim) +
+                   np.count_nonzero(np.abs(frame.imag) >= lim))
+    return int(np.count_nonzero(np.abs(frame) >= lim))
+
+
 def cmd_process(args: argparse.Namespace) -> int:
     out = out_file(args.json, ".json", "--json")
-    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
-        raise CliError(f"--plots: {args.plots} is a file, not a folder")
+    plots = out_folder(args.plots, "--plots") if args.plots else None
     if args.backend not in BACKENDS:
         raise CliError(f"--backend {args.backend}: radar process runs only "
                        f"{', '.join(BACKENDS)} for now")
@@ -87,26 +101,65 @@ def cmd_process(args: argparse.Namespace) -> int:
         warn([capture.report()], "process")
     frames = frame_range(args.frames, capture.n_frames)
     t0 = time.perf_counter()
-    clouds, per_frame = [], []
+    clouds, per_frame, clipped = [], [], []
     cube = None
-    for k in progress(frames, "frames"):
-        cube = radar_cube(capture.frame(k), cfg, params.range_window, params.doppler_window,
-                          remove_static_clutter=args.remove_static)
-        fc = frame_cloud(cube, cfg, params, k, "process")
-        clouds.append(fc.cloud)
-        per_frame.append({"frame": k, "points": len(fc.cloud)})
+    rec = open_recording(args, cfg.frame_time_s)
+    stopped: str | None = None      # why the run ended early: what was done is written
+    try:
+        for k in progress(frames, "frames"):
+            t_start = time.perf_counter()
+            adc = capture.frame(k)
+            n_clip = clipped_samples(adc, cfg.adc_full_scale)
+            cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
+                              remove_static_clutter=args.remove_static)
+            fc = frame_cloud(cube, cfg, params, k, "process")
+            clouds.append(fc.cloud)
+            per_frame.append({"frame": k, "points": len(fc.cloud), "clipped": n_clip,
+                              "damaged": False})
+            if n_clip:
+                clipped.append(k)
+            if fc.problems:
+                per_frame[-1]["problems"] = fc.problems
+            if rec is not None:
+                rec.write_frame(fc.cloud, FrameStatus(
+                    k, len(fc.cloud), processing_time_s=time.perf_counter() - t_start,
+                    problems=fc.problems))
+    except KeyboardInterrupt:
+        stopped = "interrupted"
+    except ValueError as exc:
+        stopped = str(exc)
+    finally:
+        close_recording(rec)
+    if stopped and not per_frame:
+        if stopped == "interrupted":
+            raise KeyboardInterrupt
+        raise CliError(stopped)
+    if clipped:
+        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
+              f"harmonics of the clipped echo can appear as false points (flagged "
+              f"\"clipped\" in the JSON)"], "process")
+    done = len(per_frame)
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, len(frames))
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
                 "max_speed_mps": params.max_speed_mps,
                 "min_detection_range_m": cfg.min_detection_range_m,
                 "frame_info": per_frame})
+    if stopped:
+        doc.update({"interrupted": stopped == "interrupted", "error": stopped,
+                    "frames_requested": len(frames)})
     out.write_text(json.dumps(doc, indent=1))
-    print(f"{len(cloud)} points in {len(frames)} frame(s) of {args.capture} "
+    print(f"{len(cloud)} points in {done} frame(s) of {args.capture} "
           f"({time.perf_counter() - t0:.2f} s) -> {out}")
-    if args.plots and cube is not None:
-        process_plots(Path(args.plots), cfg, cube, clouds[-1], frames[-1])
+    if stopped == "interrupted":
+        warn([f"interrupted: wrote the {done} of {len(frames)} frame(s) processed"], "process")
+        return 130
+    if stopped:
+        raise CliError(f"{stopped} (after {done} of {len(frames)} frame(s): those are in "
+                       f"{out})")
+    if plots and cube is not None:
+        process_plots(plots, cfg, cube, clouds[-1], frames[-1])
     return 0
 
 
@@ -132,6 +185,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     p.add_argument("--plots", default=None,
                    help="folder for the last frame's range-Doppler map with its detections, "
                         "range-azimuth map and x-y point cloud")
+    add_mcap_options(p)
     add_detection_options(p, max_speed_default="the profile's max_speed_mps: its unambiguous "
                                               "speed unless it says; 100 for the presets")
     p.set_defaults(func=cmd_process)
