@@ -223,3 +223,41 @@ def refuse_detection_misfits(args: argparse.Namespace, fpga: bool) -> None:
     if args.detector != "paper":
         refuse(args, ("threshold_db",), "to --detector " + args.detector
                + " (it is the paper detector's threshold)")
+
+
+def stopped_before_any(stopped: str | None, done: int) -> None:
+    """A run that stopped (``stopped``: "interrupted" or the error) before its first frame
+    has nothing to write: Ctrl-C goes on as KeyboardInterrupt, an error as a CliError."""
+    if stopped and not done:
+        if stopped == "interrupted":
+            raise KeyboardInterrupt
+        raise CliError(stopped)
+
+
+def warn_clipped(clipped: list[int], command: str) -> None:
+    """The one-line warning of the frames (indices, sorted) whose ADC values clipped."""
+    if clipped:
+        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
+              f"harmonics of the clipped echo can appear as false points (flagged "
+              f"\"clipped\" in the JSON)"], command)
+
+
+def stop_fields(stopped: str | None, requested: int) -> dict[str, object]:
+    """The JSON fields of a run that stopped early (none when it completed)."""
+    if not stopped:
+        return {}
+    return {"interrupted": stopped == "interrupted", "error": stopped,
+            "frames_requested": requested}
+
+
+def stop_exit(stopped: str | None, done: int, requested: int, out: Path, command: str
+              ) -> int | None:
+    """After the JSON of a stopped run is written: Ctrl-C warns and gives exit status 130,
+    an error is a CliError naming what was kept; None when the run completed."""
+    if stopped == "interrupted":
+        warn([f"interrupted: wrote the {done} of {requested} frame(s) processed"], command)
+        return 130
+    if stopped:
+        raise CliError(f"{stopped} (after {done} of {requested} frame(s): those are in "
+                       f"{out})")
+    return None

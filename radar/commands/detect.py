@@ -40,7 +40,11 @@ from radar.common import (
     progress,
     refuse_detection_misfits,
     scene_of,
+    stop_exit,
+    stop_fields,
+    stopped_before_any,
     warn,
+    warn_clipped,
 )
 from radar.figures import detect_plots
 from radar.frame_cloud import frame_cloud
@@ -160,15 +164,9 @@ def cmd_detect(args: argparse.Namespace) -> int:
         stopped = str(exc)
     finally:
         close_recording(rec)
-    if stopped and not per_frame:
-        if stopped == "interrupted":
-            raise KeyboardInterrupt
-        raise CliError(stopped)
+    stopped_before_any(stopped, len(per_frame))
     clipped = [k for k, n in enumerate(saturated) if n]
-    if clipped:
-        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
-              f"harmonics of the clipped echo can appear as false points (flagged "
-              f"\"clipped\" in the JSON)"], "detect")
+    warn_clipped(clipped, "detect")
     cloud = PointCloud.concat(clouds)
     done = len(per_frame) if stopped else args.frames
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
@@ -178,20 +176,15 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 "frame_info": per_frame, **report})
     if args.gnn:
         doc["objects"] = objects
-    if stopped:
-        doc.update({"interrupted": stopped == "interrupted", "error": stopped,
-                    "frames_requested": args.frames})
+    doc.update(stop_fields(stopped, args.frames))
     out.write_text(json.dumps(doc, indent=1))
     print(f"{len(cloud)} points in {done} frame(s) ({time.perf_counter() - t0:.2f} s) "
           f"-> {out}")
     if args.gnn:
         print(f"GNN: {len(objects)} object(s): " + describe(objects))
-    if stopped == "interrupted":
-        warn([f"interrupted: wrote the {done} of {args.frames} frame(s) processed"], "detect")
-        return 130
-    if stopped:
-        raise CliError(f"{stopped} (after {done} of {args.frames} frame(s): those are in "
-                       f"{out})")
+    code = stop_exit(stopped, done, args.frames, out, "detect")
+    if code is not None:
+        return code
     if plots and last_cube is not None:
         last = [o for o in objects if o["frame"] == args.frames - 1]
         detect_plots(plots, cfg, scene, last_cube, clouds[-1], object_boxes(last))

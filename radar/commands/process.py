@@ -31,7 +31,11 @@ from radar.common import (
     out_file,
     out_folder,
     progress,
+    stop_exit,
+    stop_fields,
+    stopped_before_any,
     warn,
+    warn_clipped,
 )
 from radar.figures import process_plots
 from radar.frame_cloud import frame_cloud
@@ -130,14 +134,8 @@ def cmd_process(args: argparse.Namespace) -> int:
         stopped = str(exc)
     finally:
         close_recording(rec)
-    if stopped and not per_frame:
-        if stopped == "interrupted":
-            raise KeyboardInterrupt
-        raise CliError(stopped)
-    if clipped:
-        warn([f"ADC clipped in {len(clipped)} frame(s) ({clipped[0]}..{clipped[-1]}): "
-              f"harmonics of the clipped echo can appear as false points (flagged "
-              f"\"clipped\" in the JSON)"], "process")
+    stopped_before_any(stopped, len(per_frame))
+    warn_clipped(clipped, "process")
     done = len(per_frame)
     cloud = PointCloud.concat(clouds)
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
@@ -146,18 +144,13 @@ def cmd_process(args: argparse.Namespace) -> int:
                 "max_speed_mps": params.max_speed_mps,
                 "min_detection_range_m": cfg.min_detection_range_m,
                 "frame_info": per_frame})
-    if stopped:
-        doc.update({"interrupted": stopped == "interrupted", "error": stopped,
-                    "frames_requested": len(frames)})
+    doc.update(stop_fields(stopped, len(frames)))
     out.write_text(json.dumps(doc, indent=1))
     print(f"{len(cloud)} points in {done} frame(s) of {args.capture} "
           f"({time.perf_counter() - t0:.2f} s) -> {out}")
-    if stopped == "interrupted":
-        warn([f"interrupted: wrote the {done} of {len(frames)} frame(s) processed"], "process")
-        return 130
-    if stopped:
-        raise CliError(f"{stopped} (after {done} of {len(frames)} frame(s): those are in "
-                       f"{out})")
+    code = stop_exit(stopped, done, len(frames), out, "process")
+    if code is not None:
+        return code
     if plots and cube is not None:
         process_plots(plots, cfg, cube, clouds[-1], frames[-1])
     return 0
