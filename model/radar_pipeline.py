@@ -34,11 +34,12 @@ from model.axis_packetizer import (
     unpack_iq,
 )
 from model.cfar_2d import pack_scale
-from model.config import RadarConfig, hdl_parameters
+from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
+from model.hdl import hdl_parameters
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -117,7 +118,7 @@ class PipelineParams:
 
     def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
-        (:func:`model.config.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
+        (:func:`model.hdl.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
         schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``;
         OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1)."""
         store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w,

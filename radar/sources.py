@@ -31,8 +31,9 @@ import numpy as np
 from host.receiver import chain_decoder
 from host.records import DetectionFrame
 from model.axis_packetizer import packetize_stream, words_to_bytes
-from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, RadarConfig
+from model.config import RadarConfig
 from model.detect_chain import DetectConfig
+from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W
 from model.radar_pipeline import PipelineParams, record_frames, scaled_cube
 from model.reference import radar_cube
 

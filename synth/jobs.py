@@ -12,8 +12,8 @@ import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from model.config import FULL_AXI_DATA_W
 from model.fft_axis import multipliers_per_lane
+from model.hdl import FULL_AXI_DATA_W
 
 ROOT = Path(__file__).resolve().parent.parent
 RTL = ROOT / "rtl"
@@ -122,8 +122,9 @@ def _detect_job(preset: str) -> Job:
 
 
 def _dims(preset: str) -> tuple[int, int, int, int]:
-    """(NUM_TX, NUM_RX, N_RANGE, N_DOPPLER) of a preset (:func:`model.config.hdl_parameters`)."""
-    from model.config import get_preset, hdl_parameters
+    """(NUM_TX, NUM_RX, N_RANGE, N_DOPPLER) of a preset (:func:`model.hdl.hdl_parameters`)."""
+    from model.config import get_preset
+    from model.hdl import hdl_parameters
 
     p = hdl_parameters(get_preset(preset))
     return p["NUM_TX"], p["NUM_RX"], p["N_RANGE"], p["N_DOPPLER"]

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from model.config import FULL_AXI_DATA_W
+from model.hdl import FULL_AXI_DATA_W
 from synth.jobs import RTL, Job, files_for, job_sets, rtl_files
 from synth.vivado_flow import TCL, job_tcl, parse_utilization
 from synth.yosys_estimate import main

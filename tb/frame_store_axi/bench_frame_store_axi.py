@@ -23,7 +23,8 @@ from collections import Counter
 from pathlib import Path
 
 from model import frame_store_axi as fs
-from model.config import FPGA_CLOCK_HZ, get_preset
+from model.config import get_preset
+from model.hdl import FPGA_CLOCK_HZ
 from rtlsim.toolchain import rtl_sources, run_cocotb
 
 HERE = Path(__file__).resolve().parent

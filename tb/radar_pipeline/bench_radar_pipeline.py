@@ -24,7 +24,8 @@ sys.path[:0] = [str(HERE.parents[1]), str(HERE)]
 from test_radar_pipeline import CONFIGS  # noqa: E402
 
 from model.axis_packetizer import packets_per_frame  # noqa: E402
-from model.config import FPGA_CLOCK_HZ, get_preset  # noqa: E402
+from model.config import get_preset  # noqa: E402
+from model.hdl import FPGA_CLOCK_HZ  # noqa: E402
 from model.radar_pipeline import PipelineParams  # noqa: E402
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES  # noqa: E402
 from rtlsim.toolchain import rtl_sources, run_cocotb  # noqa: E402

@@ -177,7 +177,8 @@ def test_harness_full_frame_store() -> None:
     FRAME_STORE = 1 top (512-bit AXI4 to the harness's memory with latency and 30 % stalls),
     the ADC at its real 32.5 MSPS against the 100 MHz clock: every DMA byte equals the
     model's, nothing flagged."""
-    from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, get_preset
+    from model.config import get_preset
+    from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W
     from model.radar_pipeline import PipelineParams
 
     cfg = get_preset("full")
@@ -223,7 +224,8 @@ def test_harness_full_frame_store_detect() -> None:
     """`full` in mode 1 through the external store (READ_ORDER = 1, FS_TILE_R 4), the ADC at
     its real rate, 512-bit AXI4 memory with latency and 30 % stalls, the Table I scene: the
     record packets equal the model's byte for byte, nothing flagged or truncated."""
-    from model.config import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, get_preset
+    from model.config import get_preset
+    from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W
     from model.radar_pipeline import PipelineParams
     from model.scene import table1_scene
     from model.simulate import simulate_scene

@@ -1,0 +1,29 @@
+"""The RTL's side of a radar configuration: the HDL parameters a ``model.config.RadarConfig``
+gives the top and the fixed facts of the data path (sample width, fabric clock, the external
+frame store's bus width), in one place for the tests, the RTL frame source and synthesis."""
+
+from __future__ import annotations
+
+from model.config import RadarConfig
+
+DATA_W = 16
+"""Bits of I and of Q on every sample stream of the RTL (docs/design.md section 3)."""
+
+FPGA_CLOCK_HZ = 100e6
+"""The fabric clock of the RTL (the paper's 100 MHz, Hz): ADC samples are paced against it,
+and the benchmarks turn cycle counts into frame rates and bandwidths with it."""
+
+FULL_AXI_DATA_W = 512
+"""AXI_DATA_W (bits) of the external frame store of the ``full`` top (FRAME_STORE = 1): the
+ZCU106 PL DDR4 through MIG, 512-bit user interface at the 100 MHz fabric clock
+(docs/frame_store.md). The RTL frame source, the synthesis jobs and the tests use it."""
+
+
+def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
+    """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,
+    N_DOPPLER and DATA_W, then ``overrides`` (e.g. ``PACKET_WORDS=1024``) added or replacing.
+    The one place that maps a preset to HDL parameters (tests, RTL source, synthesis)."""
+    params = {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
+              "N_DOPPLER": cfg.n_doppler, "DATA_W": DATA_W}
+    params.update(overrides)
+    return params
