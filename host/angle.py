@@ -83,15 +83,22 @@ MAX_CHANNELS = COARSE_FFT
 """The most virtual channels the estimator takes (the coarse FFT's length)."""
 
 
-def _rows_and_phasors(x: np.ndarray, tx_phasors: np.ndarray | None
-                      ) -> tuple[np.ndarray, np.ndarray]:
-    """x as complex128 (n, n_ch), and the per-TX phasors complex (n, num_tx) (ones (n, 1)
-    when None); ValueError naming a shape that does not fit."""
+def _vectors(x: np.ndarray) -> np.ndarray:
+    """x as complex128 (n, n_ch); ValueError when it is not a 2-D array of at most
+    :data:`MAX_CHANNELS` channels."""
     xs = np.ascontiguousarray(x, dtype=np.complex128)
     if xs.ndim != 2:
         raise ValueError(f"angles: channel vectors must be (n, n_channels), got {xs.shape}")
     if xs.shape[1] > MAX_CHANNELS:
         raise ValueError(f"angles: {xs.shape[1]} channels, at most {MAX_CHANNELS}")
+    return xs
+
+
+def _rows_and_phasors(x: np.ndarray, tx_phasors: np.ndarray | None
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_vectors` of x, and the per-TX phasors complex (n, num_tx) (ones (n, 1) when
+    None); ValueError naming a shape that does not fit."""
+    xs = _vectors(x)
     ph = np.ones((len(xs), 1)) if tx_phasors is None else np.asarray(tx_phasors)
     if ph.ndim != 2 or len(ph) != len(xs) or ph.shape[1] < 1 or xs.shape[1] % ph.shape[1]:
         raise ValueError(f"angles: TX phasors {ph.shape} do not fit channel vectors "
@@ -107,13 +114,10 @@ def peak_powers(x: np.ndarray, n_fft: int, tx_phasors: np.ndarray | None = None,
     x: complex (n, n_channels), channel v = tx * num_rx + rx; rows: int (m,) which row of x
     each vector is (default: every row once); tx_phasors: complex (m, num_tx), TX t's
     channels multiplied by tx_phasors[:, t] first (TDM compensation, ``host.tdm``)."""
-    xs = np.ascontiguousarray(x, dtype=np.complex128)
+    xs = _vectors(x)
     rows = np.arange(len(xs)) if rows is None else np.asarray(rows)
-    if tx_phasors is None:
-        tx_phasors = np.ones((len(rows), 1))
-    if xs.ndim == 2 and xs.shape[1] > MAX_CHANNELS:
-        raise ValueError(f"angles: {xs.shape[1]} channels, at most {MAX_CHANNELS}")
-    return class_peaks(xs, rows, np.asarray(tx_phasors), n_fft)
+    ph = np.ones((len(rows), 1)) if tx_phasors is None else np.asarray(tx_phasors)
+    return class_peaks(xs, rows, ph, n_fft)
 
 
 def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
