@@ -162,6 +162,17 @@ def select(jobs: list[Job], only: str) -> list[Job]:
     return [j for j in jobs if not keys or any(k in j.name for k in keys)]
 
 
+def jobs_of(sets: dict[str, list[Job]], name: str, only: str | None) -> list[Job]:
+    """The jobs of set ``name`` that ``--only`` (:func:`select`; None: all) keeps;
+    ValueError naming the option when it keeps none."""
+    jobs = sets[name]
+    if only:
+        jobs = select(jobs, only)
+        if not jobs:
+            raise ValueError(f"--only {only} matches no job of set {name}")
+    return jobs
+
+
 def rtl_files(rtl: Path = RTL) -> list[Path]:
     """The plain file list every tool reads: every ``rtl/**/*.sv``, packages (``*_pkg.sv``)
     first, each group sorted by path. Absolute paths, so any working directory works."""

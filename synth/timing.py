@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
-from synth.jobs import ROOT, Job, files_for, job_sets, rtl_files, select
+from synth.jobs import ROOT, Job, files_for, job_sets, jobs_of, rtl_files
 from synth.timing_report import Row, job_row, write_report
 from synth.timing_run import DEVICE, Settings, run_job
 
@@ -57,13 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-xcup", action="store_true", help="skip the synth_xilinx depth")
     args = ap.parse_args(argv)
 
-    jobs = sets[args.set]
-    if args.only:
-        jobs = select(jobs, args.only)
-        if not jobs:
-            print(f"timing: --only {args.only} matches no job of set {args.set}",
-                  file=sys.stderr)
-            return 2
+    try:
+        jobs = jobs_of(sets, args.set, args.only)
+    except ValueError as exc:
+        print(f"timing: {exc}", file=sys.stderr)
+        return 2
     seeds = [int(s) for s in args.seeds.split(",") if s]
     runs = [(replace(j, name=j.name + (f"@seed{s}" if len(seeds) > 1 else "")), s)
             for j in jobs for s in seeds]

@@ -26,7 +26,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from synth.jobs import ROOT, files_for, job_sets, rtl_files, select
+from synth.jobs import ROOT, files_for, job_sets, jobs_of, rtl_files
 from synth.yosys_report import Result, merge_reports, result_line, write_report
 from synth.yosys_run import run_job, yosys_command, yosys_version
 
@@ -61,13 +61,11 @@ def main(argv: list[str] | None = None) -> int:
             for j in jobs:
                 print(f"{name:11s} {j.name:30s} {j.top:16s} {j.label}{' -uram' if j.uram else ''}")
         return 0
-    jobs = sets[args.set]
-    if args.only:
-        jobs = select(jobs, args.only)
-        if not jobs:
-            print(f"synth-estimate: --only {args.only} matches no job of set {args.set}",
-                  file=sys.stderr)
-            return 2
+    try:
+        jobs = jobs_of(sets, args.set, args.only)
+    except ValueError as exc:
+        print(f"synth-estimate: {exc}", file=sys.stderr)
+        return 2
     yosys = yosys_command()
     out: Path = args.out.resolve()
     work = out / "work"
