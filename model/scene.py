@@ -52,7 +52,8 @@ MAX_SCATTERERS = 2048
 MAX_SEED = 2**63 - 1
 """Largest scene seed."""
 
-_BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "radial_velocity_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
+_BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "elevation_deg": (-90.0, 90.0),
+           "radial_velocity_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
            "rcs_m2": (0.0, MAX_RCS_M2), "x_m": (-MAX_RANGE_M, MAX_RANGE_M),
            "y_m": (-MAX_RANGE_M, MAX_RANGE_M), "length_m": (0.0, MAX_SIZE_M),
            "width_m": (0.0, MAX_SIZE_M), "vx_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
@@ -94,8 +95,9 @@ class Scatterers:
     """A flat set of point scatterers, all arrays of shape (n,).
 
     ``range_m`` (m), ``azimuth_deg`` (deg), ``radial_velocity_mps`` (m/s, + receding),
-    ``rcs_m2`` (m^2), and ``object_id`` (int, -1 for free point targets) linking each
-    scatterer to the scene object it belongs to (for labelled datasets).
+    ``rcs_m2`` (m^2), ``object_id`` (int, -1 for free point targets) linking each
+    scatterer to the scene object it belongs to (for labelled datasets), and
+    ``elevation_deg`` (deg, + up; None: all 0, in the radar's horizontal plane).
     """
 
     range_m: np.ndarray
@@ -103,6 +105,11 @@ class Scatterers:
     radial_velocity_mps: np.ndarray
     rcs_m2: np.ndarray
     object_id: np.ndarray
+    elevation_deg: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.elevation_deg is None:
+            object.__setattr__(self, "elevation_deg", np.zeros(np.shape(self.range_m)))
 
     def __len__(self) -> int:
         return int(self.range_m.shape[0])
@@ -114,21 +121,26 @@ class Scatterers:
             e = np.zeros(0)
             return Scatterers(e, e, e, e, np.zeros(0, dtype=int))
         return Scatterers(*(np.concatenate([getattr(p, f) for p in parts]) for f in (
-            "range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2", "object_id")))
+            "range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2", "object_id",
+            "elevation_deg")))
 
 
 @dataclass(frozen=True)
 class PointTarget:
-    """One point scatterer: range (m), azimuth (deg), radial velocity (m/s), RCS (m^2)."""
+    """One point scatterer: range (m), azimuth (deg), radial velocity (m/s), RCS (m^2) and
+    elevation (deg, + up; optional in the JSON, default 0)."""
 
     range_m: float
     azimuth_deg: float
     radial_velocity_mps: float
     rcs_m2: float
+    elevation_deg: float = 0.0
 
     FIELDS = ("range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2")
 
     def __post_init__(self) -> None:
+        if not -90.0 < self.elevation_deg < 90.0:
+            raise ValueError(f"elevation_deg: must be inside (-90, 90), got {self.elevation_deg}")
         if self.range_m <= 0:
             raise ValueError(f"range_m: must be positive, got {self.range_m}")
         if not -90.0 < self.azimuth_deg < 90.0:
@@ -138,20 +150,32 @@ class PointTarget:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "target") -> PointTarget:
-        _check_keys(d, set(cls.FIELDS), where)
+        _check_keys(d, {*cls.FIELDS, "elevation_deg"}, where)
         vals = {k: _number(d, k, where) for k in cls.FIELDS}
+        vals["elevation_deg"] = _number(d, "elevation_deg", where, 0.0)
         try:
             return cls(**vals)
         except ValueError as exc:
             raise ValueError(f"{where}.{exc}") from None
 
+    def to_dict(self) -> dict[str, float]:
+        """The target's JSON (``elevation_deg`` only when not 0)."""
+        d = asdict(self)
+        if not self.elevation_deg:
+            del d["elevation_deg"]
+        return d
+
     @property
     def x_m(self) -> float:
-        return self.range_m * math.cos(math.radians(self.azimuth_deg))
+        """Position along the boresight, m (``model.array.cartesian``)."""
+        return self.range_m * math.cos(math.radians(self.elevation_deg)) * math.cos(
+            math.radians(self.azimuth_deg))
 
     @property
     def y_m(self) -> float:
-        return self.range_m * math.sin(math.radians(self.azimuth_deg))
+        """Position to the left, m."""
+        return self.range_m * math.cos(math.radians(self.elevation_deg)) * math.sin(
+            math.radians(self.azimuth_deg))
 
 
 OBJECT_LABELS: tuple[str, ...] = ("car", "pedestrian", "pedestrian_group", "two_wheeler",
@@ -300,7 +324,7 @@ class Scene:
             parts.append(Scatterers(
                 np.array([x.range_m for x in t]), np.array([x.azimuth_deg for x in t]),
                 np.array([x.radial_velocity_mps for x in t]), np.array([x.rcs_m2 for x in t]),
-                np.full(len(t), -1)))
+                np.full(len(t), -1), np.array([x.elevation_deg for x in t])))
         for i, obj in enumerate(self.objects):
             parts.append(obj.scatterers(rng, i))
         return Scatterers.concat(parts)
@@ -350,7 +374,7 @@ class Scene:
         """Scene JSON (explicit targets and objects, never a built-in name)."""
         return {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
                 "noise": self.noise, "name": self.name,
-                "targets": [asdict(t) for t in self.targets],
+                "targets": [t.to_dict() for t in self.targets],
                 "objects": [asdict(o) for o in self.objects]}
 
 
