@@ -15,6 +15,8 @@ Scene JSON (docs/design.md 4.3)::
                   "vx_mps": -5, "vy_mps": 0, "rcs_m2": 10, "n_scatterers": 12,
                   "label": "car"}]}
 
+A target may also give ``elevation_deg`` (default 0); an ``"impairments"`` table adds the
+real-world effects of ``model.impairments`` (docs/profiles.md).
 ``{"scene": "table1", "preset": "full"}`` names the built-in paper scene instead.
 """
 
@@ -30,6 +32,8 @@ from typing import Any
 import numpy as np
 
 from model.config import PRESETS, RadarConfig, get_preset
+from model.impairments import NO_IMPAIRMENTS, Impairments
+from model.json_fields import check_keys, number
 
 KMH = 1.0 / 3.6
 """m/s per km/h."""
@@ -61,33 +65,7 @@ _BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "elevation_deg": (-90.0, 90.0),
 
 
 def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = None) -> float:
-    if key not in d:
-        if default is None:
-            raise ValueError(f"{where}: missing required field {key!r}")
-        return default
-    value = d[key]
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(f"{where}.{key}: must be a finite number, got {value!r}")
-    try:
-        finite = math.isfinite(value)
-    except OverflowError:                   # an integer beyond float range
-        finite = False
-    if not finite:
-        raise ValueError(f"{where}.{key}: must be a finite number, got {str(value)[:20]}"
-                         f"{'...' if len(str(value)) > 20 else ''}")
-    lo, hi = _BOUNDS.get(key, (-math.inf, math.inf))
-    if not lo <= value <= hi:
-        raise ValueError(f"{where}.{key}: {value!r} is outside what the simulator accepts "
-                         f"[{lo:g}, {hi:g}]")
-    return float(value)
-
-
-def _check_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    if not isinstance(d, Mapping):
-        raise ValueError(f"{where}: must be a JSON object, got {type(d).__name__}")
-    unknown = set(d) - allowed
-    if unknown:
-        raise ValueError(f"{where}: unknown field(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+    return number(d, key, where, default, _BOUNDS.get(key, (-math.inf, math.inf)))
 
 
 @dataclass(frozen=True)
@@ -150,7 +128,7 @@ class PointTarget:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "target") -> PointTarget:
-        _check_keys(d, {*cls.FIELDS, "elevation_deg"}, where)
+        check_keys(d, {*cls.FIELDS, "elevation_deg"}, where)
         vals = {k: _number(d, k, where) for k in cls.FIELDS}
         vals["elevation_deg"] = _number(d, "elevation_deg", where, 0.0)
         try:
@@ -226,7 +204,7 @@ class ExtendedObject:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "object") -> ExtendedObject:
-        _check_keys(d, set(cls.NUMBERS) | {"n_scatterers", "label"}, where)
+        check_keys(d, set(cls.NUMBERS) | {"n_scatterers", "label"}, where)
         vals: dict[str, Any] = {k: _number(d, k, where, 0.0 if k in ("heading_deg", "vx_mps",
                                                                   "vy_mps") else None)
                                 for k in cls.NUMBERS}
@@ -290,6 +268,8 @@ class Scene:
 
     ``noise=False`` switches thermal noise off (for model tests). Frame k of a scene (see
     ``model.simulate.simulate_scene``) moves each target radially by ``v * k * frame_time``.
+    ``impairments``: the real-world effects the simulator adds (``model.impairments``; the
+    JSON's ``"impairments"`` table), none by default.
     """
 
     preset: str = "full"
@@ -299,13 +279,16 @@ class Scene:
     objects: tuple[ExtendedObject, ...] = ()
     noise: bool = True
     name: str = "custom"
+    impairments: Impairments = NO_IMPAIRMENTS
 
     def __post_init__(self) -> None:
         get_preset(self.preset)  # validates the name
-        n = len(self.targets) + sum(o.n_scatterers for o in self.objects)
+        imp = self.impairments
+        n = len(self.targets) + sum(o.n_scatterers for o in self.objects) + sum(
+            w.n_scatterers for w in imp.walls) + (imp.ground.n_scatterers if imp.ground else 0)
         if n > MAX_SCATTERERS:
-            raise ValueError(f"scene: {n} scatterers (targets + objects' n_scatterers), at "
-                             f"most {MAX_SCATTERERS}")
+            raise ValueError(f"scene: {n} scatterers (targets + objects' and clutter's "
+                             f"n_scatterers), at most {MAX_SCATTERERS}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not \
                 0 <= self.seed <= MAX_SEED:
             raise ValueError(f"seed: must be an integer in 0..2**63-1, got {self.seed!r}")
@@ -340,7 +323,8 @@ class Scene:
             raise ValueError(f"preset: unknown preset {preset!r}; choose one of "
                              f"{', '.join(PRESETS)}")
         if "scene" in d:
-            _check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise"}, "scene")
+            check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise", "impairments"},
+                       "scene")
             builtin = d["scene"]
             if not isinstance(builtin, str) or builtin not in BUILTIN_SCENES:
                 raise ValueError(f"scene: unknown built-in scene {builtin!r}; choose one of "
@@ -349,9 +333,10 @@ class Scene:
             return Scene(preset=preset, seed=_int(d, "seed", base.seed),
                          tx_beamforming=_bool(d, "tx_beamforming", base.tx_beamforming),
                          targets=base.targets, objects=base.objects,
-                         noise=_bool(d, "noise", True), name=builtin)
-        _check_keys(d, {"preset", "seed", "tx_beamforming", "targets", "objects", "noise",
-                        "name"}, "scene")
+                         noise=_bool(d, "noise", True), name=builtin,
+                         impairments=_impairments(d))
+        check_keys(d, {"preset", "seed", "tx_beamforming", "targets", "objects", "noise",
+                       "name", "impairments"}, "scene")
         targets = d.get("targets", [])
         objects = d.get("objects", [])
         if not isinstance(targets, list):
@@ -368,14 +353,24 @@ class Scene:
                           for i, t in enumerate(targets)),
             objects=tuple(ExtendedObject.from_dict(o, f"objects[{i}]")
                           for i, o in enumerate(objects)),
-            noise=_bool(d, "noise", True), name=str(name))
+            noise=_bool(d, "noise", True), name=str(name), impairments=_impairments(d))
 
     def to_dict(self) -> dict[str, Any]:
-        """Scene JSON (explicit targets and objects, never a built-in name)."""
-        return {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
-                "noise": self.noise, "name": self.name,
-                "targets": [t.to_dict() for t in self.targets],
-                "objects": [asdict(o) for o in self.objects]}
+        """Scene JSON (explicit targets and objects, never a built-in name; the impairments
+        table when there are any)."""
+        d = {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
+             "noise": self.noise, "name": self.name,
+             "targets": [t.to_dict() for t in self.targets],
+             "objects": [asdict(o) for o in self.objects]}
+        if self.impairments != NO_IMPAIRMENTS:
+            d["impairments"] = self.impairments.to_dict()
+        return d
+
+
+def _impairments(d: Mapping[str, Any]) -> Impairments:
+    """The scene JSON's impairments table (none: the ideal radar)."""
+    return NO_IMPAIRMENTS if d.get("impairments") is None else Impairments.from_dict(
+        d["impairments"])
 
 
 def _int(d: Mapping[str, Any], key: str, default: int) -> int:

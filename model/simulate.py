@@ -55,6 +55,7 @@ import numpy as np
 
 from model.array import direction_cosines, steering
 from model.config import C0, RadarConfig, db_to_lin, dbm_to_w
+from model.impairments import NO_IMPAIRMENTS, Impairments, apply_iq_imbalance, phase_noise_rad
 from model.scene import Scatterers, Scene
 
 MAX_FRAME_INDEX = 1_000_000
@@ -70,6 +71,8 @@ def check_frame_index(frame_index: int) -> int:
     return int(frame_index)
 
 
+CLUTTER_ID = -2
+"""``object_id`` of the static clutter's scatterers (``model.impairments``)."""
 CHIRP_CHUNK = 64
 """Chirps per batched matrix product (bounds the (chunk, scatterers, samples) temporary)."""
 FAST_SPLIT = 16
@@ -156,7 +159,8 @@ class AdcFrame:
     complex64 with integer-valued I and Q in [-2**(b-1), 2**(b-1)-1] (the codes the FPGA
     receives) for a complex ADC, float32 of integer codes for a real one.
     ``saturated``: number of I or Q (or real) values clipped by the ADC.
-    ``dropped_scatterers``: scatterers not simulated, all reasons: ``passed_scatterers``
+    ``dropped_scatterers``: scatterers (clutter included) not simulated, all reasons:
+    ``passed_scatterers``
     (range <= 0 at some chirp of the frame: the scatterer is at or behind the radar, and
     its beat frequency would be negative) plus those beyond the IF bandwidth (beat >= fs, or
     fs / 2 for a real ADC, at the frame centre), removed by the anti-alias filter.
@@ -275,22 +279,48 @@ def thermal_noise(cfg: RadarConfig, shape: tuple[int, ...], rng: np.random.Gener
 
 def simulate_frame(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = True,
                    noise: bool = True, rng: np.random.Generator | None = None,
-                   frame_index: int = 0) -> AdcFrame:
-    """One frame of quantised ADC samples (see :class:`AdcFrame`) for ``sc``."""
+                   frame_index: int = 0, impairments: Impairments = NO_IMPAIRMENTS
+                   ) -> AdcFrame:
+    """One frame of quantised ADC samples (see :class:`AdcFrame`) for ``sc``, with the
+    real-world effects of ``impairments`` (``model.impairments``, in its order; the phase
+    noise is drawn from ``rng`` after the thermal noise). ValueError naming an impairment
+    field that does not fit ``cfg``."""
     check_frame_index(frame_index)
+    imp = impairments
+    imp.check(cfg)
     rng = rng if rng is not None else np.random.default_rng(0)
-    x, dropped = simulate_baseband(cfg, sc, beamforming=beamforming, frame_index=frame_index)
+    every = sc
+    if imp.clutter:
+        r, az, el, rcs = imp.clutter_points()
+        every = Scatterers.concat([sc, Scatterers(r, az, np.zeros_like(r), rcs,
+                                                  np.full(r.shape, CLUTTER_ID), el)])
+    x, dropped = simulate_baseband(cfg, every, beamforming=beamforming, frame_index=frame_index)
+    tx = chirp_tx(cfg)
+    if imp.leakage_dbfs is not None:
+        tone = np.exp(2j * np.pi * cfg.beat_frequency_hz(imp.leakage_range_m)
+                      / cfg.sample_rate_hz * np.arange(cfg.n_samples))
+        x += imp.leakage_amplitudes(cfg)[tx][:, :, None] * tone
+    if imp.channel_errors:
+        g_tx, g_rx = imp.channel_gains(cfg)
+        x *= g_tx[tx][:, None, None] * g_rx[None, :, None]
+    thermal = thermal_noise(cfg, x.shape, rng) if noise else None
+    if imp.phase_noise_rms_deg:
+        x *= np.exp(1j * phase_noise_rad(imp, cfg, rng))[:, None, :]
     if cfg.adc == "real":
         x = x.real.copy()
-    if noise:
-        x += thermal_noise(cfg, x.shape, rng)
+    if thermal is not None:
+        x += thermal
+    if imp.iq_imbalance:
+        x = apply_iq_imbalance(x, imp.iq_gain_db, imp.iq_phase_deg)
+    if imp.dc_offset_dbfs is not None:
+        x += imp.dc_offsets(cfg)[None, :, None]
     samples, saturated = quantize_adc(x, cfg.adc_bits)
     return AdcFrame(samples=samples, saturated=saturated, dropped_scatterers=dropped,
                     config=cfg, passed_scatterers=int(passed_radar(cfg, sc, frame_index).sum()))
 
 
 def simulate_scene(scene: Scene, frame_index: int = 0) -> AdcFrame:
-    """One frame of ``scene`` (its radar, seed, beamforming and noise switches).
+    """One frame of ``scene`` (its radar, seed, beamforming and noise switches, impairments).
 
     Noise for frame k uses the seed sequence (scene.seed, k), so frames are reproducible
     and independent.
@@ -298,4 +328,5 @@ def simulate_scene(scene: Scene, frame_index: int = 0) -> AdcFrame:
     check_frame_index(frame_index)
     rng = np.random.default_rng([scene.seed, frame_index])
     return simulate_frame(scene.config, scene.scatterers(), beamforming=scene.tx_beamforming,
-                          noise=scene.noise, rng=rng, frame_index=frame_index)
+                          noise=scene.noise, rng=rng, frame_index=frame_index,
+                          impairments=scene.impairments)
