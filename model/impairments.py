@@ -18,8 +18,10 @@ of the signal path:
    echo is multiplied by exp(j phi(t)), phi a stationary first-order Gauss-Markov process
    (a PLL-locked oscillator's phase error: rms ``phase_noise_rms_deg``, Lorentzian spectrum
    of 3 dB bandwidth B, correlation time 1 / (2 pi B)) evaluated at every sample time of the
-   frame, common to all RX (one LO). The range correlation that lowers the residual phase
-   noise of near echoes (phi(t) - phi(t - tau)) is not modelled: this is the worst case;
+   frame, common to all RX (one LO) and to every echo. ``phase_noise_rms_deg`` is the IF's
+   residual phase noise: the range correlation that makes it smaller for nearer echoes
+   (phi(t) - phi(t - tau)) is not modelled, so give the rms of the ranges of interest;
+   leakage and near clutter get the same (a worst case). Frames are independent;
 5. thermal noise (``Scene.noise``);
 6. I/Q imbalance (``iq_gain_db``, ``iq_phase_deg``; complex ADC only): I' = I,
    Q' = g (Q cos(phi) - I sin(phi)), i.e. y = mu x + nu conj(x) with mu = (1 + g e^{-j phi}) / 2,

@@ -269,7 +269,8 @@ class Scene:
     ``noise=False`` switches thermal noise off (for model tests). Frame k of a scene (see
     ``model.simulate.simulate_scene``) moves each target radially by ``v * k * frame_time``.
     ``impairments``: the real-world effects the simulator adds (``model.impairments``; the
-    JSON's ``"impairments"`` table), none by default.
+    JSON's ``"impairments"`` table), none by default. ``radar``: the radar when it is not the
+    preset (a profile, ``radar simulate --radar``; not part of the JSON), None: the preset's.
     """
 
     preset: str = "full"
@@ -280,6 +281,7 @@ class Scene:
     noise: bool = True
     name: str = "custom"
     impairments: Impairments = NO_IMPAIRMENTS
+    radar: RadarConfig | None = None
 
     def __post_init__(self) -> None:
         get_preset(self.preset)  # validates the name
@@ -295,8 +297,8 @@ class Scene:
 
     @property
     def config(self) -> RadarConfig:
-        """The radar configuration of the scene's preset."""
-        return get_preset(self.preset)
+        """The scene's radar: ``radar``, else its preset's configuration."""
+        return get_preset(self.preset) if self.radar is None else self.radar
 
     def scatterers(self) -> Scatterers:
         """All scatterers of the scene: point targets (object_id -1) then each object's."""
@@ -357,7 +359,7 @@ class Scene:
 
     def to_dict(self) -> dict[str, Any]:
         """Scene JSON (explicit targets and objects, never a built-in name; the impairments
-        table when there are any)."""
+        table when there are any; not ``radar``)."""
         d = {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
              "noise": self.noise, "name": self.name,
              "targets": [t.to_dict() for t in self.targets],

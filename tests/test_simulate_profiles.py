@@ -2,13 +2,17 @@
 order, 2-D / non-uniform arrays, elevation, frame period, real ADC; the presets unchanged."""
 
 import hashlib
+import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from host.adc_capture import open_capture
 from model.array import direction_cosines, steering
 from model.config import C0, RadarConfig
+from model.profile import load_profile
 from model.scene import ExtendedObject, PointTarget, Scatterers, Scene, table1_scene
 from model.simulate import (
     chirp_times_s,
@@ -19,6 +23,7 @@ from model.simulate import (
     simulate_scene,
     tone_amplitude_lsb,
 )
+from radar.cli import main
 
 PROFILE = RadarConfig(
     name="odd", num_tx=3, num_rx=4, n_range=64, n_doppler=16, sample_rate_hz=20e6,
@@ -140,3 +145,108 @@ def test_scene_elevation_json():
     assert "elevation_deg" not in flat.to_dict()["targets"][0]
     with pytest.raises(ValueError, match=r"targets\[0\]\.elevation_deg"):
         Scene.from_dict({**d, "targets": [{**d["targets"][0], "elevation_deg": 95}]})
+
+
+# ---- radar simulate --radar / --frames / .bin ------------------------------------------------
+DATA = Path(__file__).parent / "data" / "openradar"
+SMALL_TOML = """
+name = "small-real"
+[waveform]
+start_frequency_hz = 77.0e9
+slope_hz_per_s     = 60.0e12
+sample_rate_hz     = 5.0e6
+samples_per_chirp  = 61
+idle_time_s        = 10.0e-6
+ramp_end_time_s    = 20.0e-6
+loops              = 9
+tx_order           = [1, 0, 2]
+adc                = "real"
+[array]
+tx = [[0, 0], [2, 1], [4, 0]]
+rx = [[0, 0], [1, 0], [2, 0], [3, 0]]
+[capture]
+format      = "dca1000"
+lanes       = 4
+interleaved = true
+"""
+"""A 3-TX real-ADC profile (xWR1843-like raised TX, 61 samples, 9 loops, 4-lane capture)."""
+ROOM = {"preset": "paper-fpga", "seed": 3,
+        "targets": [{"range_m": 3.0, "azimuth_deg": 10, "radial_velocity_mps": 0.6,
+                     "rcs_m2": 0.5, "elevation_deg": 5}],
+        "impairments": {"seed": 1, "rx_phase_rms_deg": 5, "leakage_dbfs": -30,
+                        "dc_offset_dbfs": -60, "phase_noise_rms_deg": 0.5,
+                        "walls": [{"x1_m": 4.5, "y1_m": -2, "x2_m": 4.5, "y2_m": 2,
+                                   "rcs_m2": 1}]}}
+
+
+@pytest.fixture
+def room(tmp_path: Path) -> Path:
+    p = tmp_path / "room.json"
+    p.write_text(json.dumps(ROOM))
+    return p
+
+
+@pytest.mark.parametrize("profile_text, suffix", [(None, ".bin"), (None, ".npy"),
+                                                  (SMALL_TOML, ".bin"), (SMALL_TOML, ".npy")])
+def test_simulate_writes_a_capture_of_any_profile(tmp_path, room, capsys, profile_text, suffix):
+    if profile_text is None:
+        spec = str(DATA / "openradar_2tx4rx.cfg")
+    else:
+        spec = str(tmp_path / "small.toml")
+        Path(spec).write_text(profile_text)
+    out = tmp_path / f"cap{suffix}"
+    assert main(["simulate", "--scene", str(room), "--radar", spec, "--frames", "2",
+                 "--frame", "4", "--out", str(out)]) == 0
+    assert "radar " in capsys.readouterr().out
+    profile = load_profile(spec)
+    scene = replace(Scene.from_dict(ROOM), radar=profile.config)
+    cap = open_capture(out, profile)
+    got = list(cap.frames())
+    assert len(got) == 2
+    for k, frame in enumerate(got):
+        assert np.array_equal(frame, simulate_scene(scene, 4 + k).samples)
+
+
+def test_simulated_capture_processes(tmp_path, room):
+    """The round trip a user makes: an impaired capture of the OpenRadar profile, then
+    `radar process` on it."""
+    cfg = str(DATA / "openradar_2tx4rx.cfg")
+    cap = tmp_path / "room.bin"
+    assert main(["simulate", "--scene", str(room), "--radar", cfg, "--out", str(cap)]) == 0
+    assert main(["process", "--radar", cfg, "--capture", str(cap), "--json",
+                 str(tmp_path / "pts.json"), "--remove-static"]) == 0
+    assert json.loads((tmp_path / "pts.json").read_text())["points"]
+
+
+def test_one_frame_npy_is_unchanged(tmp_path):
+    out = tmp_path / "adc.npy"
+    assert main(["simulate", "--scene", "table1", "--preset", "paper-fpga", "--out",
+                 str(out)]) == 0
+    assert np.array_equal(np.load(out), simulate_scene(table1_scene("paper-fpga", 1)).samples)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--radar", "nope.toml"], "nope.toml"),
+    (["--radar", "full", "--preset", "full"], "--radar and --preset"),
+    (["--frames", "0"], "--frames"),
+    (["--frame", "999999", "--frames", "5"], "--frames"),
+    (["--out-txt"], "must end in .npy or .bin"),
+])
+def test_simulate_bad_input_one_line_exit_2(tmp_path, room, capsys, extra, message):
+    out = ["--out", str(tmp_path / ("x.txt" if extra == ["--out-txt"] else "x.npy"))]
+    args = ["simulate", "--scene", str(room), *out, *[a for a in extra if a != "--out-txt"]]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and message in err
+    assert not (tmp_path / "x.npy").exists()
+
+
+def test_simulate_refuses_impairments_the_radar_cannot_have(tmp_path, capsys):
+    scene = tmp_path / "iq.json"
+    scene.write_text(json.dumps({**ROOM, "impairments": {"iq_gain_db": 0.5}}))
+    toml = tmp_path / "small.toml"
+    toml.write_text(SMALL_TOML)
+    assert main(["simulate", "--scene", str(scene), "--radar", str(toml), "--out",
+                 str(tmp_path / "x.bin")]) == 2
+    assert "impairments.iq_gain_db" in capsys.readouterr().err
+    assert not (tmp_path / "x.bin").exists()
