@@ -294,6 +294,10 @@ class Scene:
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not \
                 0 <= self.seed <= MAX_SEED:
             raise ValueError(f"seed: must be an integer in 0..2**63-1, got {self.seed!r}")
+        try:
+            imp.check(self.config)
+        except ValueError as exc:
+            raise ValueError(f"impairments.{exc}") from None
 
     @property
     def config(self) -> RadarConfig:

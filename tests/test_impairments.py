@@ -206,8 +206,14 @@ def test_scene_json_round_trip():
     ({"ground": {"height_m": 1, "rcs_m2": 1, "min_range_m": 0.5, "max_range_m": 9}},
      r"impairments\.ground\.min_range_m"),
     ({"seed": -1}, r"impairments\.seed"),
+    ({"tx_gain_db": [0, 1]}, r"impairments\.tx_gain_db: 2 values for the 1 TX"),
+    ({"leakage_dbfs": -10, "leakage_range_m": 0.1, "iq_gain_db": 0.1}, None),
 ])
 def test_bad_impairments_name_the_field(table, message):
+    """Checked as the scene loads, against its radar (None: a valid table)."""
+    if message is None:
+        assert Scene.from_dict({**SCENE, "impairments": table}).impairments.iq_imbalance
+        return
     with pytest.raises(ValueError, match=message):
         Scene.from_dict({**SCENE, "impairments": table})
 

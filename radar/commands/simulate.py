@@ -38,7 +38,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     profile = _profile(args)
     scene = scene_of(args)
     if profile is not None:
-        scene = replace(scene, radar=profile.config)
+        try:
+            scene = replace(scene, radar=profile.config)
+        except ValueError as exc:       # impairments the radar cannot have
+            raise CliError(str(exc)) from None
     else:
         profile = preset_profile(scene.preset)
     cfg = scene.config
@@ -52,10 +55,6 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.frame + n - 1 > MAX_FRAME_INDEX:
         raise CliError(f"--frames: frames {args.frame}..{args.frame + n - 1} go beyond the "
                        f"last frame index {MAX_FRAME_INDEX}")
-    try:
-        scene.impairments.check(cfg)
-    except ValueError as exc:
-        raise CliError(f"impairments.{exc}") from None
     out = out_file(args.out, None, "--out")
     frames = range(args.frame, args.frame + n)
     _, warnings = scene_report(scene, frames, default_max_speed_mps(cfg))
