@@ -188,6 +188,7 @@ class Impairments:
                        40.0 if name.endswith("_db") else 360.0)
             if getattr(self, rms):
                 raise ValueError(f"{name}: give the list or {rms}, not both")
+            object.__setattr__(self, name, tuple(values))
         for name in ("leakage_dbfs", "dc_offset_dbfs"):
             if getattr(self, name) is not None:
                 _check(getattr(self, name), name, -200.0, 0.0)
@@ -196,8 +197,10 @@ class Impairments:
         _check(self.iq_phase_deg, "iq_phase_deg", -30.0, 30.0)
         _check(self.phase_noise_rms_deg, "phase_noise_rms_deg", 0.0, 90.0)
         _check(self.phase_noise_bandwidth_hz, "phase_noise_bandwidth_hz", 1e3, 1e9)
-        if not isinstance(self.walls, tuple) or not all(isinstance(w, Wall) for w in self.walls):
-            raise ValueError(f"walls: must be a tuple of Wall, got {self.walls!r}")
+        if not isinstance(self.walls, tuple | list) or not all(isinstance(w, Wall)
+                                                                for w in self.walls):
+            raise ValueError(f"walls: must be a list of Wall, got {self.walls!r}")
+        object.__setattr__(self, "walls", tuple(self.walls))
         if self.ground is not None and not isinstance(self.ground, Ground):
             raise ValueError(f"ground: must be a Ground, got {self.ground!r}")
 
@@ -210,10 +213,12 @@ class Impairments:
 
     @property
     def iq_imbalance(self) -> bool:
+        """An I/Q gain or phase imbalance."""
         return bool(self.iq_gain_db or self.iq_phase_deg)
 
     @property
     def clutter(self) -> bool:
+        """Any wall or ground clutter."""
         return bool(self.walls) or self.ground is not None
 
     def check(self, cfg: RadarConfig) -> None:
@@ -270,24 +275,19 @@ class Impairments:
     def clutter_points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The static clutter scatterers (walls, then the ground): range_m, azimuth_deg,
         elevation_deg, rcs_m2, float (n,) each."""
-        parts = []
         rng_w = self._rng("walls")
-        for w in self.walls:
-            parts.append((*w.points(rng_w), w.rcs_m2, w.n_scatterers, rng_w))
+        groups: list[tuple[Wall | Ground, np.random.Generator]] = [(w, rng_w) for w in self.walls]
         if self.ground is not None:
-            rng_g = self._rng("ground")
-            parts.append((*self.ground.points(rng_g), self.ground.rcs_m2,
-                          self.ground.n_scatterers, rng_g))
-        out: list[list[np.ndarray]] = [[], [], [], []]
-        for x, y, z, rcs, n, rng in parts:
-            r = np.sqrt(x**2 + y**2 + z**2)
-            weights = rng.exponential(size=n)
-            for lst, a in zip(out, (r, np.degrees(np.arctan2(y, x)),
-                                    np.degrees(np.arcsin(z / r)), rcs * weights / weights.sum()),
-                              strict=True):
-                lst.append(a)
-        return tuple(np.concatenate(lst) if lst else np.zeros(0)  # type: ignore[return-value]
-                     for lst in out)
+            groups.append((self.ground, self._rng("ground")))
+        cols = []
+        for item, rng in groups:
+            x, y, z = item.points(rng)
+            weights = rng.exponential(size=item.n_scatterers)
+            r = np.sqrt(x * x + y * y + z * z)
+            cols.append(np.stack([r, np.degrees(np.arctan2(y, x)), np.degrees(np.arcsin(z / r)),
+                                  item.rcs_m2 * weights / weights.sum()]))
+        a = np.concatenate(cols, axis=1) if cols else np.zeros((4, 0))
+        return a[0], a[1], a[2], a[3]
 
     # ---- JSON ----------------------------------------------------------------------------
     @classmethod

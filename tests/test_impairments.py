@@ -189,6 +189,7 @@ def test_scene_json_round_trip():
     assert s.impairments.rx_phase_deg == (0, 3, -2, 1) and s.impairments.walls[0].n_scatterers == 32
     assert Scene.from_dict(s.to_dict()) == s
     assert "impairments" not in Scene.from_dict(SCENE).to_dict()
+    assert Impairments(rx_phase_deg=[1, 2], walls=[]) == Impairments(rx_phase_deg=(1, 2))
     builtin = Scene.from_dict({"scene": "table1", "impairments": {"dc_offset_dbfs": -40}})
     assert builtin.impairments.dc_offset_dbfs == -40
 
