@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 
 from host.adc_capture import open_capture
-from host.params import default_max_speed_mps
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
 from model.profile import Profile, load_profile
@@ -94,8 +93,6 @@ def cmd_process(args: argparse.Namespace) -> int:
                        f"{', '.join(BACKENDS)} for now")
     profile = profile_of(args.radar)
     cfg = profile.config
-    if args.max_speed is None:
-        args.max_speed = default_max_speed_mps(cfg)
     params = detection_params(args, cfg=cfg)
     try:
         capture = open_capture(args.capture, profile)
@@ -179,6 +176,5 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="folder for the last frame's range-Doppler map with its detections, "
                         "range-azimuth map and x-y point cloud")
     add_mcap_options(p)
-    add_detection_options(p, max_speed_default="the profile's max_speed_mps: its unambiguous "
-                                              "speed unless it says; 100 for the presets")
+    add_detection_options(p)
     p.set_defaults(func=cmd_process)
