@@ -59,8 +59,8 @@ class GnnWorker:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    out_folder(args.out, "--out")               # before any work
     scene = on_radar(table1_scene(args.preset or "full"), radar_profile(args))
+    out_folder(args.out, "--out")               # before any work
     cfg = scene.config
     source = get_source(args.backend)
     check_source(source, cfg)

@@ -94,7 +94,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     scene, profile = scene_profile(args)
     cfg = scene.config
     source = get_source(args.backend)
-    check_source(source, cfg)
+    check_source(source, cfg, alternative="--backend float" if args.detect == "host"
+                 else "--detect host --backend float")
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
     plots = out_folder(args.plots, "--plots") if args.plots else None
