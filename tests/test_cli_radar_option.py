@@ -7,7 +7,6 @@ source when it runs the profile; the profile's max_speed_mps reaches detection."
 from __future__ import annotations
 
 import json
-import socket
 import threading
 import time
 from pathlib import Path
@@ -19,6 +18,7 @@ from host.capture import read_capture
 from model.profile import load_profile
 from radar.cli import build_parser, main
 from radar.commands.view import build
+from tests.test_records_udp import _round_trip
 
 SMALL = """name = "small"
 [waveform]
@@ -56,12 +56,6 @@ def _one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1, err
     return err
-
-
-def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 # ---- radar detect ----------------------------------------------------------------------------
@@ -126,19 +120,6 @@ def test_simulate_on_a_profile_or_preset(tmp_path, files, radar):
 
 
 # ---- radar capture / replay / receive ------------------------------------------------------
-def _round_trip(tmp_path: Path, cap: Path, receive_args: list[str]) -> tuple[int | None, dict]:
-    port, out, rc = _free_port(), tmp_path / "rx.json", {}
-    t = threading.Thread(target=lambda: rc.update(rc=main([
-        "receive", "--port", str(port), "--idle-timeout", "1", "--timeout", "30",
-        "--json", str(out), *receive_args])))
-    t.start()
-    time.sleep(0.5)
-    assert main(["replay", "--capture", str(cap), "--port", str(port), "--rate-mbps",
-                 "0"]) == 0
-    t.join(timeout=60)
-    return rc.get("rc"), json.loads(out.read_text())
-
-
 @pytest.mark.parametrize("radar", ["small", "paper-fpga"])
 def test_capture_replay_receive_on_a_profile_or_preset(tmp_path, files, capsys, radar):
     spec = files.get(radar, radar)
@@ -149,7 +130,8 @@ def test_capture_replay_receive_on_a_profile_or_preset(tmp_path, files, capsys, 
     info, _ = read_capture(cap)
     cfg = load_profile(spec).config
     assert info.matches(cfg)
-    rc, doc = _round_trip(tmp_path, cap, ["--radar", spec])
+    rc, out = _round_trip(tmp_path, cap, ["--radar", spec])
+    doc = json.loads(out.read_text())
     assert rc == 0 and doc["preset"] == radar
     assert [f["complete"] for f in doc["frame_info"]] == [True, True]
     assert {p["frame"] for p in doc["points"]} == {0, 1}
@@ -237,3 +219,12 @@ def test_a_bad_profile_is_one_line(tmp_path, capsys):
                  ["receive", "--json", str(tmp_path / "x.json")]):
         assert main([*argv, "--radar", str(tmp_path / "nope.toml")]) == 2
         assert "no such file" in _one_line_error(capsys)
+
+
+def test_a_profile_capture_without_its_radar_says_so(tmp_path, files, capsys):
+    cap = tmp_path / "c.dmacap"
+    assert main(["capture", "--scene", files["scene"], "--radar", files["small"], "--frames",
+                 "1", "--out", str(cap)]) == 0
+    capsys.readouterr()
+    assert main(["view", "--replay", str(cap), "--duration", "0.1", "--port", "0"]) == 2
+    assert "give its --radar" in _one_line_error(capsys)

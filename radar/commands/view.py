@@ -90,7 +90,8 @@ def preset_of_capture(path: Path) -> RadarConfig:
         cfg = get_preset(name)
         if info.matches(cfg):
             return cfg
-    raise ValueError(f"{path}: no preset has the capture's geometry {info}")
+    raise ValueError(f"{path}: no preset has the capture's geometry {info} (a radar "
+                     f"profile's capture: give its --radar)")
 
 
 def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
