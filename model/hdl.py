@@ -1,6 +1,7 @@
 """The RTL's side of a radar configuration: the HDL parameters a ``model.config.RadarConfig``
-gives the top and the fixed facts of the data path (sample width, fabric clock, the external
-frame store's bus width), in one place for the tests, the RTL frame source and synthesis."""
+gives the top, what of a configuration the top does not elaborate (:func:`check_hdl`) and the
+fixed facts of the data path (sample width, fabric clock, the external frame store's bus
+width), in one place for the tests, the frame sources and synthesis."""
 
 from __future__ import annotations
 

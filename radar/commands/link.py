@@ -254,8 +254,9 @@ def cmd_receive(args: argparse.Namespace) -> int:
         return 130
     if not clouds:
         why = ("no datagram arrived" if not rx.datagrams else
-               "no datagram was a DMA packet of a known preset (another radar's: give "
-               "its --radar)" + (
+               "no datagram was a DMA packet of " + (
+                   f"radar {fixed.name}" if fixed else
+                   "a known preset (another radar's stream: give its --radar)") + (
                    f" ({rx.unusable[0][:300]})" if rx.unusable else "") if not decoder else
                "every frame was damaged (see --use-damaged)")
         print(f"radar receive: error: no usable frame: {why} within {args.timeout:g} s",
