@@ -213,23 +213,37 @@ def estimation_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> lis
         res = [merged[f"est:{s}"] for s in snr]
         rmse = [math.sqrt(r[key] / r["trials"]) for r in res]
         crb = [dt.tone_frequency_crb(10 ** (s / 10), n, looks) * to_unit for s in snr]
-        excess = [10 * math.log10(a / b) for a, b in zip(rmse, crb, strict=True)]
-        thr = None
-        for i in range(len(snr) - 1, -1, -1):   # lowest SNR from which on within 3 dB
-            if excess[i] > 3.0:
-                break
-            thr = snr[i]
-        above = [e for s, e in zip(snr, excess, strict=True) if thr is not None and s >= thr]
-        rows.append({"quantity": quantity, "chain": "float", "unit": unit, "snr_db": snr,
-                     "cell_snr_db": [round(s + gain, 3) for s in snr],
-                     "n_elements" if quantity == "azimuth" else "n_samples": n,
-                     "looks": looks, "rmse": [float(f"{v:.5g}") for v in rmse],
-                     "crb": [float(f"{v:.5g}") for v in crb],
-                     "excess_db": [round(e, 2) for e in excess], "trials": res[0]["trials"],
-                     "threshold_snr_db": thr,
-                     "excess_above_threshold_db": None if not above else
-                     round(float(np.median(above)), 2)})
+        row = {"quantity": quantity, "chain": "float", "unit": unit, "snr_db": snr,
+               "cell_snr_db": [round(s + gain, 3) for s in snr],
+               "n_elements" if quantity == "azimuth" else "n_samples": n, "looks": looks,
+               "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],
+               "excess_db": _excess(rmse, crb), "trials": res[0]["trials"]}
+        bound = crb
+        if quantity == "azimuth":      # the array's bound for the one-cell snapshot
+            bound = [dt.tone_frequency_crb(10 ** ((s + gain) / 10), n) * to_unit for s in snr]
+            row["crb_array"] = [float(f"{v:.5g}") for v in bound]
+            row["excess_array_db"] = _excess(rmse, bound)
+        row.update(_threshold(snr, _excess(rmse, bound)))
+        rows.append(row)
     return rows
+
+
+def _excess(rmse: list[float], bound: list[float]) -> list[float]:
+    """MSE over the bound's variance, dB (20 log10 of the RMSE ratio)."""
+    return [round(20 * math.log10(a / b), 2) for a, b in zip(rmse, bound, strict=True)]
+
+
+def _threshold(snr: list[float], excess: list[float]) -> dict[str, float | None]:
+    """``threshold_snr_db``: the lowest grid SNR from which on every point is within 3 dB
+    (MSE) of the bound; ``excess_above_threshold_db``: the median excess there."""
+    thr = None
+    for i in range(len(snr) - 1, -1, -1):
+        if excess[i] > 3.0:
+            break
+        thr = snr[i]
+    above = [e for s, e in zip(snr, excess, strict=True) if thr is not None and s >= thr]
+    return {"threshold_snr_db": thr, "excess_above_threshold_db":
+            round(float(np.median(above)), 2) if above else None}
 
 
 def document(plan: Plan, seed: int, merged: dict[str, Any]) -> dict[str, Any]:

@@ -52,6 +52,9 @@ def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
         fig, ax = plt.subplots(figsize=(4.6, 3.4))
         ax.semilogy(r["snr_db"], r["rmse"], "o-", ms=3, label=f"RMSE, {r['chain']} chain")
         ax.semilogy(r["snr_db"], r["crb"], "k--", lw=1, label="Cramer-Rao bound")
+        if "crb_array" in r:
+            ax.semilogy(r["snr_db"], r["crb_array"], "k:", lw=1,
+                        label="array CRB of the cell snapshot")
         if r["threshold_snr_db"] is not None:
             ax.axvline(r["threshold_snr_db"], color="grey", lw=0.8, ls=":",
                        label="threshold (within 3 dB from here)")

@@ -110,3 +110,30 @@ def test_curves_unreachable_ray_address_from_the_environment(tmp_path: Path, cap
     monkeypatch.setenv("RAY_ADDRESS", "127.0.0.1:1")
     assert main(["curves", "--quick", "--json", str(tmp_path / "c.json")]) == 2
     assert "no Ray cluster at 127.0.0.1:1" in capsys.readouterr().err
+
+
+def test_radar_curves_tiny_run_and_resume(local_ray, tmp_path: Path) -> None:
+    """The whole command on tiny grids: the JSON layout of docs/curves.md, theory at SNR 0
+    equal to the Pfa, a second run served from the results file."""
+    out = tmp_path / "curves.json"
+    argv = ["curves", "--quick", "--json", str(out), "--trials", "70", "--pfa-cells", "8192",
+            "--pfa", "1e-3", "--cell-snr", "-2", "2", "4", "--snr", "-40", "-30", "10",
+            "--workers", "2", "--plots", str(tmp_path / "img")]
+    assert main(argv) == 0
+    doc = json.loads(out.read_text())
+    assert len(doc["detection"]) == 5 * 2           # 5 detectors x 2 Swerling cases
+    row = doc["detection"][0]
+    for key in ("detector", "path", "swerling", "pfa", "train_cells", "guard_cells",
+                "effective_train_cells", "integrated_channels", "snr_db", "cell_snr_db",
+                "pd", "pd_theory", "trials", "pfa_measured", "snr_at_pd"):
+        assert key in row, key
+    assert row["train_cells"] == 248 and row["integrated_channels"] == 64
+    assert row["snr_db"][0] == pytest.approx(-2 - doc["cell_gain_db"])
+    assert {r["quantity"] for r in doc["estimation"]} == {"range", "radial_velocity",
+                                                         "azimuth"}
+    assert sorted(p.name for p in (tmp_path / "img").iterdir())[:2] == [
+        "crb_azimuth.png", "crb_radial_velocity.png"]
+    lines = (tmp_path / "curves.campaign.jsonl").read_text().count("\n")
+    out.unlink()
+    assert main(argv) == 0 and json.loads(out.read_text()) == doc
+    assert (tmp_path / "curves.campaign.jsonl").read_text().count("\n") == lines

@@ -26,6 +26,8 @@ def plan_of(args: argparse.Namespace) -> Plan:
         over.update(cell_snr_sw0=tuple(args.cell_snr), cell_snr_sw1=tuple(args.cell_snr))
     if args.snr is not None:
         over["snr"] = tuple(args.snr)
+    if args.pfa_cells is not None:
+        over["pfa_cells"] = args.pfa_cells
     plan = dataclasses.replace(plan, **over)
     try:
         plan.check()
@@ -86,6 +88,9 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "estimation and resolution trials; --quick: 420 / 300)")
     s.add_argument("--pfa", type=float, nargs="+", default=None,
                    help="false-alarm probabilities of the detection curves (default 1e-4 1e-6)")
+    s.add_argument("--pfa-cells", type=int, default=None,
+                   help="noise-only cells the measured Pfa counts over (default 1e7; "
+                        "--quick: 1.2e6)")
     s.add_argument("--cell-snr", type=float, nargs=3, default=None,
                    metavar=("LO", "HI", "STEP"),
                    help="per-channel cell SNR grid of the Pd curves, dB (default per Swerling "
