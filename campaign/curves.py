@@ -9,6 +9,7 @@ FFTs' coherent gain with Hann windows (:func:`cell_gain_db`; a target at a bin c
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +30,10 @@ CELL_SNR_LIMITS = (-30.0, 40.0)
 """Per-channel cell SNRs (dB) a detection grid may span: beyond, every Pd is 0 or 1."""
 SNR_LIMITS = (-90.0, 10.0)
 """Per-sample SNRs (dB) an estimation grid may span."""
+CHAINS = ("float", "quantised")
+"""Estimation chains: the float chain's cells, and the same cells rounded to the FPGA's
+integer output (its LSB at 1.56 LSB RMS noise per cell; the FFT stages' internal rounding is
+not modelled)."""
 
 
 @dataclass(frozen=True)
@@ -101,8 +106,8 @@ def tasks(plan: Plan) -> dict[str, list[Task]]:
                                                      "pfas": pfas, "shape": list(MAP_SHAPE)},
                                        -(-plan.pd_trials // per_map), 4)
     for s in grid(plan.snr, "--snr", *SNR_LIMITS):
-        out[f"est:{s}"] = split("estimation", {"snr_db": s, "azimuth_deg": plan.azimuth_deg},
-                                plan.est_trials, 250)
+        out[f"est:{s}"] = split("estimation", {"snr_db": s, "azimuth_deg": plan.azimuth_deg,
+                                               "chains": list(CHAINS)}, plan.est_trials, 250)
     for s in grid(plan.separations, "--separations", 0.05, 10.0):
         out[f"res:{s}"] = split("resolution", {"sep_bw": s,
                                                "cell_snr_db": plan.res_cell_snr_db},
@@ -209,11 +214,11 @@ def estimation_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> lis
         ("radial_velocity", "m/s", "se_velocity_mps", nd, nr * nv, nd * cfg.velocity_bin_mps),
         ("azimuth", "deg", "se_azimuth_deg", nv, nr * nd, 2.0 / cos_az * 180.0 / math.pi))
     rows = []
-    for quantity, unit, key, n, looks, to_unit in specs:
+    for (quantity, unit, key, n, looks, to_unit), chain in itertools.product(specs, CHAINS):
         res = [merged[f"est:{s}"] for s in snr]
-        rmse = [math.sqrt(r[key] / r["trials"]) for r in res]
+        rmse = [math.sqrt(r[f"{chain}:{key}"] / r["trials"]) for r in res]
         crb = [dt.tone_frequency_crb(10 ** (s / 10), n, looks) * to_unit for s in snr]
-        row = {"quantity": quantity, "chain": "float", "unit": unit, "snr_db": snr,
+        row = {"quantity": quantity, "chain": chain, "unit": unit, "snr_db": snr,
                "cell_snr_db": [round(s + gain, 3) for s in snr],
                "n_elements" if quantity == "azimuth" else "n_samples": n, "looks": looks,
                "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],

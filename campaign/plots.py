@@ -48,9 +48,13 @@ def detection_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
 def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
     """RMSE against the CRB per quantity, and the resolution probability."""
     out = []
-    for r in doc["estimation"]:
+    for quantity in dict.fromkeys(r["quantity"] for r in doc["estimation"]):
+        rows = [r for r in doc["estimation"] if r["quantity"] == quantity]
+        r = rows[0]
         fig, ax = plt.subplots(figsize=(4.6, 3.4))
-        ax.semilogy(r["snr_db"], r["rmse"], "o-", ms=3, label=f"RMSE, {r['chain']} chain")
+        for row, style in zip(rows, ("o-", "s--"), strict=False):
+            ax.semilogy(row["snr_db"], row["rmse"], style, ms=3,
+                        label=f"RMSE, {row['chain']} chain")
         ax.semilogy(r["snr_db"], r["crb"], "k--", lw=1, label="Cramer-Rao bound")
         if "crb_array" in r:
             ax.semilogy(r["snr_db"], r["crb_array"], "k:", lw=1,
@@ -59,11 +63,11 @@ def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
             ax.axvline(r["threshold_snr_db"], color="grey", lw=0.8, ls=":",
                        label="threshold (within 3 dB from here)")
         ax.set_xlabel("per-channel, per-sample SNR, dB")
-        ax.set_ylabel(f"{r['quantity'].replace('_', ' ')}, {r['unit']}")
+        ax.set_ylabel(f"{quantity.replace('_', ' ')}, {r['unit']}")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
         fig.tight_layout()
-        p = folder / f"crb_{r['quantity']}.png"
+        p = folder / f"crb_{quantity}.png"
         fig.savefig(p, dpi=110)
         plt.close(fig)
         out.append(p)

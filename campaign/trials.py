@@ -6,8 +6,9 @@ Trial ``i`` draws from ``numpy.random.default_rng([seed, group, i])``.
   detector of :data:`DETECTORS` at every Pfa of ``params["pfas"]``; counts of detections at
   the target cells (Pd) or, for a noise-only map (``cell_snr_db`` None), over all cells
   (Pfa).
-- ``estimation``: one target per trial in the float chain's cells around it; squared errors
-  of range, radial velocity and azimuth from the host's estimators.
+- ``estimation``: one target per trial in the float chain's cells around it (and those cells
+  rounded to the FPGA's integer LSB); squared errors of range, radial velocity and azimuth
+  from the host's estimators.
 - ``resolution``: two equal targets in one cell, ``sep_bw`` beamwidths apart; how often the
   host's angle estimator resolves them.
 """
@@ -113,14 +114,36 @@ def detection(params: dict[str, Any], trials: range, seed: int, group: int
     return {"cells": cells, "hits": hits.tolist()}
 
 
+def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(range bins, Doppler bins, sin(az)) estimated from cells complex (n, L, 2 half + 1,
+    2 half + 1) around each target (noise power ``noise`` per channel and cell): the cell of
+    the integrated map's maximum among the 3 x 3 around the centre, the host's Gaussian
+    interpolation (``host.cells``) and angle estimator (``host.angle``, strongest component);
+    bins relative to the centre cell."""
+    n = len(cube)
+    nci = np.sum(cube.real ** 2 + cube.imag ** 2, axis=1)
+    centre = nci[:, half - 1:half + 2, half - 1:half + 2].reshape(n, 9).argmax(axis=1)
+    pr, pd = centre // 3 + half - 1, centre % 3 + half - 1
+    idx = np.arange(n)
+    logp = np.log(np.maximum(nci, 1e-300))
+    nb = np.stack([logp[idx, pr - 1, pd], logp[idx, pr + 1, pd], logp[idx, pr, pd - 1],
+                   logp[idx, pr, pd + 1]], axis=1)
+    off = neighbour_offsets(logp[idx, pr, pd], nb, np.ones(n, bool))
+    got = estimate_angles(cube[idx, :, pr, pd], np.full(n, noise), AngleParams())
+    first = np.searchsorted(got.cell, idx)                 # strongest component of each row
+    return pr - half + off[:, 0], pd - half + off[:, 1], got.sin_az[first]
+
+
 def estimation(params: dict[str, Any], trials: range, seed: int, group: int
                ) -> dict[str, Any]:
-    """params: ``snr_db`` per-channel per-sample SNR, ``azimuth_deg``. One target per trial
-    at a random sub-bin position (and azimuth within half a beamwidth of ``azimuth_deg``);
-    the cell of the integrated map's maximum among the 3 x 3 around it is the detected one;
-    range and Doppler by the host's Gaussian interpolation (``host.cells``), azimuth by the
-    host's angle estimator (``host.angle``, its strongest component). Returns ``trials`` and
-    the sums of squared errors ``se_range_m``, ``se_velocity_mps``, ``se_azimuth_deg``."""
+    """params: ``snr_db`` per-channel per-sample SNR, ``azimuth_deg``, ``chains`` (a list
+    of ``float``, ``quantised``). One target per trial at a random sub-bin position (and
+    azimuth within half a beamwidth of ``azimuth_deg``), estimated by :func:`_estimate` from
+    the float chain's cells and, for ``quantised``, from the same cells in the FPGA's LSB
+    (:func:`fpga_noise_lsb`) with I and Q rounded to integers. Returns ``trials`` and per
+    chain the sums of squared errors ``<chain>:se_range_m``, ``<chain>:se_velocity_mps``,
+    ``<chain>:se_azimuth_deg``."""
     cfg = PRESETS[PRESET]
     n = len(trials)
     rngs = [rng_of(seed, group, t) for t in trials]
@@ -133,23 +156,24 @@ def estimation(params: dict[str, Any], trials: range, seed: int, group: int
                                            10 ** (params["snr_db"] / 10), offsets[i:i + 1],
                                            sin_az[i:i + 1], half)
                            for i, r in enumerate(rngs)])               # (n, L, 5, 5)
-    nci = np.sum(np.abs(cube) ** 2, axis=1)
-    centre = nci[:, half - 1:half + 2, half - 1:half + 2].reshape(n, 9).argmax(axis=1)
-    pr, pd = centre // 3 + half - 1, centre % 3 + half - 1
-    idx = np.arange(n)
-    logp = np.log(np.maximum(nci, 1e-300))
-    nb = np.stack([logp[idx, pr - 1, pd], logp[idx, pr + 1, pd], logp[idx, pr, pd - 1],
-                   logp[idx, pr, pd + 1]], axis=1)
-    off = neighbour_offsets(logp[idx, pr, pd], nb, np.ones(n, bool))
-    err_r = (pr - half + off[:, 0] - offsets[:, 0]) * cfg.range_bin_m
-    err_v = (pd - half + off[:, 1] - offsets[:, 1]) * cfg.velocity_bin_mps
     noise = maps.patch_noise_per_channel(cfg.n_range, cfg.n_doppler)
-    got = estimate_angles(cube[idx, :, pr, pd], np.full(n, noise), AngleParams())
-    first = np.searchsorted(got.cell, idx)                 # strongest component of each row
-    err_a = got.azimuth_deg[first] - np.degrees(np.arcsin(sin_az))
-    return {"trials": n, "se_range_m": float(np.sum(err_r ** 2)),
-            "se_velocity_mps": float(np.sum(err_v ** 2)),
-            "se_azimuth_deg": float(np.sum(err_a ** 2))}
+    out: dict[str, Any] = {"trials": n}
+    for chain in params["chains"]:
+        if chain == "float":
+            est = _estimate(cube, noise, half, cfg)
+        else:
+            lsb = fpga_noise_lsb(cfg)
+            q = cube * (lsb / np.sqrt(noise))
+            est = _estimate(np.rint(q.real) + 1j * np.rint(q.imag), lsb ** 2 + 1 / 6, half,
+                            cfg)
+        az = np.degrees(np.arcsin(np.clip(est[2], -1.0, 1.0)))
+        out[f"{chain}:se_range_m"] = float(np.sum(((est[0] - offsets[:, 0])
+                                                   * cfg.range_bin_m) ** 2))
+        out[f"{chain}:se_velocity_mps"] = float(np.sum(((est[1] - offsets[:, 1])
+                                                        * cfg.velocity_bin_mps) ** 2))
+        out[f"{chain}:se_azimuth_deg"] = float(np.sum((az - np.degrees(np.arcsin(sin_az)))
+                                                      ** 2))
+    return out
 
 
 def resolution(params: dict[str, Any], trials: range, seed: int, group: int

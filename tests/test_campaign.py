@@ -22,7 +22,8 @@ def tiny_tasks() -> list[Task]:
                                 "shape": SHAPE}, 3, 1)
             + split("detection", {"swerling": 0, "cell_snr_db": None, "pfas": [1e-2, 1e-4],
                                   "shape": SHAPE}, 2, 1)
-            + split("estimation", {"snr_db": -40.0, "azimuth_deg": 10.0}, 40, 20)
+            + split("estimation", {"snr_db": -40.0, "azimuth_deg": 10.0,
+                                   "chains": ["float", "quantised"]}, 40, 20)
             + split("resolution", {"sep_bw": 0.8, "cell_snr_db": 20.0}, 40, 20))
 
 
@@ -72,7 +73,7 @@ def test_interrupted_campaign_resumes_to_the_same_numbers(local_ray, tmp_path: P
 def test_task_seeds_do_not_depend_on_the_split() -> None:
     """A trial's numbers depend on its index, not on the task that holds it."""
     from campaign.runner import execute
-    params = {"snr_db": -40.0, "azimuth_deg": 10.0}
+    params = {"snr_db": -40.0, "azimuth_deg": 10.0, "chains": ["float", "quantised"]}
     whole = split("estimation", params, 6, 6)[0]
     parts = split("estimation", params, 6, 2)
     a = execute(whole.kind, params, 0, 6, 3, whole.group())
@@ -95,6 +96,7 @@ def test_bad_campaign_inputs() -> None:
     ["--snr", "nan", "0", "1"],
     ["--snr", "-10", "-20", "1"],
     ["--workers", "0"],
+    ["--seed", "-1"],
     ["--ray-address", "127.0.0.1:1"],
     ["--ray-address", "nonsense"],
 ])
@@ -129,8 +131,8 @@ def test_radar_curves_tiny_run_and_resume(local_ray, tmp_path: Path) -> None:
         assert key in row, key
     assert row["train_cells"] == 248 and row["integrated_channels"] == 64
     assert row["snr_db"][0] == pytest.approx(-2 - doc["cell_gain_db"])
-    assert {r["quantity"] for r in doc["estimation"]} == {"range", "radial_velocity",
-                                                         "azimuth"}
+    assert {(r["quantity"], r["chain"]) for r in doc["estimation"]} == {
+        (q, c) for q in ("range", "radial_velocity", "azimuth") for c in ("float", "quantised")}
     assert sorted(p.name for p in (tmp_path / "img").iterdir())[:2] == [
         "crb_azimuth.png", "crb_radial_velocity.png"]
     lines = (tmp_path / "curves.campaign.jsonl").read_text().count("\n")

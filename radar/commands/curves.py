@@ -40,6 +40,8 @@ def cmd_curves(args: argparse.Namespace) -> int:
     plan = plan_of(args)
     if args.workers < 1:
         raise CliError(f"--workers: must be at least 1, got {args.workers}")
+    if not 0 <= args.seed < 2**63:
+        raise CliError(f"--seed: must be an integer in 0..2^63-1, got {args.seed}")
     out = out_file(args.json, ".json", "--json")
     results = out_file(args.results or str(out.with_suffix(".campaign.jsonl")), ".jsonl",
                        "--results")
