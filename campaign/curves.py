@@ -26,6 +26,8 @@ from model.config import PRESETS, RadarConfig
 
 MAP_SHAPE = (64, 128)
 """(range, Doppler) cells of each synthetic detection map."""
+COND_MAP_SHAPE = (128, 128)
+"""Maps of the conditional Pfa estimate (other maps than the counted ones)."""
 CELL_SNR_LIMITS = (-30.0, 40.0)
 """Per-channel cell SNRs (dB) a detection grid may span: beyond, every Pd is 0 or 1."""
 SNR_LIMITS = (-90.0, 10.0)
@@ -53,6 +55,12 @@ class Plan:
     res_trials: int = 1000
     res_cell_snr_db: float = 20.0
     azimuth_deg: float = 10.0
+
+    @property
+    def pfa_cond_cells(self) -> int:
+        """Noise cells of the conditional Pfa estimate (other maps): a fifth of the counted
+        ones (its spread is far smaller)."""
+        return max(1, self.pfa_cells // 5)
 
     @staticmethod
     def quick() -> Plan:
@@ -97,9 +105,14 @@ def tasks(plan: Plan) -> dict[str, list[Task]]:
     cells_per_map = MAP_SHAPE[0] * MAP_SHAPE[1]
     per_map = len(tr.maps.target_grid(MAP_SHAPE, _reach()))
     pfas = list(plan.pfas)
-    out: dict[str, list[Task]] = {"pfa": split(
-        "detection", {"swerling": 0, "cell_snr_db": None, "pfas": pfas,
-                      "shape": list(MAP_SHAPE)}, -(-plan.pfa_cells // cells_per_map), 8)}
+    cond_cells = COND_MAP_SHAPE[0] * COND_MAP_SHAPE[1]
+    out: dict[str, list[Task]] = {
+        "pfa": split("detection", {"swerling": 0, "cell_snr_db": None, "pfas": pfas,
+                                   "shape": list(MAP_SHAPE)},
+                     -(-plan.pfa_cells // cells_per_map), 8),
+        "pfa_cond": split("detection", {"swerling": 0, "cell_snr_db": None, "pfas": pfas,
+                                        "shape": list(COND_MAP_SHAPE)},
+                          -(-plan.pfa_cond_cells // cond_cells), 4)}
     for sw, g in ((0, plan.cell_snr_sw0), (1, plan.cell_snr_sw1)):
         for s in grid(g, "--cell-snr", *CELL_SNR_LIMITS):
             out[f"sw{sw}:{s}"] = split("detection", {"swerling": sw, "cell_snr_db": s,
@@ -179,7 +192,7 @@ def detection_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> list
         for pi, pfa in enumerate(plan.pfas):
             col = di * npfa + pi
             alpha, q, n_train, n_eff, noise = _theory(path, kind, pfa, n_ch, lsb)
-            fa = merged["pfa"]
+            fa, cond = merged["pfa"], merged["pfa_cond"]
             for sw, g in ((0, plan.cell_snr_sw0), (1, plan.cell_snr_sw1)):
                 cell = grid(g, "--cell-snr", *CELL_SNR_LIMITS)
                 pd = [merged[f"sw{sw}:{s}"]["hits"][col] / merged[f"sw{sw}:{s}"]["cells"]
@@ -199,7 +212,9 @@ def detection_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> list
                     "pd": [round(p, 5) for p in pd], "pd_theory": [round(p, 5) for p in theory],
                     "trials": merged[f"sw{sw}:{cell[0]}"]["cells"],
                     "pfa_measured": fa["hits"][col] / fa["cells"], "pfa_cells": fa["cells"],
-                    "pfa_false_alarms": fa["hits"][col], "snr_at_pd": at})
+                    "pfa_false_alarms": fa["hits"][col],
+                    "pfa_conditional": float(f"{cond['pfa_sum'][col] / cond['cells']:.4g}"),
+                    "pfa_conditional_cells": cond["cells"], "snr_at_pd": at})
     return rows
 
 

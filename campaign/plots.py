@@ -28,7 +28,7 @@ def detection_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
             for r, colour in zip([r for r in mine if (r["path"], r["detector"]) == (path, kind)],
                                  ("C0", "C3", "C2", "C1"), strict=False):
                 ax.plot(r["cell_snr_db"], r["pd"], "o", ms=3, color=colour,
-                        label=f"Pfa {r['pfa']:g} (meas. {r['pfa_measured']:.2g})")
+                        label=f"Pfa {r['pfa']:g} (meas. {r['pfa_conditional']:.2g})")
                 ax.plot(r["cell_snr_db"], r["pd_theory"], "-", lw=1, color=colour)
             ax.set_title(f"{path} {kind.upper()}-CFAR", fontsize=9)
             ax.set_xlabel("per-channel cell SNR, dB")

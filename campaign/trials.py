@@ -20,6 +20,7 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
+from scipy import stats
 
 from campaign import maps
 from host.angle import AngleParams, estimate_angles
@@ -66,11 +67,14 @@ def _fpga(shape: tuple[int, int], kind: str, pfa: float, n_channels: int
     return d.cfar, d.scale()
 
 
-def detect_all(cube: np.ndarray, pfas: list[float], fpga_lsb: float) -> list[np.ndarray]:
-    """Detection maps bool (n_range, n_doppler) of every (detector, Pfa), detector-major
-    (:data:`DETECTORS`, then ``pfas``), for a cube complex (L, n_range, n_doppler) with unit
-    noise per channel and cell. The FPGA model gets the cube in LSB (noise ``fpga_lsb`` RMS
-    per channel), I and Q rounded to integers, integrated exactly."""
+def detect_all(cube: np.ndarray, pfas: list[float], fpga_lsb: float
+               ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(detections bool, threshold float) maps (n_range, n_doppler) of every (detector, Pfa),
+    detector-major (:data:`DETECTORS`, then ``pfas``), for a cube complex (L, n_range,
+    n_doppler) with unit noise per channel and cell. The FPGA model gets the cube in LSB
+    (noise ``fpga_lsb`` RMS per channel), I and Q rounded to integers, integrated exactly;
+    its threshold (in LSB^2: the cell detects when its power exceeds it) is the training sum
+    times the row's scale over 2^scale_frac (every row may detect here)."""
     n_channels, shape = cube.shape[0], cube.shape[1:]
     nci = np.sum(cube.real ** 2 + cube.imag ** 2, axis=0)
     q = cube * fpga_lsb
@@ -82,10 +86,14 @@ def detect_all(cube: np.ndarray, pfas: list[float], fpga_lsb: float) -> list[np.
             if path == "host":
                 thr, _ = cfar_threshold(nci, n_channels, CfarParams(
                     pfa=pfa, guard=GUARD, train=TRAIN, kind=kind), (True, True))
-                out.append(nci > thr)
+                out.append((nci > thr, thr))
             else:
                 cfg, scale = _fpga(tuple(shape), kind, pfa, n_channels)
-                out.append(cfar_2d.cfar_2d(power, cfg, scale).detect)
+                cells = cfar_2d.cfar_2d(power, cfg, scale)
+                row_scale = np.array([scale[cfar_2d.edge_index(r, cfg)]
+                                      for r in range(shape[0])], float)
+                thr = cells.train_sum * row_scale[:, None] / (1 << cfg.scale_frac)
+                out.append((cells.detect, thr))
     return out
 
 
@@ -93,25 +101,39 @@ def detection(params: dict[str, Any], trials: range, seed: int, group: int
               ) -> dict[str, Any]:
     """params: ``swerling`` 0/1, ``cell_snr_db`` (None: noise only), ``pfas`` list,
     ``shape`` [n_range, n_doppler] of the maps. Returns ``cells`` (tested cells) and
-    ``hits`` (detections per (detector, Pfa), :func:`detect_all` order)."""
+    ``hits`` (detections per (detector, Pfa), :func:`detect_all` order); for noise-only maps
+    also ``pfa_sum``: the sum over the cells of P(X > the cell's threshold) for X the cell
+    under test's noise-only statistic, independent of its training cells (conditional Monte
+    Carlo: its mean is the Pfa, with far less spread than counting false alarms). X is
+    Gamma(L, 1) for the host; for the FPGA, Gamma(L, noise) with noise = fpga_lsb^2 + 1/6
+    LSB^2 per channel (the rounding's mean; an approximation of the rounded values' sum)."""
     cfg = PRESETS[PRESET]
     shape = tuple(params["shape"])
     snr_db = params["cell_snr_db"]
     targets = maps.target_grid(shape, (GUARD[0] + TRAIN[0], GUARD[1] + TRAIN[1]))
     hits = np.zeros(len(DETECTORS) * len(params["pfas"]), np.int64)
+    pfa_sum = np.zeros(len(hits))
     cells = 0
+    lsb = fpga_noise_lsb(cfg)
     for t in trials:
         rng = rng_of(seed, group, t)
         snr = 0.0 if snr_db is None else 10 ** (snr_db / 10)
         cube = maps.detection_map(rng, cfg.n_virtual, shape, targets, snr, params["swerling"])
-        dets = detect_all(cube, params["pfas"], fpga_noise_lsb(cfg))
+        dets = detect_all(cube, params["pfas"], lsb)
         if snr_db is None:
-            hits += [int(d.sum()) for d in dets]
+            hits += [int(d.sum()) for d, _ in dets]
             cells += shape[0] * shape[1]
+            paths = [path for path, _ in DETECTORS for _ in params["pfas"]]
+            for i, ((_, thr), path) in enumerate(zip(dets, paths, strict=True)):
+                theta = 1.0 if path == "host" else lsb ** 2 + 1 / 6
+                pfa_sum[i] += float(np.sum(stats.gamma.sf(thr, cfg.n_virtual, scale=theta)))
         else:
-            hits += [int(d[targets[:, 0], targets[:, 1]].sum()) for d in dets]
+            hits += [int(d[targets[:, 0], targets[:, 1]].sum()) for d, _ in dets]
             cells += len(targets)
-    return {"cells": cells, "hits": hits.tolist()}
+    out = {"cells": cells, "hits": hits.tolist()}
+    if snr_db is None:
+        out["pfa_sum"] = pfa_sum.tolist()
+    return out
 
 
 def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig

@@ -127,7 +127,7 @@ def test_radar_curves_tiny_run_and_resume(local_ray, tmp_path: Path) -> None:
     row = doc["detection"][0]
     for key in ("detector", "path", "swerling", "pfa", "train_cells", "guard_cells",
                 "effective_train_cells", "integrated_channels", "snr_db", "cell_snr_db",
-                "pd", "pd_theory", "trials", "pfa_measured", "snr_at_pd"):
+                "pd", "pd_theory", "trials", "pfa_measured", "pfa_conditional", "snr_at_pd"):
         assert key in row, key
     assert row["train_cells"] == 248 and row["integrated_channels"] == 64
     assert row["snr_db"][0] == pytest.approx(-2 - doc["cell_gain_db"])

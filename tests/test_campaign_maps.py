@@ -50,3 +50,16 @@ def test_target_grid_keeps_targets_out_of_each_others_windows() -> None:
     d[..., 1] = np.minimum(d[..., 1], 128 - d[..., 1])
     apart = (d[..., 0] > 7) | (d[..., 1] > 11) | (d == 0).all(axis=-1)
     assert apart.all() and len(grid) == 70
+
+
+def test_conditional_pfa_of_every_detector_is_the_configured_one() -> None:
+    """The detection trial's conditional Pfa estimate on noise-only maps: within 10 % of the
+    configured 1e-2 for CA, GO, SO within 15 % (neighbouring cells share their training
+    cells, so a few maps hold fewer independent samples than cells; OS, its independent-cell
+    factor: within 30 %)."""
+    from campaign.trials import DETECTORS, detection
+    r = detection({"swerling": 0, "cell_snr_db": None, "pfas": [1e-2], "shape": [64, 128]},
+                  range(2), 1, 2)
+    for (path, kind), s in zip(DETECTORS, r["pfa_sum"], strict=True):
+        assert s / r["cells"] == pytest.approx(1e-2, rel=0.3 if kind == "os" else 0.15), \
+            (path, kind)
