@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from campaign import maps
 from campaign import trials as tr
 from campaign.runner import CampaignError, Task, merge, run, split
 from host.cfar import CfarParams, effective_cells
@@ -103,7 +104,7 @@ def tasks(plan: Plan) -> dict[str, list[Task]]:
     """The campaign's tasks by curve (``"pfa"``, ``"sw0:<cell snr>"``, ``"sw1:..."``,
     ``"est:<snr>"``, ``"res:<sep>"``)."""
     cells_per_map = MAP_SHAPE[0] * MAP_SHAPE[1]
-    per_map = len(tr.maps.target_grid(MAP_SHAPE, _reach()))
+    per_map = len(maps.target_grid(MAP_SHAPE, _reach()))
     pfas = list(plan.pfas)
     cond_cells = COND_MAP_SHAPE[0] * COND_MAP_SHAPE[1]
     out: dict[str, list[Task]] = {
@@ -159,7 +160,7 @@ def _theory(path: str, kind: str, pfa: float, n_ch: int, fpga_lsb: float
         k = max(1, min(n_train, round(cp.os_rank * n_train)))
         return cfar_stats.os_factor(pfa, n_ch, n_train, k), dt.os_quantile(
             n_ch, n_train, k), n_train, float(n_train), 1.0
-    cfg, scale = tr._fpga(MAP_SHAPE, kind, pfa, n_ch)
+    cfg, scale = tr.fpga_cfar(MAP_SHAPE, kind, pfa, n_ch)
     half = kind != "ca"
     mask = cfar_2d.training_mask(cfg, cfg.pr, half)
     cells = float(mask.sum())

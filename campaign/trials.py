@@ -58,7 +58,7 @@ def fpga_noise_lsb(cfg: RadarConfig) -> float:
 
 
 @lru_cache(maxsize=64)
-def _fpga(shape: tuple[int, int], kind: str, pfa: float, n_channels: int
+def fpga_cfar(shape: tuple[int, int], kind: str, pfa: float, n_channels: int
           ) -> tuple[cfar_2d.Cfar2dConfig, np.ndarray]:
     """The FPGA CFAR configuration and scale table for a map of ``shape``."""
     num_tx = 4 if n_channels % 4 == 0 else 1
@@ -88,7 +88,7 @@ def detect_all(cube: np.ndarray, pfas: list[float], fpga_lsb: float
                     pfa=pfa, guard=GUARD, train=TRAIN, kind=kind), (True, True))
                 out.append((nci > thr, thr))
             else:
-                cfg, scale = _fpga(tuple(shape), kind, pfa, n_channels)
+                cfg, scale = fpga_cfar(tuple(shape), kind, pfa, n_channels)
                 cells = cfar_2d.cfar_2d(power, cfg, scale)
                 row_scale = np.array([scale[cfar_2d.edge_index(r, cfg)]
                                       for r in range(shape[0])], float)
