@@ -12,7 +12,7 @@ OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
-        formal coverage mutate mutate-ci
+        formal coverage mutate mutate-ci curves bench-ray
 all: test
 
 help:
@@ -42,6 +42,9 @@ help:
 	@echo "                     FORMAL_ARGS='cfar_2d -t bmc' runs a subset"
 	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
 	@echo "make mutate          mutation testing of rtl/ (MUTANTS=40 SEED=1), score per module"
+	@echo "make curves          Pd vs SNR against theory, RMSE vs CRB on Ray (CURVES_ARGS=--quick),"
+	@echo "                     $(OUT)/curves.json and docs/img/pd_*.png, crb_*.png (docs/curves.md)"
+	@echo "make bench-ray       the Monte-Carlo layer: 1 vs 2 Ray workers in the same run"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
@@ -117,6 +120,15 @@ mutate: $(STAMP)
 
 mutate-ci: $(STAMP)
 	MUTATE_CI=1 $(RUN) pytest -q -n 0 tests/test_verif_tools.py
+
+# Detection and estimation curves against theory on a local Ray (RAY_ADDRESS: a cluster);
+# rerunning resumes from $(OUT)/curves.campaign.jsonl. CURVES_ARGS= for the full grids.
+CURVES_ARGS ?= --quick
+curves: $(STAMP)
+	$(RUN) radar curves $(CURVES_ARGS) --json $(OUT)/curves.json --plots docs/img
+
+bench-ray: $(STAMP)
+	$(RUN) python -m benchmarks.bench_ray
 
 # Every (input gap, output backpressure) stall-regime pair of tb/stall_regimes.py (16 per
 # parameter set) instead of the 4-pair CI subset that `make test` runs

@@ -21,6 +21,7 @@ deterministic for a given ``--seed``.
     python tools/mutate.py --list frame_align          # every candidate mutant
     python tools/mutate.py -n 40 --seed 1              # 40 mutants spread over modules
     python tools/mutate.py --ci                        # the fixed CI subset
+    python tools/mutate.py --all --ray --workers 2     # every candidate, as Ray tasks
 """
 
 from __future__ import annotations
@@ -608,6 +609,14 @@ def main(argv: list[str] | None = None) -> int:
                          "meets the first one in the middle)")
     ap.add_argument("--timeout", type=float, default=300.0,
                     help="seconds per mutant (a hang counts as killed)")
+    ap.add_argument("--all", action="store_true", help="every candidate mutant, not a sample")
+    ap.add_argument("--ray", action="store_true",
+                    help="run the mutants as Ray tasks (tools/mutate_ray.py): a local Ray "
+                         "with --workers CPUs, or --ray-address / RAY_ADDRESS")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                    help="with --ray: mutants in flight at once")
+    ap.add_argument("--ray-address", default=None, metavar="ADDR",
+                    help="with --ray: an existing Ray cluster (HOST:PORT)")
     ap.add_argument("--json", type=Path, default=OUT / "results.json")
     ap.add_argument("--report", action="store_true",
                     help="only print the report of the verdicts already in --json")
@@ -652,6 +661,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: unknown mutants {missing}", file=sys.stderr)
             return 2
         chosen = [pool[w] for w in wanted]
+    elif args.all:
+        chosen = [m for mod in modules for m in candidates(mod)]
     else:
         chosen = sample(modules, args.n, args.seed)
     results: list[tuple[Mutant, str, float]] = []
@@ -662,9 +673,18 @@ def main(argv: list[str] | None = None) -> int:
         chosen = [m for m in chosen if m.ident not in done]
     if args.reverse:
         chosen = chosen[::-1]
-    for m in chosen:
-        verdict, secs = (run_mutant_formal(m, args.timeout) if args.formal
-                         else run_mutant(m, args.timeout, quick=args.quick or args.ci))
+    if args.ray and args.formal:
+        print("error: --ray runs the testbenches; not with --formal", file=sys.stderr)
+        return 2
+    if args.ray:
+        from mutate_ray import run_on_ray  # tools/ is on sys.path as the script's folder
+        runs = run_on_ray(chosen, args.timeout, args.quick or args.ci, args.workers,
+                          args.ray_address)
+    else:
+        runs = ((m, *(run_mutant_formal(m, args.timeout) if args.formal
+                      else run_mutant(m, args.timeout, quick=args.quick or args.ci)))
+                for m in chosen)
+    for m, verdict, secs in runs:
         results.append((m, verdict, secs))
         print(f"{m.ident:28s} {verdict:8s} {secs:6.0f} s  {m.path}:{m.line}: "
               f"{m.after.strip()[:60]}", flush=True)
