@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from model.config import C0, RadarConfig, db_to_lin, dbm_to_w
+from model.profile_fields import check_preset_chain
 from model.scene import Scatterers, Scene
 
 MAX_FRAME_INDEX = 1_000_000
@@ -166,9 +167,9 @@ def simulate_baseband(cfg: RadarConfig, sc: Scatterers, *, beamforming: bool = T
     Returns (complex128 (n_chirps, num_rx, n_range), scatterers not simulated: at or
     behind the radar (see :func:`passed_radar`) or beyond the IF band at the frame centre).
     ValueError for a profile the simulator does not model yet
-    (``RadarConfig.check_processable``).
+    (``model.profile_fields.check_preset_chain``).
     """
-    cfg.check_processable()
+    check_preset_chain(cfg, "the simulator")
     beat = cfg.beat_frequency_hz(frame_centre_range_m(cfg, sc, frame_index),
                                  sc.radial_velocity_mps)
     keep = (beat >= 0) & (beat < cfg.sample_rate_hz) & ~passed_radar(cfg, sc, frame_index)

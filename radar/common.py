@@ -13,7 +13,7 @@ from typing import TypeVar
 from tqdm import tqdm
 
 from host.cfar import CfarParams
-from host.params import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams
+from host.params import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams, default_guard
 from model.config import RadarConfig
 from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
 
@@ -40,9 +40,11 @@ def scene_of(args: argparse.Namespace) -> Scene:
 def detection_params(args: argparse.Namespace, scene_bf: bool = True,
                      cfg: RadarConfig | None = None) -> DetectionParams:
     """Host detection settings from the options of :func:`add_detection_options`, checked
-    against ``cfg`` when given (CFAR window larger than the map)."""
+    against ``cfg`` when given (CFAR window larger than the map); without ``--guard`` the
+    guard is ``cfg``'s main lobe (``host.params.default_guard``)."""
+    guard = tuple(args.guard) if cfg is None or given(args, "guard") else default_guard(cfg)
     try:
-        cfar = CfarParams(pfa=args.pfa, guard=tuple(args.guard), train=tuple(args.train),
+        cfar = CfarParams(pfa=args.pfa, guard=guard, train=tuple(args.train),
                           kind="os" if args.detector == "os" else "ca")
         params = DetectionParams(detector=args.detector, cfar=cfar,
                                  paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
@@ -169,7 +171,8 @@ def add_detection_options(p: argparse.ArgumentParser, max_speed_default: str | N
     p.add_argument("--pfa", type=float, default=1e-6,
                    help="CFAR false-alarm probability per range-Doppler cell (default 1e-6)")
     p.add_argument("--guard", type=int, nargs=2, default=(2, 2), metavar=("RANGE", "DOPPLER"),
-                   help="CFAR guard cells per side (default 2 2)")
+                   help="CFAR guard cells per side (default 2 2, the Hann main lobe; "
+                        "wider for a zero-padded profile)")
     p.add_argument("--train", type=int, nargs=2, default=(4, 8), metavar=("RANGE", "DOPPLER"),
                    help="CFAR training cells per side (default 4 8)")
     p.add_argument("--threshold-db", type=float, default=15.0,
