@@ -37,8 +37,10 @@ class Cells:
 
 def gaussian_offset(lm: np.ndarray | float, c: np.ndarray | float, lp: np.ndarray | float
                     ) -> np.ndarray:
-    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation);
-    element-wise over arrays, 0 where the samples do not curve down."""
+    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation: a
+    parabola through them, whatever the main lobe's width, so a zero-padded axis' wider
+    lobe needs nothing else); element-wise over arrays, 0 where the samples do not curve
+    down."""
     lm, c, lp = (np.asarray(v, dtype=float) for v in (lm, c, lp))
     den = lm - 2 * c + lp
     with np.errstate(divide="ignore", invalid="ignore"):

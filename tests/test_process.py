@@ -127,7 +127,8 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
     elif case == "unprocessable":            # TX 1 fires first: the chain refuses it
         radar = str(tmp_path / "order.cfg")
         Path(radar).write_text(CFG_FILE.read_text().replace(
-            "0 0 0 0 0 0 0 1\nchirpCfg 1 1 0 0 0 0 0 2", "0 0 0 0 0 0 0 2\nchirpCfg 1 1 0 0 0 0 0 1"))
+            "0 0 0 0 0 0 0 1\nchirpCfg 1 1 0 0 0 0 0 2",
+            "0 0 0 0 0 0 0 2\nchirpCfg 1 1 0 0 0 0 0 1"))
         want = "does not support TX firing order"
     elif case == "frames":
         extra = ["--frames", "1:3"]
