@@ -10,7 +10,6 @@ import time
 
 import numpy as np
 
-from host.adc_capture import open_capture
 from host.calibration import (
     calibration_document,
     estimate_calibration,
@@ -18,8 +17,8 @@ from host.calibration import (
     save_calibration,
 )
 from model.reference import radar_cube
-from radar.commands.process import frame_range, profile_of
-from radar.common import CliError, add_command, out_file, progress, warn
+from radar.commands.process import capture_of, profile_of
+from radar.common import CliError, add_command, out_file, progress
 
 
 def reflector_of(text: str) -> tuple[float, float, float]:
@@ -48,13 +47,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     why = reflector_range_error(reflector[0], cfg)
     if why:
         raise CliError(f"--reflector: {why}")
-    try:
-        capture = open_capture(args.capture, profile)
-    except ValueError as exc:
-        raise CliError(str(exc)) from None
-    if capture.dropped_bytes:
-        warn([capture.report()], "calibrate")
-    frames = frame_range(args.frames, capture.n_frames)
+    capture, frames = capture_of(args, profile, "calibrate")
     t0 = time.perf_counter()
     try:
         est = estimate_calibration((radar_cube(capture.frame(k), cfg) for k in

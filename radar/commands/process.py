@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from host.adc_capture import open_capture
+from host.adc_capture import NpyCapture, open_capture
 from host.calibration import check_calibration, load_calibration
+from host.dca1000 import Dca1000Capture
 from host.params import default_max_speed_mps
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
@@ -100,6 +101,20 @@ def calibration_of(path: str | None, profile: Profile, use_profile: bool = True
     return None, "none"
 
 
+def capture_of(args: argparse.Namespace, profile: Profile, command: str
+               ) -> tuple[Dca1000Capture | NpyCapture, range]:
+    """The capture of ``--capture`` in ``profile``'s format and its frames of ``--frames``;
+    a truncated capture warned about (``radar <command>``); CliError (one line) for a file
+    that does not fit the profile or frames outside it."""
+    try:
+        capture = open_capture(args.capture, profile)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if capture.dropped_bytes:
+        warn([capture.report()], command)
+    return capture, frame_range(args.frames, capture.n_frames)
+
+
 def clipped_samples(frame: np.ndarray, full_scale: int) -> int:
     """ADC values (I and Q counted apart) of a frame, complex or real integer codes, at or
     beyond full scale (+full_scale or -full_scale - 1): clipped, so the echo's harmonics
@@ -124,13 +139,7 @@ def cmd_process(args: argparse.Namespace) -> int:
     params = detection_params(args, cfg=cfg)
     calibration, cal_name = calibration_of(args.calibration, profile)
     params = replace(params, calibration=calibration)
-    try:
-        capture = open_capture(args.capture, profile)
-    except ValueError as exc:
-        raise CliError(str(exc)) from None
-    if capture.dropped_bytes:
-        warn([capture.report()], "process")
-    frames = frame_range(args.frames, capture.n_frames)
+    capture, frames = capture_of(args, profile, "process")
     t0 = time.perf_counter()
     clouds, per_frame, clipped = [], [], []
     cube = None
