@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from host.cfar import MAIN_LOBE_BINS, sidelobe_envelope
+from host.cfar import MAIN_LOBE_BINS, CfarParams, cfar_threshold, sidelobe_envelope
 from host.params import default_guard, params_for
 from host.pipeline import process_frame
 from host.points import _window_response
@@ -18,7 +18,7 @@ from model.array import steering
 from model.cfar_stats import HANN_POWER_CORRELATION
 from model.config import PRESETS, RadarConfig
 from model.radar_pipeline import PipelineParams, run_chain
-from model.reference import FftAxis, corner_turn, fft_axes, radar_cube
+from model.reference import FftAxis, corner_turn, fft_axes, radar_cube, range_doppler_power
 from radar.frame_cloud import frame_cloud
 
 BASE = RadarConfig(name="small", num_tx=2, num_rx=4, n_range=256, n_doppler=256,
@@ -146,3 +146,19 @@ def test_fixed_point_chain_refuses_profiles():
         run_chain(np.zeros(cfg.adc_shape, complex), cfg, PipelineParams())
     with pytest.raises(ValueError, match="real-valued ADC"):
         PipelineParams().check(replace(BASE, adc="real"))
+
+
+def test_padded_noise_keeps_the_configured_pfa():
+    """CA-CFAR on noise of a 160-of-256 sample, 160-of-256 loop profile: with the padded
+    axes' wider guard and noise correlation the false-alarm rate is the configured one."""
+    cfg = replace(BASE, samples_per_chirp=160, loops=160)
+    params = CfarParams(pfa=1e-3, guard=default_guard(cfg))
+    rng = np.random.default_rng(0)
+    alarms = cells = 0
+    for _ in range(6):
+        noise = rng.standard_normal(cfg.adc_shape) + 1j * rng.standard_normal(cfg.adc_shape)
+        nci = range_doppler_power(radar_cube(noise, cfg))
+        alarms += int((nci > cfar_threshold(nci, cfg.n_virtual, params, fft_axes(cfg))[0]
+                       ).sum())
+        cells += nci.size
+    assert 0.8e-3 < alarms / cells < 1.2e-3
