@@ -171,3 +171,10 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
         assert not cal.exists()
     err = capsys.readouterr().err.strip()
     assert code == 2 and err.count("\n") == 0 and want in err, err
+
+
+def test_weak_reflector_warned(tmp_path, capsys):
+    code, out = calibrate(tmp_path, write_capture(tmp_path / "weak.npy",
+                                                  reflector_frames(2, amplitude=0.05)))
+    err = capsys.readouterr().err
+    assert code == 0 and out.exists() and "warning: the reflector is only" in err

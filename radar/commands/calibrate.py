@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from host.calibration import (
+    WEAK_REFLECTOR_DB,
     calibration_document,
     estimate_calibration,
     reflector_range_error,
@@ -18,7 +19,7 @@ from host.calibration import (
 )
 from model.reference import radar_cube
 from radar.commands.process import capture_of, profile_of
-from radar.common import CliError, add_command, out_file, progress
+from radar.common import CliError, add_command, out_file, progress, warn
 
 
 def reflector_of(text: str) -> tuple[float, float, float]:
@@ -54,6 +55,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                                     progress(frames, "frames")), cfg, *reflector)
     except ValueError as exc:
         raise CliError(str(exc)) from None
+    if est.snr_db < WEAK_REFLECTOR_DB:
+        warn([f"the reflector is only {est.snr_db:.1f} dB over the zero-Doppler median "
+              f"(a clear one gives {WEAK_REFLECTOR_DB:g} dB or more): the gains are noisy; "
+              f"is it at {reflector[0]:g} m?"], "calibrate")
     save_calibration(out, calibration_document(est, cfg, reflector))
     phase = np.degrees(np.angle(est.errors))
     gain = 20 * np.log10(np.abs(est.errors))
