@@ -101,12 +101,11 @@ def preset_chain_features(cfg: RadarConfig) -> list[str]:
     return out
 
 
-def check_preset_chain(cfg: RadarConfig, what: str = "the bit-accurate model and the RTL"
-                       ) -> None:
-    """ValueError (one line) naming what of ``cfg`` ``what`` (a part that runs the presets'
-    chain only) does not handle (:func:`preset_chain_features`); the float chain processes
-    profiles."""
+def check_preset_chain(cfg: RadarConfig) -> None:
+    """ValueError (one line) naming what of ``cfg`` the bit-accurate model and the RTL (the
+    presets' chain) do not handle (:func:`preset_chain_features`); the float chain
+    processes profiles."""
     missing = preset_chain_features(cfg)
     if missing:
-        raise ValueError(f"radar {cfg.name!r}: {what} does not handle {'; '.join(missing)} "
-                         f"yet (the float chain does)")
+        raise ValueError(f"radar {cfg.name!r}: the bit-accurate model and the RTL do not "
+                         f"handle {'; '.join(missing)} yet (the float chain does)")

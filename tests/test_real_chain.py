@@ -141,7 +141,7 @@ def test_fixed_point_chain_refuses_profiles():
     """The bit-accurate model (and the RTL) run the presets' chain: a padded or real-ADC
     profile is refused with one line naming it, not mis-processed."""
     cfg = replace(BASE, samples_per_chirp=200)
-    with pytest.raises(ValueError, match="bit-accurate model and the RTL does not handle "
+    with pytest.raises(ValueError, match="bit-accurate model and the RTL do not handle "
                                          "200 samples per chirp zero-padded"):
         run_chain(np.zeros(cfg.adc_shape, complex), cfg, PipelineParams())
     with pytest.raises(ValueError, match="real-valued ADC"):
