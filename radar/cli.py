@@ -12,6 +12,7 @@
     radar profile  show NAME|FILE.toml|FILE.cfg       (a radar profile's derived numbers)
     radar process  --radar PROFILE --capture FILE --json OUT   (a capture -> point cloud)
     radar curves   [--quick] [--ray-address ADDR] --json OUT [--plots DIR]   (Pd, CRB curves)
+    radar calibrate --radar PROFILE --capture FILE --reflector R[,AZ[,EL]] --out CAL.json
 
 One module per command group under :mod:`radar.commands`. Bad input ends with exit status 2
 and a one-line reason on stderr. ``radar <cmd> --help`` explains every option.
@@ -24,6 +25,7 @@ import sys
 
 from model.config import PRESETS
 from radar.commands import (
+    calibrate,
     curves,
     demo,
     detect,
@@ -37,7 +39,8 @@ from radar.commands import (
 )
 from radar.common import CliError
 
-COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile, process, curves)
+COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile, process, calibrate,
+                  curves)
 """Command modules, each with ``add_parsers(sub, presets)``, in ``--help`` order."""
 
 

@@ -14,7 +14,13 @@ from typing import TypeVar
 from tqdm import tqdm
 
 from host.cfar import CfarParams
-from host.params import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams, default_max_speed_mps
+from host.params import (
+    DETECTORS,
+    MAX_RADIAL_SPEED_MPS,
+    DetectionParams,
+    default_guard,
+    default_max_speed_mps,
+)
 from model.config import RadarConfig, get_preset
 from model.profile import Profile, load_profile, preset_profile
 from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
@@ -115,11 +121,13 @@ def detection_params(args: argparse.Namespace, scene_bf: bool = True,
     """Host detection settings from the options of :func:`add_detection_options`, checked
     against ``cfg`` when given (CFAR window larger than the map); without ``--max-speed``
     the radar's (``host.params.default_max_speed_mps``: a profile's ``max_speed_mps``,
-    100 m/s for the presets and without ``cfg``)."""
+    100 m/s for the presets and without ``cfg``); without ``--guard`` the guard is
+    ``cfg``'s main lobe (``host.params.default_guard``)."""
     speed = args.max_speed if args.max_speed is not None else (
         MAX_RADIAL_SPEED_MPS if cfg is None else default_max_speed_mps(cfg))
+    guard = tuple(args.guard) if cfg is None or given(args, "guard") else default_guard(cfg)
     try:
-        cfar = CfarParams(pfa=args.pfa, guard=tuple(args.guard), train=tuple(args.train),
+        cfar = CfarParams(pfa=args.pfa, guard=guard, train=tuple(args.train),
                           kind="os" if args.detector == "os" else "ca")
         params = DetectionParams(detector=args.detector, cfar=cfar,
                                  paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
@@ -244,7 +252,8 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pfa", type=float, default=1e-6,
                    help="CFAR false-alarm probability per range-Doppler cell (default 1e-6)")
     p.add_argument("--guard", type=int, nargs=2, default=(2, 2), metavar=("RANGE", "DOPPLER"),
-                   help="CFAR guard cells per side (default 2 2)")
+                   help="CFAR guard cells per side (default 2 2, the Hann main lobe; "
+                        "wider for a zero-padded profile)")
     p.add_argument("--train", type=int, nargs=2, default=(4, 8), metavar=("RANGE", "DOPPLER"),
                    help="CFAR training cells per side (default 4 8)")
     p.add_argument("--threshold-db", type=float, default=15.0,

@@ -124,11 +124,12 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
         capture = str(tmp_path / "other.npy")
         np.save(capture, np.zeros(PRESETS["paper-fpga"].adc_shape, np.complex64))
         want = "expected shape"
-    elif case == "unprocessable":            # a real-ADC .cfg: the chain refuses it
-        radar = str(tmp_path / "real.cfg")
-        Path(radar).write_text(CFG_FILE.read_text().replace("adcCfg 2 1", "adcCfg 2 0")
-                               .replace("adcbufCfg -1 0 1 1 1", "adcbufCfg -1 1 1 1 1"))
-        want = "does not support real-valued ADC yet"
+    elif case == "unprocessable":            # TX 1 fires first: the chain refuses it
+        radar = str(tmp_path / "order.cfg")
+        Path(radar).write_text(CFG_FILE.read_text().replace(
+            "0 0 0 0 0 0 0 1\nchirpCfg 1 1 0 0 0 0 0 2",
+            "0 0 0 0 0 0 0 2\nchirpCfg 1 1 0 0 0 0 0 1"))
+        want = "does not support TX firing order"
     elif case == "frames":
         extra = ["--frames", "1:3"]
         want = "--frames: 1:3"
