@@ -9,8 +9,11 @@ Two edits make the regblock output readable by every tool of rtl/README.md: its 
 ``struct {`` types become ``struct packed {`` (Yosys' ``read_verilog -sv`` reads packed structs
 only; every member is a packed logic vector, so the meaning is the same), and Verilator's
 ``-Wall`` warnings of generated code (unused AXI PROT inputs and address bits, a width in the
-saturating counters) are waived inside the generated files only. The HTML leaves out the
-exporter's 7.6 MB of web fonts and its Windows launchers (browsers fall back to their fonts).
+saturating counters) are waived inside the generated files only. Its simulation assertions
+(``assert ... else $error``, which Yosys' ``read -formal`` refuses) sit in
+`` `ifndef SYNTHESIS``: formal/radar_ctrl.sby reads it with ``-DSYNTHESIS``. The HTML leaves out the
+exporter's 7.6 MB of web fonts and its Windows launchers (browsers fall back to their fonts)
+and its build time stamp is replaced by one derived from the RDL text.
 
     python tools/gen_regs.py              # rewrite the generated files in place
     python tools/gen_regs.py --out DIR    # write them under DIR instead (the up-to-date test)
@@ -19,6 +22,7 @@ exporter's 7.6 MB of web fonts and its Windows launchers (browsers fall back to 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import re
 import shutil
 import tempfile
@@ -101,6 +105,12 @@ def gen_html(root, dest: Path) -> list[Path]:
             shutil.rmtree(p)
         elif p.exists():
             p.unlink()
+    # the build time stamp (a cache-busting query string) -> one derived from the RDL text,
+    # so the same map always gives the same files
+    index = out / "index.html"
+    stamp = re.search(r"var BUILD_TS = (\d+);", index.read_text()).group(1)
+    stable = str(int(hashlib.sha1(RDL.read_bytes()).hexdigest()[:7], 16))
+    index.write_text(index.read_text().replace(stamp, stable))
     return sorted(p for p in out.rglob("*") if p.is_file())
 
 

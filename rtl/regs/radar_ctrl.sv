@@ -158,6 +158,20 @@ module radar_ctrl #(
     hwif_in.PACKET.rd_data.words = pend_words_q;
   end
 
+  // refused writes never reach the pending set, so it is always legal (and so the active set)
+  wire pend_legal = pend_kind_q <= 2'd1 && pend_maxdet_q != '0
+                    && 32'(pend_maxdet_q) <= 32'(MAX_DETECTIONS)
+                    && pend_words_q != '0 && 32'(pend_words_q) <= 32'(PACKET_WORDS);
+`ifdef FORMAL
+  always_comb if (!rst) assert (pend_legal);
+`elsif SYNTHESIS
+  wire unused_pend_legal = pend_legal;
+`else
+  always_ff @(posedge clk) begin
+    if (!rst) assert (pend_legal) else $error("%m: an out-of-range value reached the settings");
+  end
+`endif
+
   // ---- active settings: the shadow copy at frame start ------------------------------------
   always_ff @(posedge clk) begin
     if (rst) begin
