@@ -86,82 +86,90 @@ module radar_ctrl #(
     .s_axil_rready, .s_axil_rvalid, .s_axil_rdata, .s_axil_rresp,
     .hwif_in, .hwif_out);
 
-  // ---- pending settings: checked on write --------------------------------------------------
-  logic [1:0]  pend_kind_q;
-  logic        pend_clutter_q;
-  logic [15:0] pend_maxdet_q;
-  logic [31:0] pend_scale_q;
-  logic [15:0] pend_words_q;
+  // ---- settings: the pending set (checked on write) and the active set ------------------
+  typedef struct packed {
+    logic [1:0]  cfar_kind;
+    logic        clutter_removal;
+    logic [15:0] max_detections;
+    logic [31:0] cfar_scale;
+    logic [15:0] packet_words;
+  } settings_t;
+  localparam settings_t RESET_SET = {2'(CFAR_KIND), CLUTTER_REMOVAL, 16'(MAX_DETECTIONS),
+                                     32'(CFAR_SCALE), 16'(PACKET_WORDS)};
+
+  function automatic logic legal(input logic [1:0] kind, input logic [15:0] maxdet,
+                                 input logic [15:0] words);
+    legal = kind <= 2'd1 && maxdet != '0 && 32'(maxdet) <= 32'(MAX_DETECTIONS)
+            && words != '0 && 32'(words) <= 32'(PACKET_WORDS);
+  endfunction
+
+  settings_t pend_q, active_q, cand;
 
   wire set_wr   = hwif_out.SETTINGS.req && hwif_out.SETTINGS.req_is_wr;
   wire scale_wr = hwif_out.CFAR_SCALE.req && hwif_out.CFAR_SCALE.req_is_wr;
   wire pkt_wr   = hwif_out.PACKET.req && hwif_out.PACKET.req_is_wr;
 
-  // the register's value after the write (byte strobes merged with the old value)
-  logic [1:0]  new_kind;
-  logic        new_clutter;
-  logic [15:0] new_maxdet, new_words;
-  logic [31:0] new_scale;
+  // the pending set as this cycle's write would leave it (byte strobes merged with the old
+  // value); the write is refused whole when the result is not legal
   always_comb begin
-    new_kind    = (pend_kind_q & ~hwif_out.SETTINGS.wr_biten.cfar_kind)
-                | (hwif_out.SETTINGS.wr_data.cfar_kind & hwif_out.SETTINGS.wr_biten.cfar_kind);
-    new_clutter = (pend_clutter_q & ~hwif_out.SETTINGS.wr_biten.clutter_removal)
-                | (hwif_out.SETTINGS.wr_data.clutter_removal
-                   & hwif_out.SETTINGS.wr_biten.clutter_removal);
-    new_maxdet  = (pend_maxdet_q & ~hwif_out.SETTINGS.wr_biten.max_detections)
-                | (hwif_out.SETTINGS.wr_data.max_detections
-                   & hwif_out.SETTINGS.wr_biten.max_detections);
-    new_scale   = (pend_scale_q & ~hwif_out.CFAR_SCALE.wr_biten.scale)
-                | (hwif_out.CFAR_SCALE.wr_data.scale & hwif_out.CFAR_SCALE.wr_biten.scale);
-    new_words   = (pend_words_q & ~hwif_out.PACKET.wr_biten.words)
-                | (hwif_out.PACKET.wr_data.words & hwif_out.PACKET.wr_biten.words);
-  end
-
-  wire set_ok = new_kind <= 2'd1 && new_maxdet != '0
-                && 32'(new_maxdet) <= 32'(MAX_DETECTIONS);
-  wire pkt_ok = new_words != '0 && 32'(new_words) <= 32'(PACKET_WORDS);
-  wire refused = (set_wr && !set_ok) || (pkt_wr && !pkt_ok);
-
-  always_ff @(posedge clk) begin
-    if (rst) begin
-      pend_kind_q    <= 2'(CFAR_KIND);
-      pend_clutter_q <= CLUTTER_REMOVAL;
-      pend_maxdet_q  <= 16'(MAX_DETECTIONS);
-      pend_scale_q   <= CFAR_SCALE;
-      pend_words_q   <= 16'(PACKET_WORDS);
-    end else begin
-      if (set_wr && set_ok) begin
-        pend_kind_q    <= new_kind;
-        pend_clutter_q <= new_clutter;
-        pend_maxdet_q  <= new_maxdet;
-      end
-      if (scale_wr) pend_scale_q <= new_scale;
-      if (pkt_wr && pkt_ok) pend_words_q <= new_words;
+    cand = pend_q;
+    if (set_wr) begin
+      cand.cfar_kind = (pend_q.cfar_kind & ~hwif_out.SETTINGS.wr_biten.cfar_kind)
+                     | (hwif_out.SETTINGS.wr_data.cfar_kind & hwif_out.SETTINGS.wr_biten.cfar_kind);
+      cand.clutter_removal = (pend_q.clutter_removal & ~hwif_out.SETTINGS.wr_biten.clutter_removal)
+                           | (hwif_out.SETTINGS.wr_data.clutter_removal
+                              & hwif_out.SETTINGS.wr_biten.clutter_removal);
+      cand.max_detections = (pend_q.max_detections & ~hwif_out.SETTINGS.wr_biten.max_detections)
+                          | (hwif_out.SETTINGS.wr_data.max_detections
+                             & hwif_out.SETTINGS.wr_biten.max_detections);
+    end
+    if (scale_wr) begin
+      cand.cfar_scale = (pend_q.cfar_scale & ~hwif_out.CFAR_SCALE.wr_biten.scale)
+                      | (hwif_out.CFAR_SCALE.wr_data.scale & hwif_out.CFAR_SCALE.wr_biten.scale);
+    end
+    if (pkt_wr) begin
+      cand.packet_words = (pend_q.packet_words & ~hwif_out.PACKET.wr_biten.words)
+                        | (hwif_out.PACKET.wr_data.words & hwif_out.PACKET.wr_biten.words);
     end
   end
+  wire refused = !legal(cand.cfar_kind, cand.max_detections, cand.packet_words);
+
+  always_ff @(posedge clk) begin
+    if (rst)           pend_q <= RESET_SET;
+    else if (!refused) pend_q <= cand;
+  end
+
+  // the shadow copy: the whole pending set, in the cycle after frame_start only
+  always_ff @(posedge clk) begin
+    if (rst)              active_q <= RESET_SET;
+    else if (frame_start) active_q <= pend_q;
+  end
+  assign cfg_cfar_kind       = active_q.cfar_kind;
+  assign cfg_clutter_removal = active_q.clutter_removal;
+  assign cfg_max_detections  = active_q.max_detections;
+  assign cfg_cfar_scale      = active_q.cfar_scale;
+  assign cfg_packet_words    = active_q.packet_words;
 
   // external registers answer in the cycle of the request
   always_comb begin
     hwif_in.SETTINGS.wr_ack   = set_wr;
     hwif_in.SETTINGS.rd_ack   = hwif_out.SETTINGS.req && !hwif_out.SETTINGS.req_is_wr;
     hwif_in.SETTINGS.rd_data  = '0;
-    hwif_in.SETTINGS.rd_data.cfar_kind       = pend_kind_q;
-    hwif_in.SETTINGS.rd_data.clutter_removal = pend_clutter_q;
-    hwif_in.SETTINGS.rd_data.max_detections  = pend_maxdet_q;
+    hwif_in.SETTINGS.rd_data.cfar_kind       = pend_q.cfar_kind;
+    hwif_in.SETTINGS.rd_data.clutter_removal = pend_q.clutter_removal;
+    hwif_in.SETTINGS.rd_data.max_detections  = pend_q.max_detections;
     hwif_in.CFAR_SCALE.wr_ack  = scale_wr;
     hwif_in.CFAR_SCALE.rd_ack  = hwif_out.CFAR_SCALE.req && !hwif_out.CFAR_SCALE.req_is_wr;
     hwif_in.CFAR_SCALE.rd_data = '0;
-    hwif_in.CFAR_SCALE.rd_data.scale = pend_scale_q;
+    hwif_in.CFAR_SCALE.rd_data.scale = pend_q.cfar_scale;
     hwif_in.PACKET.wr_ack      = pkt_wr;
     hwif_in.PACKET.rd_ack      = hwif_out.PACKET.req && !hwif_out.PACKET.req_is_wr;
     hwif_in.PACKET.rd_data     = '0;
-    hwif_in.PACKET.rd_data.words = pend_words_q;
+    hwif_in.PACKET.rd_data.words = pend_q.packet_words;
   end
 
   // refused writes never reach the pending set, so it is always legal (and so the active set)
-  wire pend_legal = pend_kind_q <= 2'd1 && pend_maxdet_q != '0
-                    && 32'(pend_maxdet_q) <= 32'(MAX_DETECTIONS)
-                    && pend_words_q != '0 && 32'(pend_words_q) <= 32'(PACKET_WORDS);
+  wire pend_legal = legal(pend_q.cfar_kind, pend_q.max_detections, pend_q.packet_words);
 `ifdef FORMAL
   always_comb if (!rst) assert (pend_legal);
 `elsif SYNTHESIS
@@ -171,23 +179,6 @@ module radar_ctrl #(
     if (!rst) assert (pend_legal) else $error("%m: an out-of-range value reached the settings");
   end
 `endif
-
-  // ---- active settings: the shadow copy at frame start ------------------------------------
-  always_ff @(posedge clk) begin
-    if (rst) begin
-      cfg_cfar_kind       <= 2'(CFAR_KIND);
-      cfg_clutter_removal <= CLUTTER_REMOVAL;
-      cfg_max_detections  <= 16'(MAX_DETECTIONS);
-      cfg_cfar_scale      <= CFAR_SCALE;
-      cfg_packet_words    <= 16'(PACKET_WORDS);
-    end else if (frame_start) begin
-      cfg_cfar_kind       <= pend_kind_q;
-      cfg_clutter_removal <= pend_clutter_q;
-      cfg_max_detections  <= pend_maxdet_q;
-      cfg_cfar_scale      <= pend_scale_q;
-      cfg_packet_words    <= pend_words_q;
-    end
-  end
 
   // ---- read-only registers, counters, sticky flags ----------------------------------------
   always_comb begin
