@@ -25,7 +25,7 @@ from pathlib import Path
 import cocotb
 import pytest
 from cocotb.clock import Clock
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, with_timeout
 from cocotbext.axi import AxiLiteBus, AxiLiteMaster
 
 from host import regs
@@ -33,6 +33,8 @@ from model.radar_ctrl import FLAGS, RadarCtrl
 from model.radar_regs_map import REGISTERS
 from rtlsim.toolchain import param, rtl_sources, run_cocotb, seed
 
+ACCESS_TIMEOUT_US = 20
+"""An access not answered within this (a lost or misrouted response) fails the test."""
 EVENTS = ("frame_start", "frame_done", "packet_done", "drop", "error")
 CFG = ("cfar_kind", "clutter_removal", "max_detections", "cfar_scale", "packet_words")
 
@@ -108,7 +110,7 @@ class TB:
         addr = regs.address(name)
         self.busy += 1
         data = word.to_bytes(4, "little")[offset:offset + nbytes]
-        await self.axil.write(addr + offset, data)
+        await with_timeout(self.axil.write(addr + offset, data), ACCESS_TIMEOUT_US, "us")
         strb = ((1 << nbytes) - 1) << offset
         self.model.write(addr, word, strb)
         self.busy -= 1
@@ -117,7 +119,8 @@ class TB:
     async def read(self, name: str) -> int:
         """Read register ``name``, compare with the model, return the word."""
         self.busy += 1
-        resp = await self.axil.read(regs.address(name), 4)
+        resp = await with_timeout(self.axil.read(regs.address(name), 4), ACCESS_TIMEOUT_US,
+                                  "us")
         self.busy -= 1
         got = int.from_bytes(resp.data, "little")
         want = self.model.read(regs.address(name))
