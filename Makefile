@@ -10,7 +10,7 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
+.PHONY: all setup demo test test-python sim lint gen regs bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
         formal coverage mutate mutate-ci curves bench-ray
 all: test
@@ -22,7 +22,9 @@ help:
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv, fft_*_rom.sv,"
-	@echo "                     rtl/buffers/packet_crc32.sv) and check it"
+	@echo "                     rtl/buffers/packet_crc32.sv, the register map's files) and check it"
+	@echo "make regs            regenerate from rtl/regs/radar_regs.rdl: register block, C header,"
+	@echo "                     HTML map, Python map (docs/regs.md) and check them"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
@@ -76,10 +78,15 @@ lint: $(STAMP)
 	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth benchmarks
 
 # Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
-gen: $(STAMP)
+gen: $(STAMP) regs
 	$(RUN) python -m model.fft_rom
 	$(RUN) python -m model.packet_crc
 	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py tests/test_packet_crc.py -k up_to_date
+
+# Everything generated from the SystemRDL register map (tools/gen_regs.py, docs/regs.md)
+regs: $(STAMP)
+	$(RUN) python tools/gen_regs.py
+	$(RUN) pytest -q -n 0 tests/test_regs.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_simulate
