@@ -110,7 +110,10 @@ def gen_html(root, dest: Path) -> list[Path]:
     index = out / "index.html"
     stamp = re.search(r"var BUILD_TS = (\d+);", index.read_text()).group(1)
     stable = str(int(hashlib.sha1(RDL.read_bytes()).hexdigest()[:7], 16))
-    index.write_text(index.read_text().replace(stamp, stable))
+    text = index.read_text().replace(stamp, stable)
+    # nothing on a page loads from the internet: the map has no equations for MathJax
+    text = re.sub(r'\s*<script[^>]*src="https://[^"]*"[^>]*></script>', "", text)
+    index.write_text(text)
     return sorted(p for p in out.rglob("*") if p.is_file())
 
 
