@@ -18,9 +18,10 @@ from typing import Any
 import numpy as np
 
 from host.adc_capture import open_capture
-from host.params import default_max_speed_mps
+from host.params import DetectionParams, default_max_speed_mps
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
+from model.config import RadarConfig
 from model.profile import Profile, load_profile
 from model.reference import radar_cube
 from radar.common import (
@@ -38,7 +39,7 @@ from radar.common import (
     warn_clipped,
 )
 from radar.figures import process_plots
-from radar.frame_cloud import frame_cloud
+from radar.frame_cloud import FrameCloud, frame_cloud
 from radar.recording import add_mcap_options, close_recording, open_recording
 
 BACKENDS = ("float",)
@@ -75,6 +76,24 @@ def profile_of(spec: str) -> Profile:
     return profile
 
 
+def process_params(args: argparse.Namespace, cfg: RadarConfig) -> DetectionParams:
+    """``radar process``'s detection settings from its options (``--max-speed`` defaults to
+    the profile's, ``host.params.default_max_speed_mps``); CliError if they do not fit."""
+    if args.max_speed is None:
+        args.max_speed = default_max_speed_mps(cfg)
+    return detection_params(args, cfg=cfg)
+
+
+def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
+                        frame_id: int, remove_static: bool) -> FrameCloud:
+    """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
+    codes, -> its cube (the float reference, ``model.reference.radar_cube``, static clutter
+    removed if asked) and point cloud (``radar.frame_cloud``), as ``radar process`` does."""
+    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
+                      remove_static_clutter=remove_static)
+    return frame_cloud(cube, cfg, params, frame_id, "process")
+
+
 def clipped_samples(frame: np.ndarray, full_scale: int) -> int:
     """ADC values (I and Q counted apart) of a frame, complex or real integer codes, at or
     beyond full scale (+full_scale or -full_scale - 1): clipped, so the echo's harmonics
@@ -94,9 +113,7 @@ def cmd_process(args: argparse.Namespace) -> int:
                        f"{', '.join(BACKENDS)} for now")
     profile = profile_of(args.radar)
     cfg = profile.config
-    if args.max_speed is None:
-        args.max_speed = default_max_speed_mps(cfg)
-    params = detection_params(args, cfg=cfg)
+    params = process_params(args, cfg)
     try:
         capture = open_capture(args.capture, profile)
     except ValueError as exc:
@@ -114,9 +131,8 @@ def cmd_process(args: argparse.Namespace) -> int:
             t_start = time.perf_counter()
             adc = capture.frame(k)
             n_clip = clipped_samples(adc, cfg.adc_full_scale)
-            cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
-                              remove_static_clutter=args.remove_static)
-            fc = frame_cloud(cube, cfg, params, k, "process")
+            fc = capture_frame_cloud(adc, cfg, params, k, args.remove_static)
+            cube = fc.cube
             clouds.append(fc.cloud)
             per_frame.append({"frame": k, "points": len(fc.cloud), "clipped": n_clip,
                               "damaged": False})
