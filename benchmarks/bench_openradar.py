@@ -37,6 +37,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,6 +59,8 @@ MATCH_BINS = 2
 GOAL_ANGLE_DEG = 2.0
 GOAL_UNMATCHED = 0.10
 GOAL_TIME_RATIO = 1 / 3
+WIDTH = 100
+"""Printed lines wrap here."""
 
 
 @dataclass(frozen=True)
@@ -178,8 +181,9 @@ def table(peer_doc: dict[str, Any], ours: Detections, our_times_s: list[float],
     db_name = f"peer {threshold_db:g} dB"
     rows = [
         f"OpenRadar {v['openradar']} (numpy {v['numpy']}, scikit-learn {v['scikit-learn']}) "
-        f"vs ours, static-clutter removal in both; {len(our_times_s)} timed runs each, median;"
-        f" load average {' '.join(f'{x:.2f}' for x in load)} ({os.cpu_count()} cores)",
+        "vs ours, static-clutter removal in both",
+        f"{len(our_times_s)} timed runs each, median; load average "
+        f"{' '.join(f'{x:.2f}' for x in load)} ({os.cpu_count()} cores)",
         "",
         f"{'':<44}{'ours':>8}{db_name:>14}{'peer demo':>12}",
         f"{'CFAR cells':<44}{'-':>8}{db['cfar_cells']:>14}{demo['cfar_cells']:>12}",
@@ -189,26 +193,28 @@ def table(peer_doc: dict[str, Any], ours: Detections, our_times_s: list[float],
         "",
         f"against the peer's {threshold_db:g} dB detections (near: <= {MATCH_BINS} range and "
         f"{MATCH_BINS} Doppler bins)",
-        f"{'  moving returns of the peer ours finds':<52}{found} of {a.peer_moving}"
-        f"   goal all: {verdict(not a.missed)}",
-        f"{'  angle - its Bartlett, strongest point per cell':<52}{spread(a.angle_strongest)}"
-        f"   goal <= {GOAL_ANGLE_DEG:g} deg: {verdict(angle_ok)}",
-        f"{'  angle - its Bartlett, every point':<52}{spread(a.angle_all)}",
-        f"{'  our points with no peer detection near':<52}{a.outside_cells} of {a.ours}",
-        f"{'  ... or none also within ' + format(a.angle_tol_deg, '.1f') + ' deg':<52}"
+        f"{'  moving returns of the peer ours finds':<44}{found} of {a.peer_moving}"
+        f"  goal all: {verdict(not a.missed)}",
+        f"{'  angle - its Bartlett, strongest per cell':<44}{spread(a.angle_strongest)}"
+        f"  goal <= {GOAL_ANGLE_DEG:g} deg: {verdict(angle_ok)}",
+        f"{'  angle - its Bartlett, every point':<44}{spread(a.angle_all)}",
+        f"{'  our points with no peer detection near':<44}{a.outside_cells} of {a.ours}",
+        f"{'  ... or none also within ' + format(a.angle_tol_deg, '.1f') + ' deg':<44}"
         f"{len(a.outside)} of {a.ours} ({100 * frac:.0f} %)"
-        f"   goal <= {100 * GOAL_UNMATCHED:.0f} %: {verdict(frac <= GOAL_UNMATCHED)}",
-        f"{'  our time / the peer time (' + format(threshold_db, 'g') + ' dB)':<52}"
-        f"{t_ours / t_db:.2f}   goal <= 1/3: {verdict(t_ours / t_db <= GOAL_TIME_RATIO)}",
+        f"  goal <= {100 * GOAL_UNMATCHED:.0f} %: {verdict(frac <= GOAL_UNMATCHED)}",
+        f"{'  our time / the peer time (' + format(threshold_db, 'g') + ' dB)':<44}"
+        f"{t_ours / t_db:.2f}  goal <= 1/3: {verdict(t_ours / t_db <= GOAL_TIME_RATIO)}",
     ]
+    notes = []
     if a.missed:
-        rows.append(f"  the peer's that ours misses (range bin, Doppler bin): {a.missed}")
+        notes.append(f"  the peer's that ours misses (range bin, Doppler bin): {a.missed}")
     if a.outside:
-        rows.append(f"  ours outside its clusters (range bin, Doppler bin, az deg): {a.outside}")
+        notes.append(f"  ours outside its clusters (range bin, Doppler bin, az deg): {a.outside}")
     crash = peer_doc.get("tdm_compensation_error")
     if crash:
-        rows.append(f"OpenRadar's dsp.add_doppler_compensation: {crash} (the runner "
-                    "compensates as it documents)")
+        notes.append(f"OpenRadar's dsp.add_doppler_compensation: {crash} (the runner "
+                     "compensates as it documents)")
+    rows += [textwrap.fill(n, WIDTH, subsequent_indent="    ") for n in notes]
     return "\n".join(rows)
 
 

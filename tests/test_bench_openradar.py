@@ -61,15 +61,15 @@ def test_table_reports_against_the_goals():
     a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
     text = table(doc, ours(), [0.01, 0.012, 0.011], a, 15.0, (1.0, 1.5, 2.0))
     lines = text.splitlines()
-    assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[0]
+    assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[1]
     row = next(line for line in lines if line.startswith("host time per frame"))
     assert row.split()[-3:] == ["11.0", "50.0", "250.0"]
     row = next(line for line in lines if line.startswith("detections"))
     assert row.split()[-3:] == ["5", "6", "50"]
-    assert "4 of 5   goal all: MISSED" in text
-    assert "max 2.30 deg (n=3)   goal <= 2 deg: MISSED" in text
-    assert "2 of 5 (40 %)   goal <= 10 %: MISSED" in text
-    assert "0.22   goal <= 1/3: met" in text
+    assert "4 of 5  goal all: MISSED" in text
+    assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in text
+    assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in text
+    assert "0.22  goal <= 1/3: met" in text
     assert "ours misses (range bin, Doppler bin): [(80, 5)]" in text
     assert "(range bin, Doppler bin, az deg): [(60, 7, 40.0), (100, 3, 0.0)]" in text
     assert "TypeError: slice indices must be integers" in text
@@ -88,4 +88,4 @@ def test_table_without_angles(missing):
     far = Detections(np.array([120] * len(missing)), np.array([40] * len(missing)),
                      np.array(missing), np.array(missing))
     text = table(doc, far, [0.01], compare(far, peer, N_DOPPLER, 14.3), 15.0, (0.0, 0.0, 0.0))
-    assert "every point" in text and "-   goal <= 2 deg: MISSED" in text
+    assert "every point" in text and "-  goal <= 2 deg: MISSED" in text
