@@ -53,7 +53,6 @@ from radar.commands.process import capture_frame_cloud, process_params, profile_
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "tests" / "data" / "openradar"
 PEER_RUNNER = Path(__file__).with_name("openradar_peer.py")
-PEER_PYTHON = REPO / "out" / "openradar-venv" / "bin" / "python"
 MATCH_BINS = 2
 """A match: within this many range bins and Doppler bins."""
 GOAL_ANGLE_DEG = 2.0
@@ -236,8 +235,9 @@ def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--peer-python", type=Path, default=PEER_PYTHON,
-                    help="python of OpenRadar's virtualenv (make bench-openradar makes it)")
+    ap.add_argument("--peer-python", type=Path, required=True,
+                    help="python of OpenRadar's virtualenv (make bench-openradar makes it "
+                         "and passes it)")
     ap.add_argument("--radar", default=str(DATA / "openradar_2tx4rx.cfg"))
     ap.add_argument("--capture", type=Path, default=DATA / "doppler_example_1.bin",
                     help="a 2-lane DCA1000 .bin of the profile (frame 0 is used)")
