@@ -10,9 +10,9 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint gen bench bench-rtl bench-openradar soak gnn-dataset gnn-train \
+.PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
-        formal coverage mutate mutate-ci
+        formal coverage mutate mutate-ci bench-openradar
 all: test
 
 help:
