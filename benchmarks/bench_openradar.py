@@ -25,8 +25,10 @@ Printed: detections of each; agreement with the peer's 15 dB detections (a match
 ours also finds, the angle difference to its Bartlett angle (the strongest of our points in
 a cell, and every point), our points that are not part of a cluster it finds (no peer
 detection within the bins, or none also within the array's angle resolution); host time per
-frame of each, timed in the same run (``--repeat`` runs after a warm-up, median) with the
-load average. The goals (issue 29) are reported against, never asserted in tests.
+frame of each, timed in the same run (``--repeat`` runs after a warm-up, in ``--rounds``
+rounds that alternate between the chains, so a change of the machine's load falls on both;
+median) with the load average. The goals (issue 29) are reported against, never asserted in
+tests.
 """
 
 from __future__ import annotations
@@ -244,6 +246,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--threshold-db", type=float, default=15.0,
                     help="the peer's CFAR threshold compared with (default 15)")
     ap.add_argument("--repeat", type=int, default=20, help="timed runs per chain")
+    ap.add_argument("--rounds", type=int, default=4,
+                    help="the timed runs alternate between the chains in this many rounds")
     args = ap.parse_args(argv)
     if not args.peer_python.exists():
         print(f"bench_openradar: no {args.peer_python}: `make bench-openradar` creates "
@@ -256,15 +260,21 @@ def main(argv: list[str] | None = None) -> int:
     params = process_params(opts, cfg)
     capture = open_capture(args.capture, profile)
     load0 = os.getloadavg()
-    peer_doc = run_peer(args.peer_python, args.capture,
-                        (cfg.n_chirps, cfg.num_rx, cfg.n_samples, cfg.num_tx),
-                        args.threshold_db, args.repeat)
     cloud = capture_frame_cloud(capture.frame(0), cfg, params, 0, opts.remove_static).cloud
-    times = []
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        capture_frame_cloud(capture.frame(0), cfg, params, 0, opts.remove_static)
-        times.append(time.perf_counter() - t0)
+    peer_doc: dict[str, Any] = {}
+    times: list[float] = []
+    for n in np.diff(np.linspace(0, args.repeat, args.rounds + 1).round().astype(int)):
+        doc = run_peer(args.peer_python, args.capture,
+                       (cfg.n_chirps, cfg.num_rx, cfg.n_samples, cfg.num_tx),
+                       args.threshold_db, int(n))
+        for name, setting in doc["settings"].items():
+            setting["times_s"] = peer_doc.get("settings", {}).get(name, {}).get(
+                "times_s", []) + setting["times_s"]
+        peer_doc = doc
+        for _ in range(n):
+            t0 = time.perf_counter()
+            capture_frame_cloud(capture.frame(0), cfg, params, 0, opts.remove_static)
+            times.append(time.perf_counter() - t0)
     load = tuple((a + b) / 2 for a, b in zip(load0, os.getloadavg(), strict=True))
     ours = Detections.of_cloud(cloud)
     peer = Detections.of_peer(peer_doc["settings"][f"{args.threshold_db:g} dB"]["detections"])
