@@ -208,9 +208,11 @@ def table(peer_doc: dict[str, Any], ours: Detections, our_times_s: list[float],
     ]
     notes = []
     if a.missed:
-        notes.append(f"  the peer's that ours misses (range bin, Doppler bin): {a.missed}")
+        notes.append("  the peer's that ours misses (range bin,Doppler bin): "
+                     + " ".join(f"({r},{d})" for r, d in a.missed))
     if a.outside:
-        notes.append(f"  ours outside its clusters (range bin, Doppler bin, az deg): {a.outside}")
+        notes.append("  ours outside its clusters (range bin,Doppler bin,az deg): "
+                     + " ".join(f"({r},{d},{az:g})" for r, d, az in a.outside))
     crash = peer_doc.get("tdm_compensation_error")
     if crash:
         notes.append(f"OpenRadar's dsp.add_doppler_compensation: {crash} (the runner "
