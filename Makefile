@@ -12,7 +12,7 @@ OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen regs bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
-        formal coverage mutate mutate-ci curves bench-ray
+        formal coverage mutate mutate-ci curves bench-ray bench-openradar
 all: test
 
 help:
@@ -27,6 +27,7 @@ help:
 	@echo "                     HTML map, Python map (docs/regs.md) and check them"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
+	@echo "make bench-openradar this chain vs OpenRadar 1.0.1 (own venv in $(OUT)/) on the real TI frame"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
 	@echo "make test-full       one full-size frame, FRAME_STORE=1 top + AXI4 memory, bit-exact"
 	@echo "make test-full-detect  Table I full frame, OUTPUT_MODE=1 + FRAME_STORE=1, records bit-exact"
@@ -95,6 +96,17 @@ bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_detect
 	$(RUN) python -m benchmarks.bench_unfold
 	$(RUN) python -m benchmarks.bench_mcap
+
+# OpenRadar (the peer library) in its own virtualenv: openradar 1.0.1 does not declare its
+# dependencies (scikit-learn among them); benchmarks/bench_openradar.py runs it in a subprocess
+OPENRADAR_VENV := $(OUT)/openradar-venv
+$(OPENRADAR_VENV)/.installed:
+	$(PYTHON) -m venv $(OPENRADAR_VENV)
+	$(OPENRADAR_VENV)/bin/python -m pip install --quiet openradar==1.0.1 'numpy>=2' scipy scikit-learn
+	touch $@
+
+bench-openradar: $(STAMP) $(OPENRADAR_VENV)/.installed
+	$(RUN) python -m benchmarks.bench_openradar --peer-python $(OPENRADAR_VENV)/bin/python
 
 bench-rtl: $(STAMP)
 	$(RUN) python tb/fft_axis/bench_fft_axis.py

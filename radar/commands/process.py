@@ -21,8 +21,10 @@ import numpy as np
 from host.adc_capture import NpyCapture, open_capture
 from host.calibration import check_calibration, load_calibration
 from host.dca1000 import Dca1000Capture
+from host.params import DetectionParams
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
+from model.config import RadarConfig
 from model.profile import Calibration, Profile, load_profile
 from model.reference import radar_cube
 from radar.common import (
@@ -40,7 +42,7 @@ from radar.common import (
     warn_clipped,
 )
 from radar.figures import process_plots
-from radar.frame_cloud import frame_cloud
+from radar.frame_cloud import FrameCloud, frame_cloud
 from radar.recording import add_mcap_options, close_recording, open_recording
 
 BACKENDS = ("float",)
@@ -114,6 +116,26 @@ def capture_of(args: argparse.Namespace, profile: Profile, command: str
     return capture, frame_range(args.frames, capture.n_frames)
 
 
+def process_params(args: argparse.Namespace, profile: Profile) -> tuple[DetectionParams, str]:
+    """``radar process``'s detection settings from its options (``radar.common.
+    detection_params``: the profile's maximum speed and guard by default) with the
+    calibration applied before angle estimation (:func:`calibration_of`), and that
+    calibration's name for the output; CliError if they do not fit."""
+    params = detection_params(args, cfg=profile.config)
+    calibration, cal_name = calibration_of(args.calibration, profile)
+    return replace(params, calibration=calibration), cal_name
+
+
+def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
+                        frame_id: int, remove_static: bool) -> FrameCloud:
+    """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
+    codes, -> its cube (the float reference, ``model.reference.radar_cube``, static clutter
+    removed if asked) and point cloud (``radar.frame_cloud``), as ``radar process`` does."""
+    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
+                      remove_static_clutter=remove_static)
+    return frame_cloud(cube, cfg, params, frame_id, "process")
+
+
 def clipped_samples(frame: np.ndarray, full_scale: int) -> int:
     """ADC values (I and Q counted apart) of a frame, complex or real integer codes, at or
     beyond full scale (+full_scale or -full_scale - 1): clipped, so the echo's harmonics
@@ -133,9 +155,7 @@ def cmd_process(args: argparse.Namespace) -> int:
                        f"{', '.join(BACKENDS)} for now")
     profile = profile_of(args.radar)
     cfg = profile.config
-    params = detection_params(args, cfg=cfg)
-    calibration, cal_name = calibration_of(args.calibration, profile)
-    params = replace(params, calibration=calibration)
+    params, cal_name = process_params(args, profile)
     capture, frames = capture_of(args, profile, "process")
     t0 = time.perf_counter()
     clouds, per_frame, clipped = [], [], []
@@ -147,9 +167,8 @@ def cmd_process(args: argparse.Namespace) -> int:
             t_start = time.perf_counter()
             adc = capture.frame(k)
             n_clip = clipped_samples(adc, cfg.adc_full_scale)
-            cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
-                              remove_static_clutter=args.remove_static)
-            fc = frame_cloud(cube, cfg, params, k, "process")
+            fc = capture_frame_cloud(adc, cfg, params, k, args.remove_static)
+            cube = fc.cube
             clouds.append(fc.cloud)
             per_frame.append({"frame": k, "points": len(fc.cloud), "clipped": n_clip,
                               "damaged": False})

@@ -1,0 +1,291 @@
+"""Benchmark: this project's chain side by side with OpenRadar (the open library people use
+for the same job) on the real TI frame of ``tests/data/openradar`` (2 TX x 4 RX, 128 loops x
+128 samples; docs/profiles.md "Compared with OpenRadar").
+
+    make bench-openradar          # creates OpenRadar's virtualenv, then runs this
+    python -m benchmarks.bench_openradar --peer-python out/openradar-venv/bin/python [--repeat 20]
+
+OpenRadar (``openradar==1.0.1``) runs in its own virtualenv (``out/openradar-venv``, made by
+the Make target: on numpy 2 it needs scikit-learn, which it does not declare, and a
+``np.complex`` shim), in a subprocess: ``benchmarks/openradar_peer.py`` reads the frame with
+its DCA1000 reader, runs its range and Doppler FFTs (static-clutter removal on), its CA-CFAR
+at its visualizer demo's settings and at a 15 dB threshold, its peak pruning and grouping,
+and its Bartlett angle on the detections. Its TDM Doppler compensation,
+``dsp.add_doppler_compensation``, crashes on numpy >= 1.12 (a float slice index,
+``input_data[:, (num_antennas/num_tx_antennas):, :]``: TypeError) and is wrong with that
+fixed (a broadcast error for more than one detection, conjugated data for one): the runner
+does the compensation it documents instead (the runner's docstring has the details).
+
+Ours runs in this process on the same frame, through ``radar process --remove-static``'s
+path: the profile and its options (``radar.commands.process``), ``host.adc_capture``, the
+float reference (``model.reference.radar_cube``) and ``radar.frame_cloud``.
+
+Printed: detections of each; agreement with the peer's 15 dB detections (a match is within
+2 range and 2 Doppler bins; moving = Doppler bin not 0): the moving returns it finds that
+ours also finds, the angle difference to its Bartlett angle (the strongest of our points in
+a cell, and every point), our points that are not part of a cluster it finds (no peer
+detection within the bins, or none also within the array's angle resolution); host time per
+frame of each, timed in the same run (``--repeat`` runs after a warm-up, in ``--rounds``
+rounds that alternate between the chains, so a change of the machine's load falls on both;
+median) with the load average. The goals (issue 29) are reported against, never asserted in
+tests.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from host.adc_capture import open_capture
+from host.pointcloud import PointCloud
+from radar.cli import build_parser
+from radar.commands.process import capture_frame_cloud, process_params, profile_of
+
+REPO = Path(__file__).resolve().parents[1]
+DATA = REPO / "tests" / "data" / "openradar"
+PEER_RUNNER = Path(__file__).with_name("openradar_peer.py")
+MATCH_BINS = 2
+"""A match: within this many range bins and Doppler bins."""
+GOAL_ANGLE_DEG = 2.0
+GOAL_UNMATCHED = 0.10
+GOAL_TIME_RATIO = 1 / 3
+WIDTH = 100
+"""Printed lines wrap here."""
+
+
+@dataclass(frozen=True)
+class Detections:
+    """Detections of one chain, n of them: int (n,) ``range_bin``, int (n,) signed
+    ``doppler_bin``, float (n,) ``azimuth_deg``, and float (n,) ``strength`` (any unit
+    increasing with power; ranks the points of one cell)."""
+
+    range_bin: np.ndarray
+    doppler_bin: np.ndarray
+    azimuth_deg: np.ndarray
+    strength: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.range_bin)
+
+    @classmethod
+    def of_peer(cls, detections: dict[str, list]) -> Detections:
+        """From one setting's ``detections`` of the peer runner's JSON."""
+        return cls(np.asarray(detections["range_bin"], int),
+                   np.asarray(detections["doppler_bin"], int),
+                   np.asarray(detections["azimuth_deg"], float),
+                   np.asarray(detections["det_value"], float))
+
+    @classmethod
+    def of_cloud(cls, cloud: PointCloud) -> Detections:
+        return cls(cloud.range_bin.astype(int), cloud.doppler_bin.astype(int),
+                   cloud.azimuth_deg.astype(float), cloud.power_db.astype(float))
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """Ours against the peer's detections (:func:`compare`).
+
+    ``peer_moving``: the peer's detections off zero Doppler; ``missed``: their (range bin,
+    Doppler bin) that no point of ours is near; ``angle_strongest``: float |our azimuth -
+    the peer's|, deg, for the strongest point of ours in each cell near a peer detection,
+    ``angle_all`` for every such point; ``ours``: our points; ``outside_cells``: ours with no
+    peer detection near; ``outside``: (range bin, Doppler bin, azimuth deg) of ours with none
+    near and within ``angle_tol_deg``."""
+
+    peer_moving: int
+    missed: list[tuple[int, int]]
+    angle_strongest: np.ndarray
+    angle_all: np.ndarray
+    ours: int
+    outside_cells: int
+    outside: list[tuple[int, int, float]]
+    angle_tol_deg: float
+
+
+def near(ours: Detections, peer: Detections, n_doppler: int,
+         bins: int = MATCH_BINS) -> np.ndarray:
+    """bool (len(ours), len(peer)): within ``bins`` range bins and ``bins`` Doppler bins
+    (Doppler circular over ``n_doppler``)."""
+    dr = np.abs(ours.range_bin[:, None] - peer.range_bin[None, :])
+    dd = np.abs(ours.doppler_bin[:, None] - peer.doppler_bin[None, :]) % n_doppler
+    return (dr <= bins) & (np.minimum(dd, n_doppler - dd) <= bins)
+
+
+def compare(ours: Detections, peer: Detections, n_doppler: int,
+            angle_tol_deg: float) -> Agreement:
+    """How ours agree with the peer's: a peer detection off zero Doppler is found when a
+    point of ours is near it (:func:`near`); each point of ours near a peer detection is
+    compared in angle with the nearest one (fewest bins apart: the larger of the range and
+    Doppler distances, then their sum); a point of ours is outside the peer's clusters when
+    no peer detection is near it and within ``angle_tol_deg`` of it."""
+    m = near(ours, peer, n_doppler)
+    moving = peer.doppler_bin != 0
+    found = m.any(axis=0)
+    missed = [(int(r), int(d)) for r, d in zip(peer.range_bin[moving & ~found],
+                                               peer.doppler_bin[moving & ~found], strict=True)]
+    dr = np.abs(ours.range_bin[:, None] - peer.range_bin[None, :])
+    dd = np.abs(ours.doppler_bin[:, None] - peer.doppler_bin[None, :]) % n_doppler
+    dd = np.minimum(dd, n_doppler - dd)
+    cost = np.where(m, 1000 * np.maximum(dr, dd) + dr + dd, np.iinfo(np.int64).max)
+    has = m.any(axis=1)
+    nearest = np.argmin(cost, axis=1) if len(peer) else np.zeros(len(ours), int)
+    diff = np.abs(ours.azimuth_deg - peer.azimuth_deg[nearest]) if len(peer) else \
+        np.zeros(len(ours))
+    strongest = np.zeros(len(ours), bool)
+    for cell in set(zip(ours.range_bin.tolist(), ours.doppler_bin.tolist(), strict=True)):
+        idx = np.flatnonzero((ours.range_bin == cell[0]) & (ours.doppler_bin == cell[1]))
+        strongest[idx[np.argmax(ours.strength[idx])]] = True
+    in_angle = m & (np.abs(ours.azimuth_deg[:, None] - peer.azimuth_deg[None, :])
+                    <= angle_tol_deg)
+    out = ~in_angle.any(axis=1)
+    outside = [(int(r), int(d), round(float(az), 1)) for r, d, az in zip(
+        ours.range_bin[out], ours.doppler_bin[out], ours.azimuth_deg[out], strict=True)]
+    return Agreement(int(moving.sum()), missed, diff[has & strongest], diff[has], len(ours),
+                     int((~has).sum()), outside, angle_tol_deg)
+
+
+def median_ms(times_s: list[float] | np.ndarray) -> float:
+    return float(np.median(times_s)) * 1e3
+
+
+def spread(x: np.ndarray) -> str:
+    """'median a, max b' of angle differences, deg, or '-' if none."""
+    return f"median {np.median(x):.2f}, max {x.max():.2f} deg (n={len(x)})" if len(x) else "-"
+
+
+def verdict(ok: bool) -> str:
+    return "met" if ok else "MISSED"
+
+
+def table(peer_doc: dict[str, Any], ours: Detections, our_times_s: list[float],
+          agreement: Agreement, threshold_db: float, load: tuple[float, ...]) -> str:
+    """The printed comparison (see the module docstring)."""
+    demo, db = peer_doc["settings"]["demo"], peer_doc["settings"][f"{threshold_db:g} dB"]
+    v = peer_doc["versions"]
+    a = agreement
+    t_ours, t_db, t_demo = (median_ms(our_times_s), median_ms(db["times_s"]),
+                            median_ms(demo["times_s"]))
+    found = a.peer_moving - len(a.missed)
+    frac = len(a.outside) / a.ours if a.ours else 0.0
+    angle_ok = len(a.angle_strongest) > 0 and float(a.angle_strongest.max()) <= GOAL_ANGLE_DEG
+    db_name = f"peer {threshold_db:g} dB"
+    rows = [
+        f"OpenRadar {v['openradar']} (numpy {v['numpy']}, scikit-learn {v['scikit-learn']}) "
+        "vs ours, static-clutter removal in both",
+        f"{len(our_times_s)} timed runs each, median; load average "
+        f"{' '.join(f'{x:.2f}' for x in load)} ({os.cpu_count()} cores)",
+        "",
+        f"{'':<44}{'ours':>8}{db_name:>14}{'peer demo':>12}",
+        f"{'CFAR cells':<44}{'-':>8}{db['cfar_cells']:>14}{demo['cfar_cells']:>12}",
+        f"{'detections (points; peer: after its grouping)':<44}{len(ours):>8}"
+        f"{len(db['detections']['range_bin']):>14}{len(demo['detections']['range_bin']):>12}",
+        f"{'host time per frame, ms':<44}{t_ours:>8.1f}{t_db:>14.1f}{t_demo:>12.1f}",
+        "",
+        f"against the peer's {threshold_db:g} dB detections (near: <= {MATCH_BINS} range and "
+        f"{MATCH_BINS} Doppler bins)",
+        f"{'  moving returns of the peer ours finds':<44}{found} of {a.peer_moving}"
+        f"  goal all: {verdict(not a.missed)}",
+        f"{'  angle - its Bartlett, strongest per cell':<44}{spread(a.angle_strongest)}"
+        f"  goal <= {GOAL_ANGLE_DEG:g} deg: {verdict(angle_ok)}",
+        f"{'  angle - its Bartlett, every point':<44}{spread(a.angle_all)}",
+        f"{'  our points with no peer detection near':<44}{a.outside_cells} of {a.ours}",
+        f"{'  ... or none also within ' + format(a.angle_tol_deg, '.1f') + ' deg':<44}"
+        f"{len(a.outside)} of {a.ours} ({100 * frac:.0f} %)"
+        f"  goal <= {100 * GOAL_UNMATCHED:.0f} %: {verdict(frac <= GOAL_UNMATCHED)}",
+        f"{'  our time / the peer time (' + format(threshold_db, 'g') + ' dB)':<44}"
+        f"{t_ours / t_db:.2f}  goal <= 1/3: {verdict(t_ours / t_db <= GOAL_TIME_RATIO)}",
+    ]
+    notes = []
+    if a.missed:
+        notes.append("  the peer's that ours misses (range bin,Doppler bin): "
+                     + " ".join(f"({r},{d})" for r, d in a.missed))
+    if a.outside:
+        notes.append("  ours outside its clusters (range bin,Doppler bin,az deg): "
+                     + " ".join(f"({r},{d},{az:g})" for r, d, az in a.outside))
+    crash = peer_doc.get("tdm_compensation_error")
+    if crash:
+        notes.append(f"OpenRadar's dsp.add_doppler_compensation: {crash} (the runner "
+                     "compensates as it documents)")
+    rows += [textwrap.fill(n, WIDTH, subsequent_indent="    ") for n in notes]
+    return "\n".join(rows)
+
+
+def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
+             threshold_db: float, repeat: int) -> dict[str, Any]:
+    """The peer runner's JSON, run by ``python`` (OpenRadar's virtualenv) in a clean
+    environment; ``shape`` = (chirps, rx, samples, tx)."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "peer.json"
+        chirps, rx, samples, tx = shape
+        subprocess.run([str(python), str(PEER_RUNNER), "--capture", str(capture),
+                        "--chirps", str(chirps), "--rx", str(rx), "--samples", str(samples),
+                        "--tx", str(tx), "--threshold-db", f"{threshold_db:g}",
+                        "--repeat", str(repeat), "--out", str(out)], check=True, env=env)
+        return json.loads(out.read_text())
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--peer-python", type=Path, required=True,
+                    help="python of OpenRadar's virtualenv (make bench-openradar makes it "
+                         "and passes it)")
+    ap.add_argument("--radar", default=str(DATA / "openradar_2tx4rx.cfg"))
+    ap.add_argument("--capture", type=Path, default=DATA / "doppler_example_1.bin",
+                    help="a 2-lane DCA1000 .bin of the profile (frame 0 is used)")
+    ap.add_argument("--threshold-db", type=float, default=15.0,
+                    help="the peer's CFAR threshold compared with (default 15)")
+    ap.add_argument("--repeat", type=int, default=20, help="timed runs per chain")
+    ap.add_argument("--rounds", type=int, default=4,
+                    help="the timed runs alternate between the chains in this many rounds")
+    args = ap.parse_args(argv)
+    if not args.peer_python.exists():
+        print(f"bench_openradar: no {args.peer_python}: `make bench-openradar` creates "
+              "OpenRadar's virtualenv", file=sys.stderr)
+        return 2
+    opts = build_parser().parse_args(["process", "--radar", args.radar, "--capture",
+                                      str(args.capture), "--json", "-", "--remove-static"])
+    profile = profile_of(opts.radar)
+    cfg = profile.config
+    params, _ = process_params(opts, profile)
+    capture = open_capture(args.capture, profile)
+    load0 = os.getloadavg()
+    cloud = capture_frame_cloud(capture.frame(0), cfg, params, 0, opts.remove_static).cloud
+    peer_doc: dict[str, Any] = {}
+    times: list[float] = []
+    for n in np.diff(np.linspace(0, args.repeat, args.rounds + 1).round().astype(int)):
+        doc = run_peer(args.peer_python, args.capture,
+                       (cfg.n_chirps, cfg.num_rx, cfg.n_samples, cfg.num_tx),
+                       args.threshold_db, int(n))
+        for name, setting in doc["settings"].items():
+            setting["times_s"] = peer_doc.get("settings", {}).get(name, {}).get(
+                "times_s", []) + setting["times_s"]
+        peer_doc = doc
+        for _ in range(n):
+            t0 = time.perf_counter()
+            capture_frame_cloud(capture.frame(0), cfg, params, 0, opts.remove_static)
+            times.append(time.perf_counter() - t0)
+    load = tuple((a + b) / 2 for a, b in zip(load0, os.getloadavg(), strict=True))
+    ours = Detections.of_cloud(cloud)
+    peer = Detections.of_peer(peer_doc["settings"][f"{args.threshold_db:g} dB"]["detections"])
+    agreement = compare(ours, peer, cfg.n_doppler, cfg.angle_resolution_deg)
+    print(f"{os.path.relpath(args.capture)} ({cfg.num_tx} TX x {cfg.num_rx} RX, "
+          f"{cfg.n_loops} loops x {cfg.n_samples} samples), profile {os.path.relpath(args.radar)}")
+    print(table(peer_doc, ours, times, agreement, args.threshold_db, load))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,91 @@
+"""``benchmarks/bench_openradar.py`` without OpenRadar's virtualenv: the matching against a
+fake peer JSON (the runner's format), the printed table, and the missing-virtualenv exit.
+``tests/test_benchmarks_import.py`` imports the script."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.bench_openradar import Detections, compare, main, near, table
+
+N_DOPPLER = 128
+
+
+def ours() -> Detections:
+    """Points of ours: a target and a spurious second component in its cell, a second
+    target, a point at the Doppler wrap, and one where the peer has nothing."""
+    return Detections(range_bin=np.array([60, 60, 72, 10, 100]),
+                      doppler_bin=np.array([7, 7, 12, -64, 3]),
+                      azimuth_deg=np.array([-6.7, 40.0, 21.5, 0.5, 0.0]),
+                      strength=np.array([37.7, 20.0, 23.5, 15.0, 13.0]))
+
+
+def peer_doc() -> dict:
+    """The peer runner's JSON: a 15 dB setting with a static and a missed detection."""
+    det15 = {"range_bin": [60, 62, 72, 80, 110, 10], "doppler_bin": [7, 8, 12, 5, 0, 63],
+             "azimuth_deg": [-6.5, -5.6, 19.2, 3.0, 66.0, 1.0],
+             "det_value": [300.0, 280.0, 250.0, 200.0, 210.0, 190.0]}
+    demo = {"range_bin": list(range(50)), "doppler_bin": [1] * 50, "azimuth_deg": [0.0] * 50,
+            "det_value": [1.0] * 50}
+    return {"versions": {"openradar": "1.0.1", "numpy": "2.4", "scikit-learn": "1.9",
+                         "python": "3.11"},
+            "tdm_compensation_error": "TypeError: slice indices must be integers",
+            "settings": {"demo": {"bounds": [1.5, 2.5], "cfar_cells": 120, "detections": demo,
+                                  "times_s": [0.25, 0.3, 0.2]},
+                         "15 dB": {"bounds": [19.9, 19.9], "cfar_cells": 9, "detections": det15,
+                                   "times_s": [0.05, 0.04, 0.06]}}}
+
+
+def test_near_is_two_bins_and_circular_in_doppler():
+    o = Detections(np.array([60, 60, 60]), np.array([7, 12, -64]), np.zeros(3), np.zeros(3))
+    p = Detections(np.array([62, 58]), np.array([9, 63]), np.zeros(2), np.zeros(2))
+    assert near(o, p, N_DOPPLER).tolist() == [[True, False], [False, False], [False, True]]
+
+
+def test_compare_counts_finds_angles_and_clusters():
+    peer = Detections.of_peer(peer_doc()["settings"]["15 dB"]["detections"])
+    a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
+    assert a.peer_moving == 5                          # the zero-Doppler one is not counted
+    assert a.missed == [(80, 5)]
+    # strongest per cell, each against its nearest peer detection: same cell, fewest bins
+    assert sorted(np.round(a.angle_strongest, 2).tolist()) == [0.2, 0.5, 2.3]
+    assert sorted(np.round(a.angle_all, 2).tolist()) == [0.2, 0.5, 2.3, 46.5]
+    assert (a.ours, a.outside_cells) == (5, 1)
+    assert a.outside == [(60, 7, 40.0), (100, 3, 0.0)]
+
+
+def test_table_reports_against_the_goals():
+    doc = peer_doc()
+    peer = Detections.of_peer(doc["settings"]["15 dB"]["detections"])
+    a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
+    text = table(doc, ours(), [0.01, 0.012, 0.011], a, 15.0, (1.0, 1.5, 2.0))
+    lines = text.splitlines()
+    assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[1]
+    row = next(line for line in lines if line.startswith("host time per frame"))
+    assert row.split()[-3:] == ["11.0", "50.0", "250.0"]
+    row = next(line for line in lines if line.startswith("detections"))
+    assert row.split()[-3:] == ["5", "6", "50"]
+    assert "4 of 5  goal all: MISSED" in text
+    assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in text
+    assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in text
+    assert "0.22  goal <= 1/3: met" in text
+    assert "ours misses (range bin,Doppler bin): (80,5)" in text
+    assert "(range bin,Doppler bin,az deg): (60,7,40) (100,3,0)" in text
+    assert "TypeError: slice indices must be integers" in text
+
+
+def test_no_peer_virtualenv(tmp_path, capsys):
+    assert main(["--peer-python", str(tmp_path / "python")]) == 2
+    assert "make bench-openradar" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("missing", [[], [40.0]])
+def test_table_without_angles(missing):
+    """No point of ours near any peer detection: no angle numbers, the angle goal missed."""
+    doc = peer_doc()
+    peer = Detections.of_peer(doc["settings"]["15 dB"]["detections"])
+    far = Detections(np.array([120] * len(missing)), np.array([40] * len(missing)),
+                     np.array(missing), np.array(missing))
+    text = table(doc, far, [0.01], compare(far, peer, N_DOPPLER, 14.3), 15.0, (0.0, 0.0, 0.0))
+    assert "every point" in text and "-  goal <= 2 deg: MISSED" in text
