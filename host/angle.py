@@ -2,7 +2,7 @@
 spectrum, interpolated, and RELAX-style sequential estimation so that several targets in one
 range-Doppler cell each give a point and the sidelobes of a strong target do not.
 
-Virtual channel v at y = v lambda/2 sees exp(-j pi v sin(az)) (``model.simulate``), so the
+Virtual channel v at y = v lambda/2 sees exp(-j pi v sin(az)) (``model.array``), so the
 steering vector is exp(-j pi v s) and the angle spectrum is the inverse DFT over channels
 (``model.reference.angle_spectrum``). The entry points:
 
@@ -12,9 +12,37 @@ steering vector is exp(-j pi v s) and the angle spectrum is the inverse DFT over
 - :func:`estimate_angles`: the components (targets) of each row: the first at the
   spectrum's peak, always kept (the detector decided the cell holds a target); a second one
   is searched only where a Cauchy-Schwarz bound on the residual leaves room for one that
-  passes both gates of :class:`AngleParams`, and the rows that hold one go through RELAX
+  passes the gates of :class:`AngleParams`, and the rows that hold one go through RELAX
   (every component re-estimated with the others removed).
 - :func:`range_azimuth_power`: a range-azimuth map for figures.
+
+Model order (how many components a row holds). A further component k + 1 is kept only when
+its coherent SNR reaches ``min_snr_db``, it is within ``dynamic_range_db`` of the first, and
+the energy it removes from the residual is more than the residual the components already
+held explain without it. An n-channel row holding targets of per-channel amplitudes a_j on
+an array whose channels deviate from the model by complex relative errors e_v (gain and
+phase; E|e_v|^2 = eps^2 = 10^(``array_error_db`` / 10)) is
+
+    x_v = sum_j a_j s_j,v (1 + e_v) + noise_v,
+
+and after removing the components its residual holds the noise, n N on average (N per
+channel), and the part of each component the model cannot represent, n |a_j|^2 eps^2 on
+average (less the part the fit absorbs): E ||r||^2 <= n N + n eps^2 sum_j |a_j|^2. A
+further component at steering vector s (|s_v| = 1) removes n |a|^2 = |s^H r|^2 / n <=
+||r||^2 (Cauchy-Schwarz) from it, so when the held components explain the row, a further
+one removes at most the residual they leave: the test keeps it only where
+
+    n |a_{k+1}|^2 >= n N + n eps^2 sum_{j <= k} |a_j|^2,
+
+i.e. the new component alone carries more than the whole residual expected of the others,
+which no arrangement of their model error and noise reaches unless the residual exceeds its
+expected energy (a single target's error residue of n eps^2 |a_1|^2 spreads over n - 1
+dimensions, so its best single direction removes a fraction of it). With the default floor
+(-10 dB: a per-channel error of about 0.3 relative amplitude, e.g. 2 dB rms gain with 10
+deg rms phase, 3 dB above the +-2 dB, up to 12 deg of an uncalibrated TI board) an
+uncalibrated array gives one component per single target, and a second target must be
+within about 10 dB of the first (after calibration ``array_error_db`` can be lowered,
+e.g. -25 dB, to resolve weaker neighbours). ``array_error_db`` = -inf disables the test.
 
 The work runs in compiled kernels (``host._angle_peaks``, ``host._angle_relax``; numba,
 or the same code uncompiled where numba is missing: ``host.kernels``). The definition they
@@ -45,7 +73,9 @@ class AngleParams:
     always kept (the detector decided the cell, so a second gate here would lower the
     false-alarm rate below the configured Pfa and hide weak targets the CFAR found).
     ``dynamic_range_db``: further components at most this far below the strongest (model
-    errors of a strong target leave residue below that). ``refine_iterations``: RELAX passes
+    errors of a strong target leave residue below that). ``array_error_db``: the array's
+    per-channel model error (gain and phase, E|e_v|^2) relative to a component's power, the
+    floor of the model-order test (module docstring). ``refine_iterations``: RELAX passes
     re-estimating each component with the others removed.
     """
 
@@ -53,6 +83,7 @@ class AngleParams:
     max_targets: int = 3
     min_snr_db: float = 12.0
     dynamic_range_db: float = 20.0
+    array_error_db: float = -10.0
     refine_iterations: int = 2
 
     def __post_init__(self) -> None:
@@ -141,16 +172,18 @@ def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleP
     s1 = class_peaks(xs, np.arange(n_rows), ph, params.n_fft)[1] if first_sin is None \
         else np.asarray(first_sin, dtype=float)
     xc, a1, p1, maybe = first_components(xs, ph, s1, noise, params.min_snr_db,
-                                         params.dynamic_range_db, params.max_targets > 1)
+                                         params.dynamic_range_db, params.array_error_db,
+                                         params.max_targets > 1)
     more = np.zeros(n_rows, bool)
     rows = np.flatnonzero(maybe)
-    if len(rows):                       # the residual's strongest peak passes both gates?
+    if len(rows):                       # the residual's strongest peak passes the gates?
         r = xc[rows] - a1[rows, None] * steering_rows(s1[rows], n)
         s2, _ = peak_sins(r, params.n_fft)
         p2 = np.abs(np.sum(np.conj(steering_rows(s2, n)) * r, axis=1) / n) ** 2
         with np.errstate(divide="ignore"):
             more[rows] = (10 * np.log10(p2 * n / noise[rows]) >= params.min_snr_db) & (
-                10 * np.log10(p1[rows] / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+                10 * np.log10(p1[rows] / np.maximum(p2, 1e-300)) <= params.dynamic_range_db
+            ) & (p2 >= noise[rows] + 10 ** (params.array_error_db / 10) * p1[rows])
     snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
     multi = np.flatnonzero(more)
     if not len(multi):
@@ -169,7 +202,7 @@ def _relax(xs: np.ndarray, noise: np.ndarray, params: AngleParams) -> AngleArray
     per channel, as :func:`_kept_components`."""
     s_c, a_c, count = relax_rows(xs, noise, params.n_fft, params.max_targets,
                                  params.refine_iterations, params.min_snr_db,
-                                 params.dynamic_range_db)
+                                 params.dynamic_range_db, params.array_error_db)
     return _kept_components(s_c, a_c, count, noise, xs.shape[1])
 
 
