@@ -57,8 +57,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from host._angle_array import ArrayGrid, array_grid, bartlett_peaks, relax_general
 from host._angle_peaks import COARSE_FFT, class_peaks, peak_sins
 from host._angle_relax import first_components, relax_rows, steering_rows
+from model.array import steering
 from model.config import RadarConfig
 from model.reference import angle_spectrum, tdm_phase_compensation
 
@@ -98,16 +100,24 @@ class AngleArrays:
     """Angle components of many rows as flat arrays (one entry per component, rows in
     order, strongest first within a row): ``cell`` int (p,) row of the input; ``sin_az``,
     ``snr_db`` float (p,) (coherent SNR |a|^2 n / noise per channel, dB); ``amplitude``
-    complex (p,) per-channel amplitude in the input's units."""
+    complex (p,) per-channel amplitude in the input's units; ``sin_el`` float (p,) sin of
+    the elevation (None: 0, an array without vertical extent)."""
 
     cell: np.ndarray
     sin_az: np.ndarray
     amplitude: np.ndarray
     snr_db: np.ndarray
+    sin_el: np.ndarray | None = None
 
     @property
     def azimuth_deg(self) -> np.ndarray:
         return np.degrees(np.arcsin(np.clip(self.sin_az, -1.0, 1.0)))
+
+    @property
+    def elevation_deg(self) -> np.ndarray:
+        if self.sin_el is None:
+            return np.zeros(len(self.cell))
+        return np.degrees(np.arcsin(np.clip(self.sin_el, -1.0, 1.0)))
 
 
 MAX_CHANNELS = COARSE_FFT
@@ -131,44 +141,82 @@ def _rows_and_phasors(x: np.ndarray, tx_phasors: np.ndarray | None
     None); ValueError naming a shape that does not fit."""
     xs = _vectors(x)
     ph = np.ones((len(xs), 1)) if tx_phasors is None else np.asarray(tx_phasors)
-    if ph.ndim != 2 or len(ph) != len(xs) or ph.shape[1] < 1 or xs.shape[1] % ph.shape[1]:
-        raise ValueError(f"angles: TX phasors {ph.shape} do not fit channel vectors "
-                         f"{xs.shape}")
+    _check_phasors(ph, xs)
     return xs, ph
 
 
+def _check_phasors(ph: np.ndarray, x: np.ndarray) -> None:
+    """ValueError unless ph (complex (m, num_tx)) holds TX phasors of the rows x (complex
+    (m, n), n a multiple of num_tx)."""
+    if ph.ndim != 2 or len(ph) != len(x) or ph.shape[1] < 1 or x.shape[1] % ph.shape[1]:
+        raise ValueError(f"angles: TX phasors {ph.shape} do not fit channel vectors "
+                         f"{x.shape}")
+
+
 def peak_powers(x: np.ndarray, n_fft: int, tx_phasors: np.ndarray | None = None,
-                rows: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                rows: np.ndarray | None = None, positions: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """The strongest peak of the angle spectrum of each vector: (|X(k)|^2 at the
     ``n_fft``-grid maximum, float (m,); its interpolated sin(az), float (m,)).
 
     x: complex (n, n_channels), channel v = tx * num_rx + rx; rows: int (m,) which row of x
     each vector is (default: every row once); tx_phasors: complex (m, num_tx), TX t's
-    channels multiplied by tx_phasors[:, t] first (TDM compensation, ``host.tdm``)."""
+    channels multiplied by tx_phasors[:, t] first (TDM compensation, ``host.tdm``);
+    positions: float (n_channels, 2) the virtual array (``RadarConfig.
+    virtual_positions_hw``) when it is not the contiguous lambda/2 ULA: then the peak of
+    the Bartlett spectrum |s^H x|^2 over its steering vectors (``host._angle_array``) and
+    its direction cosine u (sin(az) cos(el)) instead."""
     xs = _vectors(x)
     rows = np.arange(len(xs)) if rows is None else np.asarray(rows)
     ph = np.ones((len(rows), 1)) if tx_phasors is None else np.asarray(tx_phasors)
-    return class_peaks(xs, rows, ph, n_fft)
+    if positions is None:
+        return class_peaks(xs, rows, ph, n_fft)
+    _check_phasors(ph, xs[rows])
+    u, _, power = bartlett_peaks(_compensated(xs[rows], ph), _grid_of(positions, xs))
+    return power, u
+
+
+def _compensated(x: np.ndarray, ph: np.ndarray) -> np.ndarray:
+    """Rows x (complex (m, n)) with TX t's channels times ph[:, t] (ph complex (m, num_tx),
+    :func:`_check_phasors`)."""
+    return x * np.repeat(ph, x.shape[1] // ph.shape[1], axis=1)
+
+
+def _grid_of(positions: np.ndarray, x: np.ndarray) -> ArrayGrid:
+    """``host._angle_array.array_grid`` of positions (float (n, 2)); ValueError unless
+    they are one per channel of x (complex (m, n))."""
+    p = np.asarray(positions, dtype=float)
+    if p.shape != (x.shape[1], 2):
+        raise ValueError(f"angles: array positions {p.shape} for {x.shape[1]} channels")
+    return array_grid(p)
 
 
 def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
-                    tx_phasors: np.ndarray | None = None, first_sin: np.ndarray | None = None
-                    ) -> AngleArrays:
+                    tx_phasors: np.ndarray | None = None, first_sin: np.ndarray | None = None,
+                    positions: np.ndarray | None = None) -> AngleArrays:
     """The angle components of every row (module docstring).
 
     x: complex (n, n_channels) channel vectors (cube units); noise_per_channel: float (n,)
     noise power per channel in the units of |x|^2 (0 counts as 1e-30); tx_phasors:
     complex (n, num_tx), TX t's channels of row i multiplied by tx_phasors[i, t] first
     (TDM compensation; None: the rows as they are); first_sin: float (n,) the
-    (compensated) rows' :func:`peak_powers` sin(az) when the caller has it already."""
+    (compensated) rows' :func:`peak_powers` sin(az) when the caller has it already (the
+    ULA only); positions: float (n_channels, 2) the virtual array when it is not the
+    contiguous lambda/2 ULA (``RadarConfig.virtual_positions_hw``): RELAX over its
+    steering vectors (``host._angle_array``), elevation too where it has vertical extent."""
     xs, ph = _rows_and_phasors(x, tx_phasors)
     n_rows, n = xs.shape
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
     if noise.shape != (n_rows,):
         raise ValueError(f"angles: noise {noise.shape} for {n_rows} rows")
+    if positions is not None and first_sin is not None:
+        raise ValueError("angles: first_sin is the ULA's peak; not with array positions")
     if not n_rows:
         z = np.zeros(0)
-        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
+        return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z,
+                           None if positions is None else z)
+    if positions is not None:
+        return _general(xs, ph, noise, params, positions)
     s1 = class_peaks(xs, np.arange(n_rows), ph, params.n_fft)[1] if first_sin is None \
         else np.asarray(first_sin, dtype=float)
     xc, a1, p1, maybe = first_components(xs, ph, s1, noise, params.min_snr_db,
@@ -197,6 +245,20 @@ def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleP
                        np.concatenate([snr1[single], got.snr_db])[order])
 
 
+def _general(xs: np.ndarray, ph: np.ndarray, noise: np.ndarray, params: AngleParams,
+             positions: np.ndarray) -> AngleArrays:
+    """:func:`estimate_angles` over the steering vectors of an array at ``positions`` (float
+    (n, 2)): ``host._angle_array.relax_general`` of the compensated rows xs (complex (m, n))
+    and :func:`_kept_components`, sin(az) = u / cos(el)."""
+    grid = _grid_of(positions, xs)
+    u, w, a, count = relax_general(_compensated(xs, ph), noise, grid, params)
+    got = _kept_components(u, a, count, noise, xs.shape[1], w, grid.span)
+    sin_el = got.sin_el if not grid.planar else np.zeros(len(got.cell))
+    sin_az = got.sin_az / np.sqrt(np.maximum(1.0 - sin_el ** 2, 1e-30))
+    return AngleArrays(got.cell, np.clip(sin_az, -1.0, 1.0), got.amplitude, got.snr_db,
+                       sin_el)
+
+
 def _relax(xs: np.ndarray, noise: np.ndarray, params: AngleParams) -> AngleArrays:
     """RELAX (``host._angle_relax.relax_rows``) of rows xs, complex (m, n), noise float (m,)
     per channel, as :func:`_kept_components`."""
@@ -207,25 +269,34 @@ def _relax(xs: np.ndarray, noise: np.ndarray, params: AngleParams) -> AngleArray
 
 
 def _kept_components(s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray, noise: np.ndarray,
-                     n: int) -> AngleArrays:
+                     n: int, w_c: np.ndarray | None = None,
+                     span: tuple[float, float] | None = None) -> AngleArrays:
     """The components found per row (sin s_c float (m, k), amplitude a_c complex (m, k), the
     first count int (m,) slots of each row valid; noise float (m,) per channel, n channels)
     strongest first (a stable sort), without those that collapsed onto a stronger one during
-    refinement (within 0.5 / n in sin(az)), as flat :class:`AngleArrays`."""
+    refinement (within 0.5 / n in sin(az)), as flat :class:`AngleArrays`. A general array:
+    s_c holds the direction cosines u, w_c float (m, k) the w, span (H + 1, V + 1) its
+    apertures (``host._angle_array.ArrayGrid``): collapsed within 0.5 / (H + 1) in u and
+    0.5 / (V + 1) in w, the w kept as ``sin_el``."""
     kmax = s_c.shape[1]
     with np.errstate(divide="ignore"):
         snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
     valid = np.arange(kmax)[None, :] < count[:, None]
     order = np.argsort(np.where(valid, -np.abs(a_c), np.inf), axis=1, kind="stable")
     s_o = np.take_along_axis(s_c, order, axis=1)
+    w_o = None if w_c is None else np.take_along_axis(w_c, order, axis=1)
+    tol_u, tol_w = (0.5 / n, np.inf) if span is None else (0.5 / span[0], 0.5 / span[1])
     kept = np.take_along_axis(valid, order, axis=1)
     for p in range(kmax):
         for u in range(p):
-            kept[:, p] &= ~kept[:, u] | (np.abs(s_o[:, p] - s_o[:, u]) > 0.5 / n)
+            apart = np.abs(s_o[:, p] - s_o[:, u]) > tol_u
+            if w_o is not None:
+                apart |= np.abs(w_o[:, p] - w_o[:, u]) > tol_w
+            kept[:, p] &= ~kept[:, u] | apart
     rows, pos = np.nonzero(kept)
     comp = order[rows, pos]
     return AngleArrays(rows.astype(np.int64), s_c[rows, comp], a_c[rows, comp],
-                       snr_c[rows, comp])
+                       snr_c[rows, comp], None if w_c is None else w_c[rows, comp])
 
 
 def range_azimuth_power(cube: np.ndarray, cfg: RadarConfig, n_fft: int = 256
@@ -234,9 +305,16 @@ def range_azimuth_power(cube: np.ndarray, cfg: RadarConfig, n_fft: int = 256
     summed over Doppler (for figures; detection uses :func:`estimate_angles`).
 
     cube: complex (n_virtual, n_range, n_doppler). Returns (float (n_range, n_fft) power,
-    float (n_fft,) azimuth of each column in deg, NaN outside the visible region).
+    float (n_fft,) azimuth of each column in deg, NaN outside the visible region). A
+    virtual array other than the contiguous lambda/2 ULA: the Bartlett spectrum over its
+    steering vectors at elevation 0 (untapered) on the same sin(az) grid.
     """
     comp = tdm_phase_compensation(cfg, np.arange(cfg.n_doppler))             # (n_d, n_v)
     x = np.moveaxis(cube, 0, -1) * comp[None, :, :]                           # (r, d, n_v)
-    spec, az = angle_spectrum(x, n_fft=n_fft, window=True)                    # (r, d, n_fft)
+    if cfg.uniform_linear_array:
+        spec, az = angle_spectrum(x, n_fft=n_fft, window=True)                # (r, d, n_fft)
+    else:                   # the azimuths of the same grid, from one (empty) vector
+        _, az = angle_spectrum(np.zeros(cfg.n_virtual), n_fft=n_fft)
+        s = 2.0 * (np.arange(n_fft) - n_fft // 2) / n_fft
+        spec = x @ np.conj(steering(cfg.virtual_positions_hw, s)).T
     return np.sum(np.abs(spec) ** 2, axis=1), az

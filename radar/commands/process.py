@@ -21,6 +21,7 @@ from host.adc_capture import open_capture
 from host.params import default_max_speed_mps
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
+from model.array import has_vertical_extent
 from model.profile import Profile, load_profile
 from model.reference import radar_cube
 from radar.common import (
@@ -138,7 +139,8 @@ def cmd_process(args: argparse.Namespace) -> int:
     warn_clipped(clipped, "process")
     done = len(per_frame)
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped,
+                                             has_vertical_extent(cfg.virtual_positions_hw))
     doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
                 "max_speed_mps": params.max_speed_mps,
