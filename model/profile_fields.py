@@ -72,18 +72,13 @@ def check_profile_fields(cfg: RadarConfig) -> None:
 
 def unsupported_features(cfg: RadarConfig) -> list[str]:
     """What of ``cfg`` the processing chain cannot handle yet, one phrase each (empty for the
-    presets): zero padding, a firing order other than 0..num_tx-1, a real ADC, a virtual
-    array other than the contiguous lambda/2 ULA."""
+    presets): zero padding, a real ADC."""
     out = []
     if cfg.n_samples != cfg.n_range:
         out.append(f"{cfg.n_samples} samples per chirp zero-padded to a {cfg.n_range}-point "
                    "range FFT")
     if cfg.n_loops != cfg.n_doppler:
         out.append(f"{cfg.n_loops} loops zero-padded to a {cfg.n_doppler}-point Doppler FFT")
-    if cfg.tx_sequence != tuple(range(cfg.num_tx)):
-        out.append(f"TX firing order {list(cfg.tx_sequence)}")
     if cfg.adc != "complex":
         out.append("real-valued ADC")
-    if not cfg.uniform_linear_array:
-        out.append("a virtual array other than the contiguous horizontal lambda/2 ULA")
     return out
