@@ -1,10 +1,16 @@
-"""Angle of arrival over the virtual ULA: the strongest peak of the zero-padded angle
-spectrum, interpolated, and RELAX-style sequential estimation so that several targets in one
+"""Angle of arrival over the virtual array: the strongest peak of the angle spectrum,
+interpolated, and RELAX-style sequential estimation so that several targets in one
 range-Doppler cell each give a point and the sidelobes of a strong target do not.
 
-Virtual channel v at y = v lambda/2 sees exp(-j pi v sin(az)) (``model.array``), so the
-steering vector is exp(-j pi v s) and the angle spectrum is the inverse DFT over channels
-(``model.reference.angle_spectrum``). The entry points:
+The contiguous lambda/2 ULA (``RadarConfig.uniform_linear_array``, the presets): virtual
+channel v at y = v lambda/2 sees exp(-j pi v sin(az)) (``model.array``), so the steering
+vector is exp(-j pi v s) and the angle spectrum is the zero-padded inverse DFT over channels
+(``model.reference.angle_spectrum``), searched by compiled kernels. Any other array (gaps,
+another channel order, elements at several heights) is given by its virtual positions
+(``positions``, ``RadarConfig.virtual_positions_hw``): the Bartlett spectrum |s^H x|^2 over
+its steering vectors ``model.array.steering`` on a grid of directions, refined locally
+(``host._angle_array``), with the same RELAX and gates; where the array has vertical extent
+the components carry an elevation too. The entry points:
 
 - :func:`peak_powers`: the strongest peak (power, sin(az)) of each row's spectrum, the rows
   optionally TDM-compensated per TX (the velocity-unfolding test of ``host.tdm`` compares
