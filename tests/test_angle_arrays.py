@@ -188,3 +188,16 @@ def test_elevation_in_json_ros_and_figures() -> None:
     power, az = range_azimuth_power(synth_cube(cfg, SCENE, np.random.default_rng(3)), cfg)
     assert power.shape == (cfg.n_range, 256)
     assert abs(az[np.argmax(power[90])] - 5.0) < 2.0
+
+
+@pytest.mark.parametrize("order", [(0, 1, 2), (2, 0, 1)])
+def test_velocity_unfolding_on_the_2d_array(order: tuple[int, ...]) -> None:
+    """A target beyond the unambiguous speed (Doppler bin 84 of 128: measured at -44): the
+    TDM test over the 2-D array's Bartlett peaks unfolds it, in either firing order."""
+    cfg = xwr1843(order)
+    cube = synth_cube(cfg, [(60, 84.0, 12.0, -8.0)], np.random.default_rng(4))
+    cloud = process_cube(cube, cfg, DetectionParams(max_speed_mps=3 * cfg.max_velocity_mps))
+    best = np.argmax(cloud.snr_db)
+    assert cloud.doppler_bin[best] == 84 and cloud.ambiguous[best]
+    assert abs(cloud.azimuth_deg[best] - 12.0) < 1.0
+    assert abs(cloud.elevation_deg[best] + 8.0) < 1.0
