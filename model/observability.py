@@ -61,12 +61,13 @@ class Unobservable:
 def integrated_snr_db(cfg: RadarConfig, sc: Scatterers, beamforming: bool,
                       frame_index: int = 0) -> np.ndarray:
     """Expected SNR of each scatterer after coherent integration over range, Doppler and
-    virtual channels with Hann windows, dB, shape (n,)."""
+    virtual channels with Hann windows (the ADC samples and loops: zero padding adds no
+    gain), dB, shape (n,)."""
     moved = Scatterers(np.maximum(frame_centre_range_m(cfg, sc, frame_index), 1e-3),
                        sc.azimuth_deg, sc.radial_velocity_mps, sc.rcs_m2, sc.object_id)
     with np.errstate(divide="ignore"):
         per_sample = snr_per_sample_db(cfg, moved, beamforming)
-    gain = 10 * np.log10(cfg.n_range * cfg.n_doppler * cfg.n_virtual) - 2 * HANN_LOSS_DB
+    gain = 10 * np.log10(cfg.n_samples * cfg.n_loops * cfg.n_virtual) - 2 * HANN_LOSS_DB
     return per_sample + gain
 
 

@@ -15,6 +15,8 @@ Scene JSON (docs/design.md 4.3)::
                   "vx_mps": -5, "vy_mps": 0, "rcs_m2": 10, "n_scatterers": 12,
                   "label": "car"}]}
 
+A target may also give ``elevation_deg`` (default 0); an ``"impairments"`` table adds the
+real-world effects of ``model.impairments`` (docs/profiles.md).
 ``{"scene": "table1", "preset": "full"}`` names the built-in paper scene instead.
 """
 
@@ -30,6 +32,8 @@ from typing import Any
 import numpy as np
 
 from model.config import PRESETS, RadarConfig, get_preset
+from model.impairments import NO_IMPAIRMENTS, Impairments
+from model.json_fields import check_keys, number
 
 KMH = 1.0 / 3.6
 """m/s per km/h."""
@@ -52,7 +56,8 @@ MAX_SCATTERERS = 2048
 MAX_SEED = 2**63 - 1
 """Largest scene seed."""
 
-_BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "radial_velocity_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
+_BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "elevation_deg": (-90.0, 90.0),
+           "radial_velocity_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
            "rcs_m2": (0.0, MAX_RCS_M2), "x_m": (-MAX_RANGE_M, MAX_RANGE_M),
            "y_m": (-MAX_RANGE_M, MAX_RANGE_M), "length_m": (0.0, MAX_SIZE_M),
            "width_m": (0.0, MAX_SIZE_M), "vx_mps": (-MAX_SPEED_MPS, MAX_SPEED_MPS),
@@ -60,33 +65,7 @@ _BOUNDS = {"range_m": (0.0, MAX_RANGE_M), "radial_velocity_mps": (-MAX_SPEED_MPS
 
 
 def _number(d: Mapping[str, Any], key: str, where: str, default: float | None = None) -> float:
-    if key not in d:
-        if default is None:
-            raise ValueError(f"{where}: missing required field {key!r}")
-        return default
-    value = d[key]
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(f"{where}.{key}: must be a finite number, got {value!r}")
-    try:
-        finite = math.isfinite(value)
-    except OverflowError:                   # an integer beyond float range
-        finite = False
-    if not finite:
-        raise ValueError(f"{where}.{key}: must be a finite number, got {str(value)[:20]}"
-                         f"{'...' if len(str(value)) > 20 else ''}")
-    lo, hi = _BOUNDS.get(key, (-math.inf, math.inf))
-    if not lo <= value <= hi:
-        raise ValueError(f"{where}.{key}: {value!r} is outside what the simulator accepts "
-                         f"[{lo:g}, {hi:g}]")
-    return float(value)
-
-
-def _check_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    if not isinstance(d, Mapping):
-        raise ValueError(f"{where}: must be a JSON object, got {type(d).__name__}")
-    unknown = set(d) - allowed
-    if unknown:
-        raise ValueError(f"{where}: unknown field(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+    return number(d, key, where, default, _BOUNDS.get(key, (-math.inf, math.inf)))
 
 
 @dataclass(frozen=True)
@@ -94,8 +73,9 @@ class Scatterers:
     """A flat set of point scatterers, all arrays of shape (n,).
 
     ``range_m`` (m), ``azimuth_deg`` (deg), ``radial_velocity_mps`` (m/s, + receding),
-    ``rcs_m2`` (m^2), and ``object_id`` (int, -1 for free point targets) linking each
-    scatterer to the scene object it belongs to (for labelled datasets).
+    ``rcs_m2`` (m^2), ``object_id`` (int, -1 for free point targets) linking each
+    scatterer to the scene object it belongs to (for labelled datasets), and
+    ``elevation_deg`` (deg, + up; None: all 0, in the radar's horizontal plane).
     """
 
     range_m: np.ndarray
@@ -103,6 +83,11 @@ class Scatterers:
     radial_velocity_mps: np.ndarray
     rcs_m2: np.ndarray
     object_id: np.ndarray
+    elevation_deg: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.elevation_deg is None:
+            object.__setattr__(self, "elevation_deg", np.zeros(np.shape(self.range_m)))
 
     def __len__(self) -> int:
         return int(self.range_m.shape[0])
@@ -114,21 +99,26 @@ class Scatterers:
             e = np.zeros(0)
             return Scatterers(e, e, e, e, np.zeros(0, dtype=int))
         return Scatterers(*(np.concatenate([getattr(p, f) for p in parts]) for f in (
-            "range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2", "object_id")))
+            "range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2", "object_id",
+            "elevation_deg")))
 
 
 @dataclass(frozen=True)
 class PointTarget:
-    """One point scatterer: range (m), azimuth (deg), radial velocity (m/s), RCS (m^2)."""
+    """One point scatterer: range (m), azimuth (deg), radial velocity (m/s), RCS (m^2) and
+    elevation (deg, + up; optional in the JSON, default 0)."""
 
     range_m: float
     azimuth_deg: float
     radial_velocity_mps: float
     rcs_m2: float
+    elevation_deg: float = 0.0
 
     FIELDS = ("range_m", "azimuth_deg", "radial_velocity_mps", "rcs_m2")
 
     def __post_init__(self) -> None:
+        if not -90.0 < self.elevation_deg < 90.0:
+            raise ValueError(f"elevation_deg: must be inside (-90, 90), got {self.elevation_deg}")
         if self.range_m <= 0:
             raise ValueError(f"range_m: must be positive, got {self.range_m}")
         if not -90.0 < self.azimuth_deg < 90.0:
@@ -138,20 +128,32 @@ class PointTarget:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "target") -> PointTarget:
-        _check_keys(d, set(cls.FIELDS), where)
+        check_keys(d, {*cls.FIELDS, "elevation_deg"}, where)
         vals = {k: _number(d, k, where) for k in cls.FIELDS}
+        vals["elevation_deg"] = _number(d, "elevation_deg", where, 0.0)
         try:
             return cls(**vals)
         except ValueError as exc:
             raise ValueError(f"{where}.{exc}") from None
 
+    def to_dict(self) -> dict[str, float]:
+        """The target's JSON (``elevation_deg`` only when not 0)."""
+        d = asdict(self)
+        if not self.elevation_deg:
+            del d["elevation_deg"]
+        return d
+
     @property
     def x_m(self) -> float:
-        return self.range_m * math.cos(math.radians(self.azimuth_deg))
+        """Position along the boresight, m (``model.array.cartesian``)."""
+        return self.range_m * math.cos(math.radians(self.elevation_deg)) * math.cos(
+            math.radians(self.azimuth_deg))
 
     @property
     def y_m(self) -> float:
-        return self.range_m * math.sin(math.radians(self.azimuth_deg))
+        """Position to the left, m."""
+        return self.range_m * math.cos(math.radians(self.elevation_deg)) * math.sin(
+            math.radians(self.azimuth_deg))
 
 
 OBJECT_LABELS: tuple[str, ...] = ("car", "pedestrian", "pedestrian_group", "two_wheeler",
@@ -202,7 +204,7 @@ class ExtendedObject:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], where: str = "object") -> ExtendedObject:
-        _check_keys(d, set(cls.NUMBERS) | {"n_scatterers", "label"}, where)
+        check_keys(d, set(cls.NUMBERS) | {"n_scatterers", "label"}, where)
         vals: dict[str, Any] = {k: _number(d, k, where, 0.0 if k in ("heading_deg", "vx_mps",
                                                                   "vy_mps") else None)
                                 for k in cls.NUMBERS}
@@ -266,6 +268,9 @@ class Scene:
 
     ``noise=False`` switches thermal noise off (for model tests). Frame k of a scene (see
     ``model.simulate.simulate_scene``) moves each target radially by ``v * k * frame_time``.
+    ``impairments``: the real-world effects the simulator adds (``model.impairments``; the
+    JSON's ``"impairments"`` table), none by default. ``radar``: the radar when it is not the
+    preset (a profile, ``radar simulate --radar``; not part of the JSON), None: the preset's.
     """
 
     preset: str = "full"
@@ -275,21 +280,29 @@ class Scene:
     objects: tuple[ExtendedObject, ...] = ()
     noise: bool = True
     name: str = "custom"
+    impairments: Impairments = NO_IMPAIRMENTS
+    radar: RadarConfig | None = None
 
     def __post_init__(self) -> None:
         get_preset(self.preset)  # validates the name
-        n = len(self.targets) + sum(o.n_scatterers for o in self.objects)
+        imp = self.impairments
+        n = len(self.targets) + sum(o.n_scatterers for o in self.objects) + sum(
+            w.n_scatterers for w in imp.walls) + (imp.ground.n_scatterers if imp.ground else 0)
         if n > MAX_SCATTERERS:
-            raise ValueError(f"scene: {n} scatterers (targets + objects' n_scatterers), at "
-                             f"most {MAX_SCATTERERS}")
+            raise ValueError(f"scene: {n} scatterers (targets + objects' and clutter's "
+                             f"n_scatterers), at most {MAX_SCATTERERS}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not \
                 0 <= self.seed <= MAX_SEED:
             raise ValueError(f"seed: must be an integer in 0..2**63-1, got {self.seed!r}")
+        try:
+            imp.check(self.config)
+        except ValueError as exc:
+            raise ValueError(f"impairments.{exc}") from None
 
     @property
     def config(self) -> RadarConfig:
-        """The radar configuration of the scene's preset."""
-        return get_preset(self.preset)
+        """The scene's radar: ``radar``, else its preset's configuration."""
+        return get_preset(self.preset) if self.radar is None else self.radar
 
     def scatterers(self) -> Scatterers:
         """All scatterers of the scene: point targets (object_id -1) then each object's."""
@@ -300,7 +313,7 @@ class Scene:
             parts.append(Scatterers(
                 np.array([x.range_m for x in t]), np.array([x.azimuth_deg for x in t]),
                 np.array([x.radial_velocity_mps for x in t]), np.array([x.rcs_m2 for x in t]),
-                np.full(len(t), -1)))
+                np.full(len(t), -1), np.array([x.elevation_deg for x in t])))
         for i, obj in enumerate(self.objects):
             parts.append(obj.scatterers(rng, i))
         return Scatterers.concat(parts)
@@ -316,7 +329,8 @@ class Scene:
             raise ValueError(f"preset: unknown preset {preset!r}; choose one of "
                              f"{', '.join(PRESETS)}")
         if "scene" in d:
-            _check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise"}, "scene")
+            check_keys(d, {"scene", "preset", "seed", "tx_beamforming", "noise", "impairments"},
+                       "scene")
             builtin = d["scene"]
             if not isinstance(builtin, str) or builtin not in BUILTIN_SCENES:
                 raise ValueError(f"scene: unknown built-in scene {builtin!r}; choose one of "
@@ -325,9 +339,10 @@ class Scene:
             return Scene(preset=preset, seed=_int(d, "seed", base.seed),
                          tx_beamforming=_bool(d, "tx_beamforming", base.tx_beamforming),
                          targets=base.targets, objects=base.objects,
-                         noise=_bool(d, "noise", True), name=builtin)
-        _check_keys(d, {"preset", "seed", "tx_beamforming", "targets", "objects", "noise",
-                        "name"}, "scene")
+                         noise=_bool(d, "noise", True), name=builtin,
+                         impairments=_impairments(d))
+        check_keys(d, {"preset", "seed", "tx_beamforming", "targets", "objects", "noise",
+                       "name", "impairments"}, "scene")
         targets = d.get("targets", [])
         objects = d.get("objects", [])
         if not isinstance(targets, list):
@@ -344,14 +359,24 @@ class Scene:
                           for i, t in enumerate(targets)),
             objects=tuple(ExtendedObject.from_dict(o, f"objects[{i}]")
                           for i, o in enumerate(objects)),
-            noise=_bool(d, "noise", True), name=str(name))
+            noise=_bool(d, "noise", True), name=str(name), impairments=_impairments(d))
 
     def to_dict(self) -> dict[str, Any]:
-        """Scene JSON (explicit targets and objects, never a built-in name)."""
-        return {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
-                "noise": self.noise, "name": self.name,
-                "targets": [asdict(t) for t in self.targets],
-                "objects": [asdict(o) for o in self.objects]}
+        """Scene JSON (explicit targets and objects, never a built-in name; the impairments
+        table when there are any; not ``radar``)."""
+        d = {"preset": self.preset, "seed": self.seed, "tx_beamforming": self.tx_beamforming,
+             "noise": self.noise, "name": self.name,
+             "targets": [t.to_dict() for t in self.targets],
+             "objects": [asdict(o) for o in self.objects]}
+        if self.impairments != NO_IMPAIRMENTS:
+            d["impairments"] = self.impairments.to_dict()
+        return d
+
+
+def _impairments(d: Mapping[str, Any]) -> Impairments:
+    """The scene JSON's impairments table (none: the ideal radar)."""
+    return NO_IMPAIRMENTS if d.get("impairments") is None else Impairments.from_dict(
+        d["impairments"])
 
 
 def _int(d: Mapping[str, Any], key: str, default: int) -> int:

@@ -16,13 +16,12 @@ from model.reference import (
 from model.scene import Scatterers
 from model.simulate import (
     chirp_times_s,
+    chirp_tx,
     quantize_adc,
-    rx_positions_m,
     simulate_baseband,
     simulate_frame,
     subarray_factor_power,
     tone_amplitude_lsb,
-    tx_positions_m,
 )
 
 
@@ -177,8 +176,9 @@ def test_vectorised_simulator_equals_direct_formula():
     assert dropped == 0
     amp = tone_amplitude_lsb(cfg, sc, True)
     t_c = chirp_times_s(cfg)[:, None, None, None]
-    y_tx = tx_positions_m(cfg)[np.arange(cfg.n_chirps) % cfg.num_tx][:, None, None, None]
-    y_rx = rx_positions_m(cfg)[None, :, None, None]
+    half = cfg.wavelength_m / 2
+    y_tx = half * cfg.tx_positions_hw[chirp_tx(cfg), 0][:, None, None, None]
+    y_rx = half * cfg.rx_positions_hw[:, 0][None, :, None, None]
     t_n = (np.arange(cfg.n_range) / cfg.sample_rate_hz)[None, None, :, None]
     r, v, s = sc.range_m, sc.radial_velocity_mps, np.sin(np.radians(sc.azimuth_deg))
     tau = (2 * (r + v * (t_c + t_n)) - (y_tx + y_rx) * s) / C0
