@@ -10,9 +10,9 @@ RUN    := tools/venv-run
 JOBS   ?= auto
 OUT    ?= out
 
-.PHONY: all setup demo test test-python sim lint gen bench bench-rtl soak gnn-dataset gnn-train \
+.PHONY: all setup demo test test-python sim lint gen regs bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
-        formal coverage mutate mutate-ci
+        formal coverage mutate mutate-ci curves bench-ray
 all: test
 
 help:
@@ -22,7 +22,9 @@ help:
 	@echo "make sim BLOCK=name  one block's cocotb testbench (tb/name)"
 	@echo "make lint            Verilator --lint-only -Wall on every RTL module"
 	@echo "make gen             regenerate generated RTL (rtl/fft/fft_rom_pkg.sv, fft_*_rom.sv,"
-	@echo "                     rtl/buffers/packet_crc32.sv) and check it"
+	@echo "                     rtl/buffers/packet_crc32.sv, the register map's files) and check it"
+	@echo "make regs            regenerate from rtl/regs/radar_regs.rdl: register block, C header,"
+	@echo "                     HTML map, Python map (docs/regs.md) and check them"
 	@echo "make bench           model and host benchmarks (print tables)"
 	@echo "make bench-rtl       FFT core, radar_pipeline and frame_store_axi benchmarks (Verilator)"
 	@echo "make soak            SOAK_FRAMES=1000 paper-fpga frames, C++ harness, random stalls"
@@ -42,6 +44,9 @@ help:
 	@echo "                     FORMAL_ARGS='cfar_2d -t bmc' runs a subset"
 	@echo "make coverage        Verilator line/toggle coverage of the block testbenches, table"
 	@echo "make mutate          mutation testing of rtl/ (MUTANTS=40 SEED=1), score per module"
+	@echo "make curves          Pd vs SNR against theory, RMSE vs CRB on Ray (CURVES_ARGS=--quick),"
+	@echo "                     $(OUT)/curves.json and docs/img/pd_*.png, crb_*.png (docs/curves.md)"
+	@echo "make bench-ray       the Monte-Carlo layer: 1 vs 2 Ray workers in the same run"
 	@echo "make clean           remove build products (keeps .venv)"
 
 setup: $(STAMP)
@@ -73,10 +78,15 @@ lint: $(STAMP)
 	$(RUN) ruff check model rtlsim host gnn radar tb tests tools synth benchmarks
 
 # Generated RTL: rewritten only here (never by a test); the up-to-date test then checks it.
-gen: $(STAMP)
+gen: $(STAMP) regs
 	$(RUN) python -m model.fft_rom
 	$(RUN) python -m model.packet_crc
 	$(RUN) pytest -q -n 0 tb/fft_axis/test_fft_axis_model.py tests/test_packet_crc.py -k up_to_date
+
+# Everything generated from the SystemRDL register map (tools/gen_regs.py, docs/regs.md)
+regs: $(STAMP)
+	$(RUN) python tools/gen_regs.py
+	$(RUN) pytest -q -n 0 tests/test_regs.py -k up_to_date
 
 bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_simulate
@@ -117,6 +127,15 @@ mutate: $(STAMP)
 
 mutate-ci: $(STAMP)
 	MUTATE_CI=1 $(RUN) pytest -q -n 0 tests/test_verif_tools.py
+
+# Detection and estimation curves against theory on a local Ray (RAY_ADDRESS: a cluster);
+# rerunning resumes from $(OUT)/curves.campaign.jsonl. CURVES_ARGS= for the full grids.
+CURVES_ARGS ?= --quick
+curves: $(STAMP)
+	$(RUN) radar curves $(CURVES_ARGS) --json $(OUT)/curves.json --plots docs/img
+
+bench-ray: $(STAMP)
+	$(RUN) python -m benchmarks.bench_ray
 
 # Every (input gap, output backpressure) stall-regime pair of tb/stall_regimes.py (16 per
 # parameter set) instead of the 4-pair CI subset that `make test` runs

@@ -20,7 +20,8 @@ class Cells:
     (n,) the detector's mean noise power per cell of the non-coherent map; ``offsets``:
     float (n, 2) fractional (range, Doppler) offsets of the peak from the cell centre, bins
     in (-0.5, 0.5) (:func:`neighbour_offsets`); ``snapshot``: complex (n, n_virtual) the
-    cell's Doppler-FFT values per virtual channel v = tx * num_rx + rx."""
+    cell's Doppler-FFT values per virtual channel v = tx * num_rx + rx; ``range_bias_m``:
+    subtracted from the points' range (a calibration's, ``host.calibration``)."""
 
     range_bin: np.ndarray
     doppler_bin: np.ndarray
@@ -28,6 +29,7 @@ class Cells:
     noise: np.ndarray
     offsets: np.ndarray
     snapshot: np.ndarray
+    range_bias_m: float = 0.0
 
     def __len__(self) -> int:
         return len(self.range_bin)
@@ -35,8 +37,10 @@ class Cells:
 
 def gaussian_offset(lm: np.ndarray | float, c: np.ndarray | float, lp: np.ndarray | float
                     ) -> np.ndarray:
-    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation);
-    element-wise over arrays, 0 where the samples do not curve down."""
+    """Offset in (-0.5, 0.5) of a peak from 3 log-power samples (Gaussian interpolation: a
+    parabola through them, whatever the main lobe's width, so a zero-padded axis' wider
+    lobe needs nothing else); element-wise over arrays, 0 where the samples do not curve
+    down."""
     lm, c, lp = (np.asarray(v, dtype=float) for v in (lm, c, lp))
     den = lm - 2 * c + lp
     with np.errstate(divide="ignore", invalid="ignore"):

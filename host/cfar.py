@@ -8,6 +8,11 @@ peak grouping therefore wrap around at the range edges instead of being cut: a s
 target's window sidelobes that wrap into the top bins meet a training window that holds the
 target itself, exactly as its sidelobes on the other side do. Which bins may be *reported*
 is a separate rule, ``RadarConfig.detection_bins`` (applied by :func:`detection_mask`).
+A real ADC's range axis (bins 0..N/2-1, ``model.reference.FftAxis.real``) is not circular
+but mirrored at both ends (bin -k is bin k's image): windows and peak grouping reflect there.
+Zero-padded axes widen the main lobe and correlate the noise of more neighbouring bins:
+the ``windowed`` arguments take the map's ``model.reference.FftAxis`` pair
+(``fft_axes``) for that, or plain booleans (unpadded, complex).
 
 Thresholds for a configured false-alarm probability are derived, not tuned (the statistics
 live in ``model/cfar_stats.py``, shared with the FPGA CFAR model). A cell of a
@@ -38,7 +43,11 @@ from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports th
     effective_cells_mask,
     os_factor,
 )
-from model.reference import HANN_MAIN_LOBE_BINS
+from model.reference import HANN_MAIN_LOBE_BINS, FftAxis
+
+Windows = tuple[bool | FftAxis, bool | FftAxis]
+"""The (range, Doppler) windows of a map: booleans (Hann or not, no padding, complex) or
+the chain's axes (``model.reference.fft_axes``)."""
 
 OS_MAX_ELEMENTS = 2 * 10**8
 """OS-CFAR holds (cells x training cells) values at once: bound on that product."""
@@ -84,9 +93,20 @@ def _kernel(params: CfarParams) -> np.ndarray:
     return k
 
 
-def effective_cells(params: CfarParams, windowed: tuple[bool, bool] = (True, True)) -> float:
+def map_axes(windowed: Windows, shape: tuple[int, int]) -> tuple[FftAxis, FftAxis]:
+    """The two axes of a (n_range, n_doppler) map: ``windowed``'s axes as given, a boolean
+    as an unpadded complex axis of the map's length."""
+    return tuple(w if isinstance(w, FftAxis) else FftAxis(n, n, bool(w))  # type: ignore
+                 for w, n in zip(windowed, shape, strict=True))
+
+
+def effective_cells(params: CfarParams, windowed: Windows = (True, True)) -> float:
     """Number of independent cells with the same averaging power as the training set."""
-    return effective_cells_mask(_kernel(params), windowed)
+    if all(isinstance(w, bool) for w in windowed):
+        return effective_cells_mask(_kernel(params), windowed)  # type: ignore[arg-type]
+    axes = map_axes(windowed, (1, 1))
+    return effective_cells_mask(_kernel(params), correlations=(
+        axes[0].power_correlation(), axes[1].power_correlation()))
 
 
 def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
@@ -106,19 +126,25 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
                          f"({OS_MAX_ELEMENTS:.0e} values); use fewer training cells or CA")
 
 
-def _pad(power: np.ndarray, params: CfarParams) -> tuple[np.ndarray, np.ndarray]:
-    """Map padded circularly on both axes, and the matching validity mask (all ones: kept so
-    a cut window could be expressed again)."""
+def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False
+         ) -> tuple[np.ndarray, np.ndarray]:
+    """Map padded circularly on both axes (``mirrored``: the range axis reflected at both
+    ends, a real ADC's), and the matching validity mask (all ones: kept so a cut window
+    could be expressed again)."""
     (gr, gd), (tr, td) = params.guard, params.train
     pr, pd = gr + tr, gd + td
     check_window(params, power.shape)
-    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
+    if mirrored:
+        padded = np.pad(np.pad(power, ((pr, pr), (0, 0)), mode="reflect"), ((0, 0), (pd, pd)),
+                        mode="wrap")
+    else:
+        padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
     vpad = np.ones_like(padded)
     return padded, vpad
 
 
 def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
-                   windowed: tuple[bool, bool] = (True, True)) -> tuple[np.ndarray, np.ndarray]:
+                   windowed: Windows = (True, True)) -> tuple[np.ndarray, np.ndarray]:
     """Per-cell detection threshold and noise estimate (mean power per cell).
 
     power: float (n_range, n_doppler). Returns (threshold, noise), both float of that shape.
@@ -126,7 +152,8 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     kernel = _kernel(params)
-    padded, vpad = _pad(power.astype(np.float64), params)
+    mirrored = map_axes(windowed, power.shape)[0].real
+    padded, vpad = _pad(power.astype(np.float64), params, mirrored)
     count = np.rint(fftconvolve(vpad, kernel, mode="valid"))
     # effective cells scale with the count of training cells that remain near range edges
     n_eff = count * effective_cells(params, windowed) / kernel.sum()
@@ -157,11 +184,12 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     return threshold, noise
 
 
-def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3)
-                ) -> np.ndarray:
+def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3),
+                mirrored: bool = False) -> np.ndarray:
     """Peak grouping: cells of ``mask`` that are the maximum of their (range, Doppler)
-    neighbourhood (both axes circular). Returns int (n, 2) of (range_bin, doppler_bin)."""
-    mx = maximum_filter(power, size=size, mode="wrap")
+    neighbourhood (both axes circular; ``mirrored``: the range axis reflected at its ends,
+    a real ADC's). Returns int (n, 2) of (range_bin, doppler_bin)."""
+    mx = maximum_filter(power, size=size, mode=("mirror" if mirrored else "wrap", "wrap"))
     return np.argwhere(mask & (power >= mx))
 
 
@@ -186,15 +214,21 @@ def paper_threshold(cube: np.ndarray, threshold_db: float) -> tuple[np.ndarray, 
 
 
 MAIN_LOBE_BINS = HANN_MAIN_LOBE_BINS
-"""Half width of the periodic Hann main lobe, bins: sidelobe masking starts beyond it."""
+"""Half width of the periodic Hann main lobe, bins, unpadded: sidelobe masking starts beyond
+it (``model.reference.FftAxis.main_lobe_bins`` when zero-padded)."""
 
 
 @lru_cache(maxsize=16)
-def sidelobe_envelope(n: int, windowed: bool) -> np.ndarray:
-    """Power envelope of a windowed tone's response, float (n,): for circular offset k,
-    the largest |W(k + delta)|^2 / |W(0)|^2 over fractional offsets |delta| <= 0.5 of the
-    tone from the bin centre; 0 within the main lobe (|k| <= MAIN_LOBE_BINS)."""
-    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n) if windowed else np.ones(n)
+def sidelobe_envelope(n: int, windowed: bool, n_samples: int | None = None) -> np.ndarray:
+    """Power envelope of a windowed tone's response on an ``n``-point FFT of ``n_samples``
+    samples (default n; zero-padded beyond), float (n,): for circular offset k, the largest
+    |W(k + delta)|^2 / |W(0)|^2 over fractional offsets |delta| <= 0.5 of the tone from
+    the bin centre; 0 within the main lobe (|k| <= MAIN_LOBE_BINS, or the padded axis'
+    ``FftAxis.main_lobe_bins``)."""
+    m = n if n_samples is None else n_samples
+    axis = FftAxis(n, m, windowed)
+    w = np.zeros(n)
+    w[:m] = axis.window()
     k = np.arange(n)
     k = np.where(k > n // 2, k - n, k)
     delta = np.linspace(-0.5, 0.5, 21)
@@ -203,28 +237,35 @@ def sidelobe_envelope(n: int, windowed: bool) -> np.ndarray:
     shifted = w[None, :] * np.exp(-2j * np.pi * np.outer(delta, np.arange(n)) / n)
     resp = np.abs(np.fft.fft(shifted, axis=1)) / w.sum()                  # (delta, k)
     env = np.max(resp**2, axis=0)
-    env[np.abs(k) <= MAIN_LOBE_BINS] = 0.0
+    env[np.abs(k) <= (MAIN_LOBE_BINS if m == n else axis.main_lobe_bins)] = 0.0
     return env
 
 
-def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: tuple[bool, bool],
+def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: Windows,
                     margin_db: float) -> np.ndarray:
     """bool (n,): cells (int (n, 2) of (range, Doppler)) of ``power`` (float (n_range,
     n_doppler)) that are not ``margin_db`` above the window sidelobes of some stronger cell
-    in the same Doppler column (range sidelobes, circular) or range row (Doppler
-    sidelobes). A target 95 dB above the noise has Hann sidelobes above the noise 30 bins
-    away, which a CFAR window a few cells wide cannot tell from targets."""
-    env_r = sidelobe_envelope(power.shape[0], windowed[0]) * 10 ** (margin_db / 10)
-    env_d = sidelobe_envelope(power.shape[1], windowed[1]) * 10 ** (margin_db / 10)
+    in the same Doppler column (range sidelobes, circular; on a real ADC's mirrored range
+    axis those of the cell and of its mirror image) or range row (Doppler sidelobes). A
+    target 95 dB above the noise has Hann sidelobes above the noise 30 bins away, which a
+    CFAR window a few cells wide cannot tell from targets."""
+    ax_r, ax_d = map_axes(windowed, power.shape)
+    scale = 10 ** (margin_db / 10)
+    env_r = sidelobe_envelope(ax_r.n_fft, ax_r.hann, ax_r.n_samples) * scale
+    env_d = sidelobe_envelope(ax_d.n_fft, ax_d.hann, ax_d.n_samples) * scale
     cells = np.asarray(cells).reshape(-1, 2)
     out = np.zeros(len(cells), bool)
     nr, nd = power.shape
+    fr, fd = ax_r.n_fft, ax_d.n_fft
     # all cells at once, in chunks that keep the (n_range, chunk) gathers small:
-    # column sidelobes env_r[(r - r') mod n_range] * power[r', d] over r', rows likewise
+    # column sidelobes env_r[(r - r') mod n_fft] * power[r', d] over r', rows likewise
     for lo in range(0, len(cells), 512):
         r, d = cells[lo:lo + 512, 0], cells[lo:lo + 512, 1]
-        col = power[:, d] * env_r[(r[None, :] - np.arange(nr)[:, None]) % nr]
-        row = power[r, :] * env_d[(d[:, None] - np.arange(nd)[None, :]) % nd]
+        col = power[:, d] * env_r[(r[None, :] - np.arange(nr)[:, None]) % fr]
+        if ax_r.real:              # the mirror image at -r' throws sidelobes too
+            col = np.maximum(col, power[:, d] * env_r[(r[None, :] + np.arange(nr)[:, None])
+                                                      % fr])
+        row = power[r, :] * env_d[(d[:, None] - np.arange(nd)[None, :]) % fd]
         p = power[r, d]
         out[lo:lo + 512] = (col.max(axis=0) > p) | (row.max(axis=1) > p)
     return out

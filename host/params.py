@@ -5,13 +5,30 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from host.angle import AngleParams
+from host.calibration import check_calibration
 from host.cfar import CfarParams, check_window
 from model.config import RadarConfig
+from model.profile import Calibration
+from model.reference import fft_axes
 
 DETECTORS = ("ca", "os", "paper")
 MAX_RADIAL_SPEED_MPS = 100.0
 """Default fastest radial speed the application expects, m/s (360 km/h: two cars at
 180 km/h head-on). Velocities are unfolded and flagged ``ambiguous`` against it."""
+
+
+def default_guard(cfg: RadarConfig) -> tuple[int, int]:
+    """CFAR guard cells per side (range, Doppler) for ``cfg`` when the user gives none: the
+    Hann main lobe of each axis, (2, 2) unpadded (``model.reference.FftAxis.main_lobe_bins``;
+    a zero-padded axis' lobe is wider)."""
+    ax_r, ax_d = fft_axes(cfg)
+    return ax_r.main_lobe_bins, ax_d.main_lobe_bins
+
+
+def params_for(cfg: RadarConfig) -> DetectionParams:
+    """The default settings for ``cfg``: :class:`DetectionParams` () with the CFAR guard
+    of :func:`default_guard` (the presets': the defaults unchanged)."""
+    return DetectionParams(cfar=CfarParams(guard=default_guard(cfg)))
 
 
 def default_max_speed_mps(cfg: RadarConfig) -> float:
@@ -38,7 +55,9 @@ class DetectionParams:
     Reported range bins are ``RadarConfig.detection_bins`` (DC and negative-beat guards).
     ``sidelobe_margin_db``: a detected cell must exceed the window sidelobes of every
     stronger cell in its Doppler column and range row by this much (``host.cfar.
-    sidelobe_masked``; beyond the +-2-bin main lobe); None turns the masking off.
+    sidelobe_masked``; beyond the Hann main lobe); None turns the masking off.
+    ``calibration``: channel gains and range bias applied to the detected cells before the
+    angle estimation (``host.calibration.apply_calibration``); None: none.
     """
 
     detector: str = "ca"
@@ -53,6 +72,7 @@ class DetectionParams:
     unfold_margin_db: float = 0.45
     max_speed_mps: float = MAX_RADIAL_SPEED_MPS
     sidelobe_margin_db: float | None = 10.0
+    calibration: Calibration | None = None
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
@@ -69,6 +89,8 @@ class DetectionParams:
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError when the settings do not fit ``cfg`` (CFAR window larger than the
-        range-Doppler map)."""
+        range-Doppler map, a calibration of another channel count)."""
+        if self.calibration is not None:
+            check_calibration(self.calibration, cfg)
         if self.detector != "paper":
-            check_window(self.cfar, (cfg.n_range, cfg.n_doppler))
+            check_window(self.cfar, (cfg.n_range_bins, cfg.n_doppler))

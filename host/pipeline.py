@@ -45,36 +45,37 @@ from host.cfar import (
     paper_threshold,
     sidelobe_masked,
 )
-from host.params import DetectionParams
+from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from model.config import RadarConfig
-from model.reference import radar_cube, range_doppler_power
+from model.reference import fft_axes, radar_cube, range_doppler_power
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Detected range-Doppler cells of a cube.
 
-    cube: complex (n_virtual, n_range, n_doppler). Returns (cells int (n, 2) of
+    cube: complex (n_virtual, n_range_bins, n_doppler). Returns (cells int (n, 2) of
     (range_bin, doppler_bin natural order), noise float (n,) mean noise power per cell of the
-    non-coherent map, nci float (n_range, n_doppler) the non-coherent map).
+    non-coherent map, nci float (n_range_bins, n_doppler) the non-coherent map).
     """
     nci = range_doppler_power(cube)
-    windowed = (params.range_window, params.doppler_window)
+    windowed = fft_axes(cfg, params.range_window, params.doppler_window)
+    mirrored = windowed[0].real
     cf = params.cfar if params.detector != "os" else CfarParams(
         pfa=params.cfar.pfa, guard=params.cfar.guard, train=params.cfar.train, kind="os",
         os_rank=params.cfar.os_rank)
     if params.detector == "paper":
         mask, p0 = paper_threshold(cube, params.paper_threshold_db)
-        cells = local_peaks(p0, mask)
+        cells = local_peaks(p0, mask, mirrored=mirrored)
         noise_map = np.full(nci.shape, np.median(nci))
     else:
         if params.detector == "ca":
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
         threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
-        cells = local_peaks(nci, nci > threshold)
-    ok = detection_mask(cfg.n_range, cfg.n_doppler, cfg.detection_bins)
+        cells = local_peaks(nci, nci > threshold, mirrored=mirrored)
+    ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]
     if params.sidelobe_margin_db is not None and len(cells):
         cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
@@ -83,7 +84,7 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
 
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
                  frame: int = 0) -> PointCloud:
-    """Point cloud of one radar cube, complex (n_virtual, n_range, n_doppler), in
+    """Point cloud of one radar cube, complex (n_virtual, n_range_bins, n_doppler), in
     float-reference units (``model.reference.radar_cube``)."""
     return process_cube_nci(cube, cfg, params, frame)[0]
 
@@ -91,9 +92,9 @@ def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | N
 def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
                      frame: int = 0) -> tuple[PointCloud, np.ndarray]:
     """:func:`process_cube` that also returns the integrated power map it computed, float
-    (n_range, n_doppler), in the cube's units squared (a display needs it; computing it
+    (n_range_bins, n_doppler), in the cube's units squared (a display needs it; computing it
     again costs a cube pass)."""
-    params = params or DetectionParams()
+    params = params or params_for(cfg)
     cfg.check_cube(cube)
     dtype = np.asarray(cube).dtype
     if dtype.kind != "c":
@@ -132,8 +133,8 @@ def real_only(cube: np.ndarray) -> bool:
 
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
                   frame: int = 0) -> PointCloud:
-    """ADC frame, complex (n_chirps, num_rx, n_range) -> point cloud, through the float
+    """ADC frame, complex or real (n_chirps, num_rx, n_samples) -> point cloud, through the float
     reference of the FPGA chain (``model.reference.radar_cube``) and :func:`process_cube`."""
-    params = params or DetectionParams()
+    params = params or params_for(cfg)
     cube = radar_cube(adc, cfg, params.range_window, params.doppler_window)
     return process_cube(cube, cfg, params, frame)

@@ -51,7 +51,7 @@ def _rd_grid(cfg: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     row) of a natural-order (n_range, n_doppler) map."""
     order = np.argsort(signed_bins(cfg.n_doppler))
     vel = signed_bins(cfg.n_doppler)[order] * cfg.velocity_bin_mps
-    return order, vel, np.arange(cfg.n_range) * cfg.range_bin_m
+    return order, vel, np.arange(cfg.n_range_bins) * cfg.range_bin_m
 
 
 def plot_range_doppler(power: np.ndarray, cfg: RadarConfig, path: Path, title: str,
@@ -130,7 +130,7 @@ def plot_range_azimuth_pair(maps: list[tuple[np.ndarray, str]], az: np.ndarray,
     without TX beamforming). maps: (float (n_range, n_fft) power, title). ``note``: text
     under the maps (e.g. why an aliased target is smeared in azimuth); ``title``: over
     them."""
-    rng = np.arange(cfg.n_range) * cfg.range_bin_m
+    rng = np.arange(cfg.n_range_bins) * cfg.range_bin_m
     ok = np.isfinite(az)
     dbs = [10 * np.log10(np.maximum(m[:, ok], 1e-12)) for m, _ in maps]
     vmax = max(d.max() for d in dbs)

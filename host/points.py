@@ -20,19 +20,22 @@ from __future__ import annotations
 import numpy as np
 
 from host.angle import estimate_angles, peak_powers
+from host.calibration import apply_calibration
 from host.cells import Cells
 from host.params import DetectionParams
 from host.pointcloud import PointCloud
 from host.tdm import choose_folds, hypothesis_classes, tx_phasors
 from model.config import RadarConfig, dbm_to_w
-from model.reference import signed_bins
+from model.reference import fft_axes, signed_bins
 from model.simulate import rx_gain, tx_gain
 
 
 def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
                       frame: int = 0) -> PointCloud:
     """Point cloud of detected cells (module docstring); ``frame`` is the points' frame
-    index. ValueError when the snapshots do not have ``cfg``'s virtual channels."""
+    index. ValueError when the snapshots do not have ``cfg``'s virtual channels. The
+    calibration of ``params`` is applied first (``host.calibration.apply_calibration``)."""
+    cells = apply_calibration(cells, params.calibration)
     n = len(cells)
     if not n:
         return PointCloud.empty()
@@ -68,7 +71,7 @@ def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
                           positions)
     return cloud(cfg, params, np.asarray(cells.range_bin), cells.offsets, k, ambiguous,
                  ang.cell, ang.azimuth_deg, ang.amplitude, ang.snr_db, frame,
-                 ang.elevation_deg)
+                 ang.elevation_deg, cells.range_bias_m)
 
 
 def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndarray:
@@ -83,23 +86,26 @@ def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndar
 def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.ndarray,
           k: np.ndarray, ambiguous: np.ndarray, cell: np.ndarray, az: np.ndarray,
           amplitude: np.ndarray, snr_db: np.ndarray, frame: int,
-          elevation_deg: np.ndarray | float = 0.0) -> PointCloud:
+          elevation_deg: np.ndarray | float = 0.0, range_bias_m: float = 0.0
+          ) -> PointCloud:
     """Step 3 of the module docstring, one point per angle component: range (Doppler
     coupling removed), velocity of the unfolded bin ``k``, power and RCS (window
     scalloping and coherent gain undone).
 
     Per cell (n,): r range bin, k unfolded signed Doppler bin, ambiguous flag; offsets
     float (n, 2) bins. Per component (m,): ``cell`` its cell index, ``az`` deg,
-    ``amplitude`` complex (LSB), ``snr_db``, ``elevation_deg`` (or a scalar)."""
+    ``amplitude`` complex (LSB), ``snr_db``, ``elevation_deg`` (or a scalar);
+    ``range_bias_m`` is subtracted from the range (calibration)."""
     nr, nd = cfg.n_range, cfg.n_doppler
     dr, dd = offsets[:, 0], offsets[:, 1]
     velocity = (k + dd) * cfg.velocity_bin_mps
     # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
-    range_m = (r + dr - coupling) * cfg.range_bin_m
-    scallop = _window_response(nr, dr, params.range_window) * _window_response(
-        nd, dd, params.doppler_window)
-    cg = (0.5 if params.range_window else 1.0) * (0.5 if params.doppler_window else 1.0)
+    range_m = (r + dr - coupling) * cfg.range_bin_m - range_bias_m
+    ax_r, ax_d = fft_axes(cfg, params.range_window, params.doppler_window)
+    scallop = _window_response(nr, dr, params.range_window, ax_r.n_samples) * \
+        _window_response(nd, dd, params.doppler_window, ax_d.n_samples)
+    cg = ax_r.coherent_gain * ax_d.coherent_gain
     amp = np.abs(amplitude)
     amp_adc = amp / (cg * scallop[cell])
     rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
@@ -118,15 +124,20 @@ def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:
     return np.where(small, n, sin_pi_y / np.where(small, 1.0, den))
 
 
-def _window_response(n: int, offset: np.ndarray | float, windowed: bool) -> np.ndarray:
+def _window_response(n: int, offset: np.ndarray | float, windowed: bool,
+                     n_samples: int | None = None) -> np.ndarray:
     """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
-    a bin centre, float (m,) or scalar; W is the DFT of the periodic Hann window
+    a bin centre of an ``n``-point FFT of ``n_samples`` samples (default n; zero-padded:
+    the n_samples-point response at offset * n_samples / n), float (m,) or scalar; W is
+    the DFT of the periodic Hann window
     (``model.reference.hann_periodic``: 0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the
     Dirichlet kernel D) or of the rectangular one (D). The three kernels share their phase
     up to exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
     |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
     R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
     x = np.asarray(offset, dtype=float)
+    if n_samples is not None and n_samples != n:
+        x, n = x * (n_samples / n), n_samples
     s = np.sin(np.pi * x)
     r0 = _dirichlet_ratio(x, n, s)
     if not windowed:

@@ -71,7 +71,7 @@ def select_records(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams
     Doppler) order. Works on the records alone (compiled, :func:`select_cells`: a 3x3
     gather per record, pairs of detected cells in a row or column), with the result of
     ``host.cfar.local_peaks`` and ``host.cfar.sidelobe_masked`` on the map."""
-    nr, nd = cfg.n_range, cfg.n_doppler
+    nr, nd = cfg.n_range_bins, cfg.n_doppler
     envelopes = None
     if params.sidelobe_margin_db is not None:
         envelopes = (_envelope(nr, params.range_window, params.sidelobe_margin_db),
@@ -114,7 +114,7 @@ def _check_records(arr: RecordArrays, cfg: RadarConfig) -> None:
     out = np.flatnonzero(outside_map(arr, cfg))
     if len(out):
         i = out[0]
-        raise ValueError(f"{len(out)} record(s) outside {cfg.name}'s {cfg.n_range} x "
+        raise ValueError(f"{len(out)} record(s) outside {cfg.name}'s {cfg.n_range_bins} x "
                          f"{cfg.n_doppler} map (first: range bin {arr.range_bin[i]}, Doppler "
                          f"bin {arr.doppler_bin[i]}); host.records.inside_map drops them")
 
@@ -135,7 +135,7 @@ def record_cells(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams) -
     _check_records(arr, cfg)
     idx = select_records(arr, cfg, params)
     r = arr.range_bin[idx]
-    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg.n_range)
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg.n_range_bins)
     return Cells(r, arr.doppler_bin[idx], arr.power[idx], arr.noise[idx], offsets,
                  arr.snapshot[idx])
 

@@ -280,7 +280,7 @@ def outside_map(arr: RecordArrays, cfg: RadarConfig) -> np.ndarray:
     n_range x n_doppler map (the header fields are 12 bits wide: corrupt words that still
     look like records, or records of another configuration)."""
     r, d = np.asarray(arr.range_bin), np.asarray(arr.doppler_bin)
-    return (r < 0) | (r >= cfg.n_range) | (d < 0) | (d >= cfg.n_doppler)
+    return (r < 0) | (r >= cfg.n_range_bins) | (d < 0) | (d >= cfg.n_doppler)
 
 
 def inside_map(arr: RecordArrays, cfg: RadarConfig) -> tuple[RecordArrays, int]:
@@ -299,7 +299,7 @@ def inside_map(arr: RecordArrays, cfg: RadarConfig) -> tuple[RecordArrays, int]:
 
 def outside_problem(frame_id: int, dropped: int, cfg: RadarConfig) -> str:
     """The frame problem a receiver reports for records :func:`inside_map` dropped."""
-    return (f"frame {frame_id}: {dropped} record(s) outside the {cfg.n_range} x "
+    return (f"frame {frame_id}: {dropped} record(s) outside the {cfg.n_range_bins} x "
             f"{cfg.n_doppler} map dropped")
 
 

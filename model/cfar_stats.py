@@ -51,11 +51,16 @@ def correlation_sum(mask: np.ndarray, rho_r: tuple[float, ...],
     return total
 
 
-def effective_cells_mask(mask: np.ndarray, windowed: tuple[bool, bool] = (True, True)) -> float:
-    """Number of independent cells with the same averaging power as the cells of ``mask``."""
+def effective_cells_mask(mask: np.ndarray, windowed: tuple[bool, bool] = (True, True),
+                         correlations: tuple[tuple[float, ...], tuple[float, ...]] | None
+                         = None) -> float:
+    """Number of independent cells with the same averaging power as the cells of ``mask``;
+    ``correlations``: the (range, Doppler) power correlations between bins 0, 1, ... apart
+    (``model.reference.FftAxis.power_correlation``), else those of ``windowed``'s
+    unpadded Hann or rectangular windows."""
     n = float((mask > 0).sum())
-    rho_r = HANN_POWER_CORRELATION if windowed[0] else RECT_POWER_CORRELATION
-    rho_d = HANN_POWER_CORRELATION if windowed[1] else RECT_POWER_CORRELATION
+    rho_r, rho_d = correlations or tuple(
+        HANN_POWER_CORRELATION if w else RECT_POWER_CORRELATION for w in windowed)
     return n * n / correlation_sum(mask, rho_r, rho_d)
 
 

@@ -17,14 +17,19 @@ Where the paper's numbers disagree (docs/design.md section 2):
 - The paper's "3.5 m" and "1.6 km/h" resolutions are the Hann main lobe (2 bins) of the
   1.7275 m and 0.78 km/h (0.217 m/s) bins.
 
-Sampling is complex (I/Q), so a beat frequency in [0, fs) maps to range bins 0..N-1 and the
-maximum range is ``n_range * range_bin_m``.
+The presets sample complex (I/Q), so a beat frequency in [0, fs) maps to range bins 0..N-1
+and the maximum range is ``n_range * range_bin_m``. A real ADC (a profile's ``adc = "real"``)
+samples beats in [0, fs/2): the range FFT of real samples is Hermitian (bin N-k mirrors bin
+k), so the cube keeps bins 0..N/2-1 (:attr:`RadarConfig.n_range_bins`, the cube's range
+length) and the maximum range is half.
 
 Range bins and the range edge: the range FFT of a complex IF signal is circular. Bin N-k is
 the beat frequency -k fs/N just as much as (N-k) fs/N: a target at range <= 0 (one that has
 driven past the radar), and the window sidelobes of a strong near target, land in the top
 bins. The detectors therefore treat the range axis as circular (CFAR windows wrap, they are
-not cut) and never report the ``NEGATIVE_BEAT_GUARD_BINS`` top bins nor the
+not cut; a real ADC's half axis is mirrored at both ends instead) and never report the
+``NEGATIVE_BEAT_GUARD_BINS`` top bins (with a real ADC: the bins next to fs/2, the
+anti-alias filter's edge, where a tone and its mirror image meet) nor the
 ``DC_GUARD_BINS`` lowest ones (DC offset / TX leakage; a profile's ``min_range_m`` guards
 more); :meth:`RadarConfig.detection_bins` is
 that one rule, for the host CFAR and the FPGA detector alike, and
@@ -54,7 +59,8 @@ NEGATIVE_BEAT_GUARD_BINS = 4
 """Top range bins N-4..N-1 are never detections: with complex sampling they hold negative
 beat frequencies (range < 0), i.e. only the wrapped window sidelobes of near targets
 (periodic Hann main lobe +-2 bins, first sidelobes at +-2.5 bins) and targets that have
-passed the radar."""
+passed the radar. A real ADC's top bins of its n_range / 2 sit next to fs / 2 (the
+anti-alias filter's edge, where a tone meets its mirror image): guarded the same."""
 
 
 def db_to_lin(db: float) -> float:
@@ -269,10 +275,16 @@ class RadarConfig:
         return C0 / (2.0 * self.sweep_bandwidth_hz) * (self.n_samples / self.n_range)
 
     @property
+    def n_range_bins(self) -> int:
+        """Range bins of the cube: n_range (complex ADC), n_range / 2 (real ADC: bins
+        0..n_range/2-1, the rest are their mirror images)."""
+        return self.n_range if self.adc == "complex" else self.n_range // 2
+
+    @property
     def max_range_m(self) -> float:
-        """Largest unambiguous range, m: n_range * range_bin (beat frequency = fs) for a
-        complex ADC, half of it (fs / 2) for a real one."""
-        return self.n_range * self.range_bin_m * (self.if_bandwidth_hz / self.sample_rate_hz)
+        """Largest unambiguous range, n_range_bins * range_bin, m (beat frequency fs for a
+        complex ADC, fs / 2 for a real one)."""
+        return self.n_range_bins * self.range_bin_m
 
     @property
     def detection_bins(self) -> tuple[int, int]:
@@ -281,7 +293,7 @@ class RadarConfig:
         top of the circular range axis)."""
         lo = DC_GUARD_BINS if self.min_range_m is None else max(
             DC_GUARD_BINS, math.ceil(self.min_range_m / self.range_bin_m - 1e-9))
-        return lo, self.n_range - NEGATIVE_BEAT_GUARD_BINS
+        return lo, self.n_range_bins - NEGATIVE_BEAT_GUARD_BINS
 
     @property
     def max_detection_range_m(self) -> float:
@@ -386,12 +398,12 @@ class RadarConfig:
 
     @property
     def cube_shape(self) -> tuple[int, int, int]:
-        """Shape of one radar cube: (n_virtual, n_range, n_doppler)."""
-        return (self.n_virtual, self.n_range, self.n_doppler)
+        """Shape of one radar cube: (n_virtual, n_range_bins, n_doppler)."""
+        return (self.n_virtual, self.n_range_bins, self.n_doppler)
 
     def check_adc(self, adc: np.ndarray, what: str = "adc") -> None:
         """ValueError naming the expected and actual shape unless ``adc`` is one ADC frame
-        of this configuration, (n_chirps, num_rx, n_range), and the chain can process it
+        of this configuration, (n_chirps, num_rx, n_samples), and the chain can process it
         (:meth:`check_processable`)."""
         self.check_processable()
         if np.shape(adc) != self.adc_shape:
@@ -400,8 +412,8 @@ class RadarConfig:
 
     def check_cube(self, cube: np.ndarray, what: str = "cube") -> None:
         """ValueError naming the expected and actual shape unless ``cube`` is one radar cube
-        of this configuration, (n_virtual, n_range, n_doppler), and the chain can process
-        it (:meth:`check_processable`)."""
+        of this configuration, (n_virtual, n_range_bins, n_doppler), and the chain can
+        process it (:meth:`check_processable`)."""
         self.check_processable()
         if np.shape(cube) != self.cube_shape:
             raise ValueError(f"{what}: expected shape {self.cube_shape} for preset "

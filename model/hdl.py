@@ -1,6 +1,7 @@
 """The RTL's side of a radar configuration: the HDL parameters a ``model.config.RadarConfig``
-gives the top and the fixed facts of the data path (sample width, fabric clock, the external
-frame store's bus width), in one place for the tests, the RTL frame source and synthesis."""
+gives the top, what of a configuration the top does not elaborate (:func:`check_hdl`) and the
+fixed facts of the data path (sample width, fabric clock, the external frame store's bus
+width), in one place for the tests, the frame sources and synthesis."""
 
 from __future__ import annotations
 
@@ -27,3 +28,34 @@ def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
               "N_DOPPLER": cfg.n_doppler, "DATA_W": DATA_W}
     params.update(overrides)
     return params
+
+
+MAX_NUM_RX = 16
+"""Largest NUM_RX of the ``radar_pipeline`` top (its ``g_bad_num_rx`` elaboration check)."""
+MAX_NUM_TX = 16
+"""Largest NUM_TX of the top; NUM_TX is a power of two (``g_bad_num_tx``)."""
+
+
+def hdl_unsupported(cfg: RadarConfig) -> list[str]:
+    """What of ``cfg`` the ``radar_pipeline`` top refuses at elaboration
+    (rtl/top/radar_pipeline.sv, its ``g_bad_*`` blocks), one phrase each (empty for the
+    presets): more than MAX_NUM_RX RX, a TX count that is not a power of two up to
+    MAX_NUM_TX, ADC codes wider than the DATA_W-bit sample streams. Every RadarConfig's FFT
+    lengths (powers of two in 16..4096) are the top's already."""
+    out = []
+    if cfg.num_rx > MAX_NUM_RX:
+        out.append(f"{cfg.num_rx} RX (NUM_RX at most {MAX_NUM_RX})")
+    if cfg.num_tx > MAX_NUM_TX or cfg.num_tx & (cfg.num_tx - 1):
+        out.append(f"{cfg.num_tx} TX (NUM_TX a power of two up to {MAX_NUM_TX})")
+    if cfg.adc_bits > DATA_W:
+        out.append(f"a {cfg.adc_bits}-bit ADC (DATA_W = {DATA_W} bits of I and of Q)")
+    return out
+
+
+def check_hdl(cfg: RadarConfig) -> None:
+    """ValueError (one line) naming what of ``cfg`` the RTL top, and so its bit-accurate
+    model, does not run (:func:`hdl_unsupported`)."""
+    missing = hdl_unsupported(cfg)
+    if missing:
+        raise ValueError(f"radar {cfg.name!r}: the RTL (and its bit-accurate model) does not "
+                         f"run {'; '.join(missing)}")

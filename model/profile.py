@@ -76,15 +76,17 @@ def next_pow2(n: int, lo: int = 16) -> int:
 def default_max_range_m(cfg: RadarConfig) -> float:
     """The range a profile covers when it does not say: its maximum range less the top
     ``NEGATIVE_BEAT_GUARD_BINS`` range bins the detectors never report, m."""
-    return cfg.max_range_m * (1.0 - NEGATIVE_BEAT_GUARD_BINS / cfg.n_range)
+    return cfg.max_range_m * (1.0 - NEGATIVE_BEAT_GUARD_BINS / cfg.n_range_bins)
 
 
 def default_min_range_m(cfg: RadarConfig) -> float:
     """The near-range guard of a TOML or ``.cfg`` profile that states no ``min_range_m``, m:
     the leakage zone ``LEAKAGE_RANGE_M`` plus the range window's main lobe
-    (``HANN_MAIN_LOBE_BINS`` range bins) that spreads the leakage beyond it. The presets
-    keep ``min_range_m`` None (only range bin 0 guarded)."""
-    return LEAKAGE_RANGE_M + HANN_MAIN_LOBE_BINS * cfg.range_bin_m
+    (``HANN_MAIN_LOBE_BINS`` range bins, times n_range / n_samples when zero-padded) that
+    spreads the leakage beyond it. The presets keep ``min_range_m`` None (only range bin 0
+    guarded)."""
+    return LEAKAGE_RANGE_M + HANN_MAIN_LOBE_BINS * (cfg.n_range / cfg.n_samples) \
+        * cfg.range_bin_m
 
 
 def build_config(names: dict[str, str], **kw: object) -> RadarConfig:

@@ -64,21 +64,43 @@ def check_profile_fields(cfg: RadarConfig) -> None:
     lo, hi = cfg.detection_bins
     if lo >= hi:
         raise ValueError(f"min_range_m: {cfg.min_range_m} m leaves no range bin to detect in "
-                         f"(the top {cfg.n_range - hi} are guarded too)")
+                         f"(the top {cfg.n_range_bins - hi} are guarded too)")
     if cfg.frame_period_s is not None and cfg.frame_period_s < cfg.frame_time_s:
         raise ValueError(f"frame_period_s: {cfg.frame_period_s * 1e3:.3f} ms is shorter than "
                          f"the frame's chirps, {cfg.frame_time_s * 1e3:.3f} ms")
 
 
 def unsupported_features(cfg: RadarConfig) -> list[str]:
-    """What of ``cfg`` the processing chain cannot handle yet, one phrase each (empty for the
-    presets): zero padding, a real ADC."""
+    """What of ``cfg`` the float processing chain cannot handle yet, one phrase each: nothing
+    today (zero padding, a real ADC, any firing order, non-uniform and 2-D virtual arrays
+    are processed); ``RadarConfig.check_processable`` and ``radar profile show`` read it."""
+    return []
+
+
+def preset_chain_features(cfg: RadarConfig) -> list[str]:
+    """What of ``cfg`` the presets' fixed-point chain (the bit-accurate model, the RTL) does
+    not run, one phrase each (empty for the presets): zero padding, a firing order other
+    than 0..num_tx-1, a real ADC, a virtual array other than the contiguous lambda/2 ULA."""
     out = []
     if cfg.n_samples != cfg.n_range:
         out.append(f"{cfg.n_samples} samples per chirp zero-padded to a {cfg.n_range}-point "
                    "range FFT")
     if cfg.n_loops != cfg.n_doppler:
         out.append(f"{cfg.n_loops} loops zero-padded to a {cfg.n_doppler}-point Doppler FFT")
+    if cfg.tx_sequence != tuple(range(cfg.num_tx)):
+        out.append(f"TX firing order {list(cfg.tx_sequence)}")
     if cfg.adc != "complex":
         out.append("real-valued ADC")
+    if not cfg.uniform_linear_array:
+        out.append("a virtual array other than the contiguous horizontal lambda/2 ULA")
     return out
+
+
+def check_preset_chain(cfg: RadarConfig) -> None:
+    """ValueError (one line) naming what of ``cfg`` the bit-accurate model and the RTL (the
+    presets' chain) do not handle (:func:`preset_chain_features`); the float chain
+    processes profiles."""
+    missing = preset_chain_features(cfg)
+    if missing:
+        raise ValueError(f"radar {cfg.name!r}: the bit-accurate model and the RTL do not "
+                         f"handle {'; '.join(missing)} yet (the float chain does)")

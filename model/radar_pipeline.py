@@ -40,6 +40,7 @@ from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
 from model.hdl import hdl_parameters
+from model.profile_fields import check_preset_chain
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -143,7 +144,8 @@ class PipelineParams:
         return pack_scale(d.scale(), d.cfar)
 
     def check(self, cfg: RadarConfig) -> None:
-        """ValueError for a combination the RTL refuses at elaboration."""
+        """ValueError for a radar or a combination the RTL refuses at elaboration."""
+        check_preset_chain(cfg)
         self.check_mode(cfg)
         check_geometry(self.frame_words(cfg), self.packet_words)
 
@@ -219,6 +221,7 @@ def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams
     """Doppler-FFT output words, integer-valued complex ``(frame words, num_rx)`` in the
     corner turn's read order (mode 0: (t, r, d); mode 1: (r, t, d)), and the overflow beats
     of the range and Doppler FFTs."""
+    check_preset_chain(cfg)
     cfg.check_adc(adc)
     order = params.output_mode
     # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values

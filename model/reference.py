@@ -6,11 +6,18 @@ schedule (``fft_axis``: output = DFT(x)/N), so reference and RTL outputs share u
 
 Axis conventions:
 
-- ADC frame: complex (n_chirps = num_tx * n_doppler in transmit order, num_rx, n_range);
-  chirp c was sent by TX c mod num_tx.
-- Radar cube: complex (n_virtual, n_range, n_doppler), virtual channel v = tx * num_rx + rx,
-  range bin r in 0..n_range-1 (natural order), Doppler bin d in 0..n_doppler-1 in natural FFT
-  order (bins >= n_doppler/2 are negative velocities; see :func:`signed_bins`).
+- ADC frame: complex, or real for a real ADC, (n_chirps = num_tx * n_loops in transmit
+  order, num_rx, n_samples); chirp c is slot c mod num_tx of loop c // num_tx and was sent
+  by TX ``cfg.tx_sequence[c % num_tx]`` (``model.array``).
+- Radar cube: complex (n_virtual, n_range_bins, n_doppler), virtual channel v = tx * num_rx
+  + rx by TX index (whatever the firing order), range bin r in 0..n_range_bins-1 (natural
+  order; a real ADC keeps 0..n_range/2-1, the other half mirrors it), Doppler bin d in
+  0..n_doppler-1 in natural FFT order (bins >= n_doppler/2 are negative velocities; see
+  :func:`signed_bins`).
+- Zero padding (a profile's samples_per_chirp < n_range, loops < n_doppler): the samples
+  are windowed by a periodic Hann of their own count, then zero-padded to the FFT length,
+  so the window's main lobe spans ``2 n_fft / n_samples`` bins (:class:`FftAxis`, which
+  the host's CFAR, sidelobe masking and amplitude corrections read).
 - DMA payload order (docs/design.md 3.2): (num_tx, n_range, n_doppler, num_rx) -- for tx, for
   range bin, for Doppler bin, one word of num_rx lanes; see :func:`cube_to_dma_order`.
 
@@ -21,20 +28,81 @@ Angle (host side): virtual channel v at y = v lambda/2 sees phase exp(-j pi v si
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 
 from model.array import tx_slots
+from model.cfar_stats import HANN_POWER_CORRELATION, RECT_POWER_CORRELATION
 from model.config import RadarConfig
 
 HANN_MAIN_LOBE_BINS = 2
-"""Half width of the periodic Hann window's main lobe, bins: a tone spreads over +-2 bins of
-its FFT (host CFAR sidelobe masking starts beyond it; a profile's near-range guard covers the
-leakage's main lobe, ``model.profile.default_min_range_m``)."""
+"""Half width of the periodic Hann window's main lobe, bins of an FFT as long as the window:
+a tone spreads over +-2 bins (+-2 n_fft / n_samples when zero-padded, :class:`FftAxis`;
+host CFAR guard and sidelobe masking; a profile's near-range guard covers the leakage's
+main lobe, ``model.profile.default_min_range_m``)."""
+POWER_CORRELATION_FLOOR = 1e-4
+"""Power correlations between noise bins below this are taken as 0 (:class:`FftAxis`)."""
 
 
 def hann_periodic(n: int) -> np.ndarray:
     """Periodic Hann window w[i] = 0.5 - 0.5 cos(2 pi i / n), float64 (n,) (w[0] = 0)."""
     return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
+
+
+@dataclass(frozen=True)
+class FftAxis:
+    """One FFT axis of the chain: ``n_samples`` inputs, periodic-Hann windowed over their own
+    count (``hann``) or not, zero-padded to ``n_fft``; ``real``: the inputs were real, so
+    the map keeps bins 0..n_fft/2-1 (the rest mirror them). What a detector needs of it:
+    main lobe, coherent gain, noise correlation between bins (:func:`fft_axes`)."""
+
+    n_fft: int
+    n_samples: int
+    hann: bool = True
+    real: bool = False
+
+    @property
+    def n_bins(self) -> int:
+        """Bins of the map along this axis: n_fft, or n_fft / 2 for real inputs."""
+        return self.n_fft // 2 if self.real else self.n_fft
+
+    @property
+    def main_lobe_bins(self) -> int:
+        """Half width of the Hann main lobe in whole bins, ceil(2 n_fft / n_samples): 2
+        without padding (also used unwindowed, as the presets' masking always has)."""
+        return math.ceil(HANN_MAIN_LOBE_BINS * self.n_fft / self.n_samples - 1e-9)
+
+    def window(self) -> np.ndarray:
+        """The window over the samples, float64 (n_samples,)."""
+        return hann_periodic(self.n_samples) if self.hann else np.ones(self.n_samples)
+
+    @property
+    def coherent_gain(self) -> float:
+        """Bin amplitude over the input tone's amplitude at a bin centre: sum(window) / n_fft
+        (0.5 with Hann, 1 without, times n_samples / n_fft when padded), halved for real
+        inputs (a real tone's amplitude splits between its bin and the mirror)."""
+        gain = (0.5 if self.hann else 1.0) * (self.n_samples / self.n_fft)
+        return gain * 0.5 if self.real else gain
+
+    def power_correlation(self) -> tuple[float, ...]:
+        """Power correlation of white noise between bins i = 0, 1, ... apart,
+        |sum w^2 e^{-j 2 pi i t / n_fft}|^2 / (sum w^2)^2, while above
+        :data:`POWER_CORRELATION_FLOOR` (``model.cfar_stats``' constants unpadded)."""
+        if self.n_samples == self.n_fft:
+            return HANN_POWER_CORRELATION if self.hann else RECT_POWER_CORRELATION
+        w2 = self.window() ** 2
+        rho = np.abs(np.fft.fft(w2, self.n_fft)[: self.n_fft // 2]) ** 2 / w2.sum() ** 2
+        n = int(np.flatnonzero(rho >= POWER_CORRELATION_FLOOR).max()) + 1
+        return tuple(float(r) for r in rho[:n])
+
+
+def fft_axes(cfg: RadarConfig, range_window: bool = True, doppler_window: bool = True
+             ) -> tuple[FftAxis, FftAxis]:
+    """The (range, Doppler) axes of ``cfg``'s cube with these windows."""
+    return (FftAxis(cfg.n_range, cfg.n_samples, range_window, cfg.adc == "real"),
+            FftAxis(cfg.n_doppler, cfg.n_loops, doppler_window))
 
 
 def signed_bin(k: np.ndarray | int, n: int) -> np.ndarray:
@@ -51,40 +119,50 @@ def signed_bins(n: int) -> np.ndarray:
 
 
 def range_fft(adc: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndarray:
-    """Range FFT of every chirp, scaled 1/n_range.
+    """Range FFT of every chirp, scaled 1/n_range: each chirp's n_samples (windowed by a
+    periodic Hann of n_samples) zero-padded to n_range; a real ADC keeps bins
+    0..n_range/2-1.
 
-    adc: complex (n_chirps, num_rx, n_range) -> complex128 (n_chirps, num_rx, n_range).
+    adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
+    (n_chirps, num_rx, n_range_bins).
     """
     cfg.check_adc(adc)
+    if cfg.adc == "real" and np.iscomplexobj(adc):
+        raise ValueError(f"adc: complex samples for radar {cfg.name!r}, which has a real ADC")
     x = adc.astype(np.complex128)
     if window:
-        x = x * hann_periodic(cfg.n_range)
-    return np.fft.fft(x, axis=-1) / cfg.n_range
+        x = x * hann_periodic(cfg.n_samples)
+    out = np.fft.fft(x, n=cfg.n_range, axis=-1) / cfg.n_range
+    return out if cfg.adc == "complex" else out[..., :cfg.n_range_bins]
 
 
 def corner_turn(range_out: np.ndarray, cfg: RadarConfig) -> np.ndarray:
-    """Reorder range-FFT output into Doppler vectors.
+    """Reorder range-FFT output into Doppler vectors, by TX index.
 
-    range_out: (n_chirps, num_rx, n_range) in transmit order ->
-    (num_tx, num_rx, n_range, n_doppler): for each TX, RX and range bin the slow-time vector
-    of that TX's chirps in order.
+    range_out: (n_chirps, num_rx, n_range_bins) in transmit order ->
+    (num_tx, num_rx, n_range_bins, n_loops): for each TX (index, not firing slot), RX and
+    range bin the slow-time vector of that TX's chirps in order.
     """
-    x = range_out.reshape(cfg.n_doppler, cfg.num_tx, cfg.num_rx, cfg.n_range)
+    x = range_out.reshape(cfg.n_loops, cfg.num_tx, cfg.num_rx, cfg.n_range_bins)
+    if cfg.tx_sequence != tuple(range(cfg.num_tx)):
+        x = x[:, tx_slots(cfg)]                 # slot of each TX index
     return np.transpose(x, (1, 2, 3, 0))
 
 
 def doppler_fft(turned: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndarray:
-    """Doppler FFT along the last axis, scaled 1/n_doppler, natural bin order."""
+    """Doppler FFT along the last axis (n_loops slow-time samples, windowed by a periodic
+    Hann of n_loops, zero-padded to n_doppler), scaled 1/n_doppler, natural bin order:
+    (..., n_loops) -> complex128 (..., n_doppler)."""
     x = turned
     if window:
-        x = x * hann_periodic(cfg.n_doppler)
-    return np.fft.fft(x, axis=-1) / cfg.n_doppler
+        x = x * hann_periodic(cfg.n_loops)
+    return np.fft.fft(x, n=cfg.n_doppler, axis=-1) / cfg.n_doppler
 
 
 def remove_static(turned: np.ndarray) -> np.ndarray:
     """Static-clutter removal: each slow-time vector less its mean over the frame's chirps,
     i.e. per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing a
-    capture"). turned: complex (..., n_doppler) -> the same shape; returns a new array."""
+    capture"). turned: complex (..., n_loops) -> the same shape; returns a new array."""
     return turned - turned.mean(axis=-1, keepdims=True)
 
 
@@ -94,7 +172,8 @@ def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     """The FPGA chain in float: ADC frame -> radar cube; ``remove_static_clutter``: apply
     :func:`remove_static` before the Doppler FFT (not a step of the FPGA chain).
 
-    adc: complex (n_chirps, num_rx, n_range) -> complex128 (n_virtual, n_range, n_doppler).
+    adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
+    (n_virtual, n_range_bins, n_doppler).
     """
     turned = corner_turn(range_fft(adc, cfg, range_window), cfg)
     if remove_static_clutter:

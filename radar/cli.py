@@ -11,6 +11,8 @@
     radar gnn      dataset|train|eval|detect ...      (the GNN object detector)
     radar profile  show NAME|FILE.toml|FILE.cfg       (a radar profile's derived numbers)
     radar process  --radar PROFILE --capture FILE --json OUT   (a capture -> point cloud)
+    radar curves   [--quick] [--ray-address ADDR] --json OUT [--plots DIR]   (Pd, CRB curves)
+    radar calibrate --radar PROFILE --capture FILE --reflector R[,AZ[,EL]] --out CAL.json
 
 One module per command group under :mod:`radar.commands`. Bad input ends with exit status 2
 and a one-line reason on stderr. ``radar <cmd> --help`` explains every option.
@@ -22,10 +24,23 @@ import argparse
 import sys
 
 from model.config import PRESETS
-from radar.commands import demo, detect, gnn, link, mcap, process, profile, simulate, view
+from radar.commands import (
+    calibrate,
+    curves,
+    demo,
+    detect,
+    gnn,
+    link,
+    mcap,
+    process,
+    profile,
+    simulate,
+    view,
+)
 from radar.common import CliError
 
-COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile, process)
+COMMAND_GROUPS = (simulate, detect, demo, link, view, mcap, profile, process, calibrate,
+                  curves)
 """Command modules, each with ``add_parsers(sub, presets)``, in ``--help`` order."""
 
 

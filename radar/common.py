@@ -7,15 +7,24 @@ import argparse
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import TypeVar
 
 from tqdm import tqdm
 
 from host.cfar import CfarParams
-from host.params import DETECTORS, MAX_RADIAL_SPEED_MPS, DetectionParams
-from model.config import RadarConfig
+from host.params import (
+    DETECTORS,
+    MAX_RADIAL_SPEED_MPS,
+    DetectionParams,
+    default_guard,
+    default_max_speed_mps,
+)
+from model.config import RadarConfig, get_preset
+from model.profile import Profile, load_profile, preset_profile
 from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
+from radar.sources import FrameSource, SourceError, get_source
 
 T = TypeVar("T")
 
@@ -29,24 +38,100 @@ def progress(iterable: Iterable[T], desc: str, total: int | None = None) -> Iter
     return tqdm(iterable, desc=desc, total=total, disable=not sys.stderr.isatty(), leave=False)
 
 
-def scene_of(args: argparse.Namespace) -> Scene:
-    """The scene of ``--scene`` (file or built-in name) with ``--preset`` if given."""
+def add_radar_option(p: argparse.ArgumentParser, instead: str) -> None:
+    """``--radar PROFILE``: the radar ``instead`` of the preset (a preset name, a TOML
+    profile or a TI .cfg; :func:`radar_profile`)."""
+    p.add_argument("--radar", default=None, metavar="PROFILE",
+                   help=f"the radar instead of {instead}: a preset name, a TOML profile or a "
+                        f"TI .cfg (docs/profiles.md); not with --preset")
+
+
+def radar_profile(args: argparse.Namespace) -> Profile | None:
+    """The profile of ``--radar`` (``model.profile.load_profile``), None without it;
+    CliError (one line) for a bad profile or when ``--preset`` is given too."""
+    spec = getattr(args, "radar", None)
+    if spec is None:
+        return None
+    if getattr(args, "preset", None) is not None:
+        raise CliError("--radar and --preset: give one of them")
     try:
-        return load_scene(args.scene, getattr(args, "preset", None))
+        return load_profile(spec)
     except ValueError as exc:
         raise CliError(str(exc)) from None
+
+
+def radar_of(args: argparse.Namespace) -> RadarConfig | None:
+    """The radar of ``--radar`` or ``--preset`` (None: neither given)."""
+    profile = radar_profile(args)
+    if profile is not None:
+        return profile.config
+    return get_preset(args.preset) if args.preset else None
+
+
+def on_radar(scene: Scene, profile: Profile | None) -> Scene:
+    """``scene`` on the radar of ``profile`` (``Scene.radar``; None: the scene's preset);
+    CliError (one line) for impairments that radar cannot have."""
+    if profile is None:
+        return scene
+    try:
+        return replace(scene, radar=profile.config)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+
+
+def scene_profile(args: argparse.Namespace) -> tuple[Scene, Profile]:
+    """The scene of ``--scene`` (file or built-in name) on the radar of ``--radar`` or
+    ``--preset`` (:func:`radar_profile`), and that radar's profile (without ``--radar``:
+    the scene's preset's, ``model.profile.preset_profile``)."""
+    profile = radar_profile(args)
+    try:
+        scene = load_scene(args.scene, getattr(args, "preset", None))
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    return on_radar(scene, profile), profile or preset_profile(scene.preset)
+
+
+def scene_of(args: argparse.Namespace) -> Scene:
+    """The scene of ``--scene`` on the radar of ``--radar`` or ``--preset``
+    (:func:`scene_profile`)."""
+    return scene_profile(args)[0]
+
+
+def check_source(source: FrameSource, cfg: RadarConfig, what: str | None = None,
+                 alternative: str | None = "--backend float") -> None:
+    """One-line CliError, before any work, when ``source`` cannot run the radar ``cfg``
+    (``FrameSource.check``: the bit-accurate model and the RTL run what the HDL supports):
+    ``what`` (default ``--backend NAME``), why, and ``alternative`` when the float source
+    runs ``cfg``."""
+    try:
+        source.check(cfg)
+    except SourceError as exc:
+        line = f"{what or '--backend ' + source.name}: {exc}"
+        if alternative and source.name != "float":
+            try:
+                get_source("float").check(cfg)
+                line += f" ({alternative} runs it)"
+            except SourceError:
+                pass
+        raise CliError(line) from None
 
 
 def detection_params(args: argparse.Namespace, scene_bf: bool = True,
                      cfg: RadarConfig | None = None) -> DetectionParams:
     """Host detection settings from the options of :func:`add_detection_options`, checked
-    against ``cfg`` when given (CFAR window larger than the map)."""
+    against ``cfg`` when given (CFAR window larger than the map); without ``--max-speed``
+    the radar's (``host.params.default_max_speed_mps``: a profile's ``max_speed_mps``,
+    100 m/s for the presets and without ``cfg``); without ``--guard`` the guard is
+    ``cfg``'s main lobe (``host.params.default_guard``)."""
+    speed = args.max_speed if args.max_speed is not None else (
+        MAX_RADIAL_SPEED_MPS if cfg is None else default_max_speed_mps(cfg))
+    guard = tuple(args.guard) if cfg is None or given(args, "guard") else default_guard(cfg)
     try:
-        cfar = CfarParams(pfa=args.pfa, guard=tuple(args.guard), train=tuple(args.train),
+        cfar = CfarParams(pfa=args.pfa, guard=guard, train=tuple(args.train),
                           kind="os" if args.detector == "os" else "ca")
         params = DetectionParams(detector=args.detector, cfar=cfar,
                                  paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
-                                 max_speed_mps=args.max_speed)
+                                 max_speed_mps=speed)
         if cfg is not None:
             params.check(cfg)
         return params
@@ -159,27 +244,26 @@ def ego_speed_mps(args: argparse.Namespace, scene: Scene | None) -> float:
     return default_ego_speed_mps(scene) if scene is not None else 0.0
 
 
-def add_detection_options(p: argparse.ArgumentParser, max_speed_default: str | None = None
-                          ) -> None:
-    """Detector choice and CFAR settings; ``max_speed_default``: what ``--max-speed``
-    defaults to when the command fills it in (the option's default is then None)."""
+def add_detection_options(p: argparse.ArgumentParser) -> None:
+    """Detector choice and CFAR settings (:func:`detection_params`)."""
     p.add_argument("--detector", choices=DETECTORS, default="ca",
                    help="ca: 2-D CA-CFAR on the non-coherent map (default); os: OS-CFAR "
                         "(slower); paper: the paper's threshold on channel 0")
     p.add_argument("--pfa", type=float, default=1e-6,
                    help="CFAR false-alarm probability per range-Doppler cell (default 1e-6)")
     p.add_argument("--guard", type=int, nargs=2, default=(2, 2), metavar=("RANGE", "DOPPLER"),
-                   help="CFAR guard cells per side (default 2 2)")
+                   help="CFAR guard cells per side (default 2 2, the Hann main lobe; "
+                        "wider for a zero-padded profile)")
     p.add_argument("--train", type=int, nargs=2, default=(4, 8), metavar=("RANGE", "DOPPLER"),
                    help="CFAR training cells per side (default 4 8)")
     p.add_argument("--threshold-db", type=float, default=15.0,
                    help="paper detector: threshold over the channel-0 median, dB (default 15)")
-    p.add_argument("--max-speed", type=float,
-                   default=MAX_RADIAL_SPEED_MPS if max_speed_default is None else None,
+    p.add_argument("--max-speed", type=float, default=None,
                    help="fastest radial speed to expect, m/s: velocities are unfolded within "
                         "it and a point is flagged ambiguous when another velocity within it "
-                        "explains the measurement (default "
-                        f"{max_speed_default or format(MAX_RADIAL_SPEED_MPS, 'g')})")
+                        "explains the measurement (default: the radar profile's max_speed_mps, "
+                        "its unambiguous speed unless it states one; "
+                        f"{MAX_RADIAL_SPEED_MPS:g} for the presets)")
 
 
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,

@@ -40,8 +40,8 @@ class CubeFrame(Protocol):
 class FrameCloud:
     """A frame's point cloud and what it came from.
 
-    ``cube``: complex (n_virtual, n_range, n_doppler) and ``nci``: float (n_range,
-    n_doppler) its integrated power, both float-reference units (None for records);
+    ``cube``: complex (n_virtual, n_range_bins, n_doppler) and ``nci``: float
+    (n_range_bins, n_doppler) its integrated power, both float-reference units (None for records);
     ``records``: the records inside the map, float-reference units (None for a cube);
     ``problems``: what was dropped (records outside the map: corrupt words that still looked
     like records)."""
@@ -68,7 +68,7 @@ def frame_cloud(frame: np.ndarray | CubeFrame | DetectionFrame, cfg: RadarConfig
     cube = frame if isinstance(frame, np.ndarray) else frame.cube()
     cloud, nci = process_cube_nci(cube, cfg, params, frame_id)
     problems = []
-    if real_only(cube):
+    if cfg.adc == "complex" and real_only(cube):
         problems.append(f"frame {frame_id}: {REAL_ONLY}")
         note_real_only(command, frame_id)
     return FrameCloud(cloud, cube=cube, nci=nci, problems=problems)

@@ -33,7 +33,7 @@ from host.records import DetectionFrame
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
-from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W
+from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, check_hdl
 from model.radar_pipeline import PipelineParams, record_frames, scaled_cube
 from model.reference import radar_cube
 
@@ -57,6 +57,8 @@ class FrameSource:
     help: ClassVar[str] = ""
     per_frame: ClassVar[bool] = True
     """True if a single frame is cheap (offered by ``radar demo``)."""
+    hdl: ClassVar[bool] = False
+    """True if the source runs the RTL's chain, so the HDL's limits apply (:meth:`check`)."""
 
     def __init__(self, chain: PipelineParams | None = None) -> None:
         self.chain = chain or PipelineParams()
@@ -65,6 +67,26 @@ class FrameSource:
         super().__init_subclass__(**kwargs)
         if cls.name:
             SOURCES[cls.name] = cls
+
+    def check(self, cfg: RadarConfig) -> None:
+        """SourceError (one line) when this source cannot run the radar ``cfg``: what the
+        processing chain does not support (``RadarConfig.check_processable``) and, for the
+        sources of the RTL's chain (``hdl``), what the RTL does not elaborate
+        (``model.hdl.check_hdl``, ``PipelineParams.check``, the frame store's geometry)."""
+        try:
+            cfg.check_processable()
+            if self.hdl:
+                check_hdl(cfg)
+                chain = self.chain_for(cfg)
+                chain.check(cfg)
+                if chain.frame_store:
+                    chain.store_geometry(cfg)
+        except ValueError as exc:
+            raise SourceError(str(exc)) from None
+
+    def chain_for(self, cfg: RadarConfig) -> PipelineParams:
+        """The chain settings the source runs ``cfg`` with."""
+        return self.chain
 
     def cube(self, adc: np.ndarray, cfg: RadarConfig) -> np.ndarray:
         """One ADC frame -> its radar cube."""
@@ -97,6 +119,7 @@ class FrameSource:
 class ModelSource(FrameSource):
     name = "model"
     help = "bit-accurate model of the FPGA chain (default)"
+    hdl = True
 
     def cube(self, adc: np.ndarray, cfg: RadarConfig) -> np.ndarray:
         # complex64 like the cube decoded from the DMA stream, so both give identical clouds
@@ -128,8 +151,9 @@ class RtlSource(FrameSource):
     name = "rtl"
     help = "the Verilated radar_pipeline"
     per_frame = False
+    hdl = True
 
-    def _chain(self, cfg: RadarConfig) -> PipelineParams:
+    def chain_for(self, cfg: RadarConfig) -> PipelineParams:
         """The chain with FRAME_STORE = 1 when the frame does not fit on chip."""
         chain = self.chain
         frame_bits = cfg.num_tx * cfg.n_range * cfg.n_doppler * cfg.num_rx * 32
@@ -165,7 +189,7 @@ class RtlSource(FrameSource):
         """All frames stream through the RTL back to back (one simulation); the DMA packets
         are decoded like the board's."""
         adcs = list(adc_frames)
-        packets, status = self._run(adcs, cfg, self._chain(cfg))
+        packets, status = self._run(adcs, cfg, self.chain_for(cfg))
         dec = chain_decoder(cfg, self.chain.packet_words, self.chain)
         decoded = [f for p in packets for f in dec.push_packet(p)] + dec.flush()
         if len(decoded) != len(adcs) or not all(f.complete for f in decoded):
@@ -178,7 +202,7 @@ class RtlSource(FrameSource):
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
         """All frames through the Verilated top in OUTPUT_MODE = 1 (one simulation)."""
-        chain = replace(self._chain(cfg), output_mode=1, detect=dcfg)
+        chain = replace(self.chain_for(cfg), output_mode=1, detect=dcfg)
         try:
             chain.check(cfg)
         except ValueError as exc:

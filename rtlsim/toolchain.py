@@ -28,6 +28,40 @@ such builds go to ``<tag>_cov`` folders and each run's ``coverage.dat`` is kept 
 ``sim_build/coverage/``."""
 
 
+WATCHDOG_MS = 50.0
+"""Default simulated-time limit of every cocotb test, ms (``TB_WATCHDOG_MS`` overrides it,
+0 turns it off; a test's own ``@cocotb.test(timeout_time=...)`` wins). The longest test of
+``make test`` simulates 3.3 ms (corner_turn's stall cross), the full 16-pair cross about 13 ms;
+a design that stops answering (a mutant, a bug) then fails within minutes of wall time
+instead of simulating for ever."""
+
+
+def install_watchdog() -> None:
+    """Inside a cocotb simulation: give every test defined from now on (tests are defined
+    when their module is imported, after it imports this one) the :data:`WATCHDOG_MS`
+    simulated-time limit unless it sets its own. Outside a simulation it does nothing."""
+    cocotb = sys.modules.get("cocotb")
+    if cocotb is None or not getattr(cocotb, "is_simulation", False):
+        return
+    from cocotb.regression import TestGenerator
+    if getattr(TestGenerator, "watchdog_installed", False):
+        return
+    limit = float(os.environ.get("TB_WATCHDOG_MS", WATCHDOG_MS))
+    if limit <= 0:
+        return
+    init = TestGenerator.__init__
+
+    def with_watchdog(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
+        init(self, *args, **kwargs)
+        self.timeout = (limit, "ms")      # the decorator's timeout_time replaces it
+
+    TestGenerator.__init__ = with_watchdog     # type: ignore[method-assign]
+    TestGenerator.watchdog_installed = True    # type: ignore[attr-defined]
+
+
+install_watchdog()
+
+
 def coverage_enabled() -> bool:
     """True when ``COVERAGE=1``: build with line and toggle coverage."""
     return os.environ.get("COVERAGE", "0") not in ("", "0")

@@ -8,6 +8,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from host.angle import AngleParams
 from host.params import DetectionParams
@@ -38,11 +39,14 @@ def strongest_near(cloud, range_m: float, velocity_mps: float) -> int:  # noqa: 
     return int(near[np.argmax(cloud.snr_db[near])])
 
 
-def test_simulated_2d_array_measures_elevation() -> None:
-    """A simulated frame of the xWR1843's 3 TX x 4 RX array (TX1 half a wavelength up):
-    each target's strongest point within 1.5 deg in azimuth and 3 deg in elevation, z from
-    the elevation."""
-    cfg = replace(OPENRADAR.config, num_tx=3, tx_positions=((0, 0), (2, 1), (4, 0)))
+@pytest.mark.parametrize("order", [None, (2, 0, 1), (1, 2, 0)])
+def test_simulated_2d_array_measures_elevation(order: tuple[int, ...] | None) -> None:
+    """A simulated frame of the xWR1843's 3 TX x 4 RX array (TX1 half a wavelength up),
+    fired in order or permuted (the corner turn sorts the chirps by TX, the TDM
+    compensation uses each TX's slot): each target's strongest point within 1.5 deg in
+    azimuth and 3 deg in elevation, z from the elevation."""
+    cfg = replace(OPENRADAR.config, num_tx=3, tx_positions=((0, 0), (2, 1), (4, 0)),
+                  tx_order=order)
     frame = simulate_frame(cfg, scatterers(*TARGETS), rng=np.random.default_rng(1))
     cloud = process_frame(frame.samples, cfg, DetectionParams(max_speed_mps=cfg.max_speed_mps))
     for r, az, v, _, el in TARGETS:

@@ -25,7 +25,8 @@ LAYOUTS = {"4-lane": CaptureFormat("dca1000", 4, True),
 
 
 def small(adc: str = "complex", num_rx: int = 4, samples: int = 10, loops: int = 3):
-    """A small profile (2 TX) of the given ADC kind, RX count and sizes."""
+    """A small profile (2 TX) of the given ADC kind, RX count and sizes (its near-range
+    guard stated: the default one would leave a 10-sample real ADC no bin)."""
     rx = ", ".join(f"[{r}, 0]" for r in range(num_rx))
     return profile_from_toml(f"""
         [waveform]
@@ -36,6 +37,7 @@ def small(adc: str = "complex", num_rx: int = 4, samples: int = 10, loops: int =
         chirp_period_s = 20e-6
         loops = {loops}
         adc = "{adc}"
+        min_range_m = 0.1
         [array]
         tx = [[0, 0], [{num_rx}, 0]]
         rx = [{rx}]""", "small.toml").config

@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-PROJECT = ("model", "rtlsim", "tb", "host", "gnn", "radar", "synth", "tests", "benchmarks")
+PROJECT = ("model", "rtlsim", "tb", "host", "gnn", "radar", "synth", "campaign", "tests",
+           "benchmarks")
 """The project's Python packages (folders) whose imports are checked."""
 MAY_IMPORT: dict[str, frozenset[str]] = {
     "model": frozenset({"model"}),
@@ -22,12 +23,13 @@ MAY_IMPORT: dict[str, frozenset[str]] = {
     "tb": frozenset({"tb", "model", "rtlsim", "host"}),
     "host": frozenset({"host", "model"}),
     "gnn": frozenset({"gnn", "model", "host"}),
-    "radar": frozenset({"radar", "model", "rtlsim", "host", "gnn", "synth"}),
+    "radar": frozenset({"radar", "model", "rtlsim", "host", "gnn", "synth", "campaign"}),
     "synth": frozenset({"synth", "model"}),
+    "campaign": frozenset({"campaign", "model", "host"}),
     "tests": frozenset({"tests", "model", "rtlsim", "host", "gnn", "radar", "synth",
-                        "benchmarks"}),
+                        "campaign", "benchmarks"}),
     "benchmarks": frozenset({"benchmarks", "model", "rtlsim", "host", "gnn", "radar", "synth",
-                             "tests"}),
+                             "campaign", "tests"}),
 }
 """Project packages each package may import (DESIGN.md section 1, last column; ``benchmarks``
 is the top-level folder of benchmark scripts, not an installed package)."""
@@ -86,6 +88,8 @@ def test_imports_follow_the_layering(package: str) -> None:
     ("radar", "def f():\n    import benchmarks.bench_view\n"),
     ("model", "import torch"),
     ("synth", "from host import plots"),
+    ("campaign", "from radar.cli import main"),
+    ("host", "from campaign.runner import run"),
 ])
 def test_checker_catches_an_upward_import(package: str, source: str) -> None:
     assert violations(package, source)
@@ -104,6 +108,6 @@ def test_checker_allows_the_table() -> None:
 def test_no_product_package_imports_test_or_benchmark_code() -> None:
     """The table keeps ``tests``, ``tb`` and ``benchmarks`` out of every installed package,
     and pyproject.toml installs none of them."""
-    assert set(PRODUCT) == {"model", "rtlsim", "host", "gnn", "radar", "synth"}
+    assert set(PRODUCT) == {"model", "rtlsim", "host", "gnn", "radar", "synth", "campaign"}
     for package in PRODUCT:
         assert not MAY_IMPORT[package] & {"tests", "tb", "benchmarks"}, package

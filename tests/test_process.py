@@ -112,8 +112,8 @@ def test_plots_written(tmp_path, capsys):
 
 
 
-@pytest.mark.parametrize("case", ["short", "other-profile", "unprocessable", "frames",
-                                  "backend", "json", "missing", "plots"])
+@pytest.mark.parametrize("case", ["short", "other-profile", "frames", "backend", "json",
+                                  "missing", "plots"])
 def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
     radar, capture, extra = str(CFG_FILE), str(BIN_FILE), []
     if case == "short":                      # fits no whole frame
@@ -124,11 +124,6 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
         capture = str(tmp_path / "other.npy")
         np.save(capture, np.zeros(PRESETS["paper-fpga"].adc_shape, np.complex64))
         want = "expected shape"
-    elif case == "unprocessable":            # a real-ADC .cfg: the chain refuses it
-        radar = str(tmp_path / "real.cfg")
-        Path(radar).write_text(CFG_FILE.read_text().replace("adcCfg 2 1", "adcCfg 2 0")
-                               .replace("adcbufCfg -1 0 1 1 1", "adcbufCfg -1 1 1 1 1"))
-        want = "does not support real-valued ADC yet"
     elif case == "frames":
         extra = ["--frames", "1:3"]
         want = "--frames: 1:3"

@@ -16,6 +16,7 @@ from model.profile import (
     profile_from_toml,
     profile_to_toml,
 )
+from model.profile_fields import preset_chain_features
 from model.scene import Scatterers
 from model.simulate import simulate_frame
 from model.ti_cfg import profile_from_cfg
@@ -143,12 +144,11 @@ def test_cfg_beyond_the_chain_loads_and_is_refused_by_the_chain():
     assert c.max_range_m == pytest.approx(c.n_range * c.range_bin_m / 2)
     assert p.calibration.range_bias_m == 0.05
     assert p.calibration.channel_gain == (1,) * 4 + (1j,) * 4 + (-1,) * 4
-    features = " ".join(c.unsupported_features())
-    for word in ("200 samples", "255 loops", "real-valued ADC"):
+    features = " ".join(preset_chain_features(c))
+    for word in ("200 samples", "255 loops", "firing order", "real-valued ADC", "ULA"):
         assert word in features
-    assert "firing order" not in features and "ULA" not in features     # processed
-    with pytest.raises(ValueError, match="real-valued ADC"):
-        c.check_adc(np.zeros(c.adc_shape))
+    assert c.unsupported_features() == []                 # the float chain takes them all
+    c.check_adc(np.zeros(c.adc_shape))
     assert simulate_frame(c, Scatterers(*(np.ones(1),) * 4, np.zeros(1, dtype=int))
                           ).samples.shape == c.adc_shape      # the simulator models it all
     back = profile_from_toml(profile_to_toml(p)).config
@@ -260,7 +260,7 @@ def test_profile_show_files(tmp_path, capsys):
     beyond.write_text(BEYOND_CFG)
     assert main(["profile", "show", str(beyond)]) == 0
     out = capsys.readouterr().out
-    assert "elevation resolution" in out and "not yet: 200 samples" in out
+    assert "elevation resolution" in out and "supported by the chain" in out
     assert "200 (zero-padded to 256)" in out and "255 (zero-padded to 256)" in out
     profile = tmp_path / "awr.toml"
     profile.write_text(CONTRACT_TOML)

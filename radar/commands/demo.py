@@ -8,20 +8,30 @@ import json
 import multiprocessing
 import time
 from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from host.cfar import paper_threshold
 from host.evaluate import alias_note, match_targets, table3
+from host.params import default_max_speed_mps
 from host.pipeline import DetectionParams
 from model.reference import range_doppler_power
 from model.scene import Scene, default_ego_speed_mps, table1_scene
 from model.simulate import simulate_scene
-from radar.common import add_command, out_folder
+from radar.common import (
+    CliError,
+    add_command,
+    add_radar_option,
+    check_source,
+    on_radar,
+    out_folder,
+    radar_profile,
+)
 from radar.figures import truth_range_doppler, truth_xy
 from radar.frame_cloud import frame_cloud
 from radar.objects import gnn_objects, object_boxes
-from radar.sources import SOURCES, get_source
+from radar.sources import SOURCES, FrameSource, get_source
 
 
 def _import_gnn() -> None:
@@ -49,16 +59,26 @@ class GnnWorker:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
+    scene = on_radar(table1_scene(args.preset or "full"), radar_profile(args))
     out_folder(args.out, "--out")               # before any work
+    cfg = scene.config
+    source = get_source(args.backend)
+    check_source(source, cfg)
+    params = DetectionParams(max_speed_mps=default_max_speed_mps(cfg))
+    try:
+        params.check(cfg)
+    except ValueError as exc:
+        raise CliError(f"--radar: {exc}") from None
     gnn = None if args.no_gnn else GnnWorker()
     try:
-        return _demo(args, gnn)
+        return _demo(args, gnn, scene, source, params)
     finally:
         if gnn is not None:
             gnn.close()
 
 
-def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
+def _demo(args: argparse.Namespace, gnn: GnnWorker | None, scene: Scene, source: FrameSource,
+          params: DetectionParams) -> int:
     from host.angle import range_azimuth_power
     from host.plots import (
         plot_detection_mask,
@@ -68,10 +88,7 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     )
 
     out = Path(args.out)
-    scene = table1_scene(args.preset)
     cfg = scene.config
-    params = DetectionParams()
-    source = get_source(args.backend)
     t0 = time.perf_counter()
     adc = simulate_scene(scene)
     cube = source.cube(adc.samples, cfg)
@@ -82,7 +99,8 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
     frame_cloud(cube, cfg, params, 0, "demo")
     t_host = time.perf_counter() - t_host
     matches, used = match_targets(cloud, scene.targets, cfg)
-    print(f"Table I scene, preset {cfg.name} ({cfg.num_tx} TX x {cfg.num_rx} RX, "
+    print(f"Table I scene, {'preset' if scene.radar is None else 'radar'} {cfg.name} "
+          f"({cfg.num_tx} TX x {cfg.num_rx} RX, "
           f"{cfg.n_range} x {cfg.n_doppler} FFTs), {args.backend} backend, CA-CFAR Pfa "
           f"{params.cfar.pfa:g}: {len(cloud)} points, {int((~used).sum())} unmatched, host "
           f"processing {t_host * 1e3:.0f} ms per frame (the process's first frame "
@@ -101,8 +119,7 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None) -> int:
             plot_range_doppler(range_doppler_power(cube), cfg, out / "range_doppler_nci.png",
                                f"{cfg.name}: range-Doppler, {cfg.n_virtual} channels "
                                f"non-coherent", truth_range_doppler(scene, "V"), zoom)]
-    no_bf = Scene(preset=scene.preset, seed=scene.seed, tx_beamforming=False,
-                  targets=scene.targets, name="table1-no-bf")
+    no_bf = replace(scene, tx_beamforming=False, name="table1-no-bf")
     cube_nobf = source.cube(simulate_scene(no_bf).samples, cfg)
     ra_bf, az = range_azimuth_power(cube, cfg)
     ra_nobf, _ = range_azimuth_power(cube_nobf, cfg)
@@ -142,8 +159,9 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
         range-azimuth with and without TX beamforming (Fig. 5), the non-coherent range-Doppler map
         and the x-y point cloud.""")
     m.add_argument("--out", default="out", help="folder for figures and JSON (default out/)")
-    m.add_argument("--preset", choices=presets, default="full",
+    m.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default full)")
+    add_radar_option(m, "a preset")
     m.add_argument("--backend", choices=[n for n, s in SOURCES.items() if s.per_frame],
                    default="model",
                    help="model: bit-accurate FPGA chain (default, ~20 s on full); float: "

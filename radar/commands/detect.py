@@ -32,6 +32,8 @@ from radar.common import (
     CliError,
     add_command,
     add_detection_options,
+    add_radar_option,
+    check_source,
     count,
     detection_params,
     ego_speed_mps,
@@ -39,7 +41,7 @@ from radar.common import (
     out_folder,
     progress,
     refuse_detection_misfits,
-    scene_of,
+    scene_profile,
     stop_exit,
     stop_fields,
     stopped_before_any,
@@ -89,11 +91,14 @@ def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     refuse_detection_misfits(args, args.detect == "fpga")
-    scene = scene_of(args)
+    scene, profile = scene_profile(args)
+    cfg = scene.config
+    source = get_source(args.backend)
+    check_source(source, cfg, alternative="--backend float" if args.detect == "host"
+                 else "--detect host --backend float")
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
     plots = out_folder(args.plots, "--plots") if args.plots else None
-    cfg = scene.config
     params = detection_params(args, scene.tx_beamforming, cfg)
     clouds, per_frame, objects = [], [], []
     last_cube = None
@@ -123,7 +128,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     stopped: str | None = None      # why the run ended early: what was done is written
     try:
         if dcfg is not None:
-            frames = get_source(args.backend).record_frames(adc_frames(), cfg, dcfg)
+            frames = source.record_frames(adc_frames(), cfg, dcfg)
             for f in frames:
                 t_start = time.perf_counter()
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
@@ -144,7 +149,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 finish_frame(k, cloud, t_start, complete=f.complete, truncated=f.truncated,
                              detections=f.detections, problems=f.problems + fc.problems)
         else:
-            for k, cube in enumerate(get_source(args.backend).cubes(adc_frames(), cfg)):
+            for k, cube in enumerate(source.cubes(adc_frames(), cfg)):
                 t_start = time.perf_counter()
                 fc = frame_cloud(cube, cfg, params, k, "detect")
                 cloud = fc.cloud
@@ -171,7 +176,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     done = len(per_frame) if stopped else args.frames
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
-                "scene": scene.name,
+                "scene": scene.name, **({"radar": profile.source} if args.radar else {}),
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
                 "frame_info": per_frame, **report})
     if args.gnn:
@@ -216,6 +221,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help=f"frames to process, 1..{MAX_DETECT_FRAMES} (default 1)")
     d.add_argument("--preset", choices=presets, default=None,
                    help="override the scene's radar preset")
+    add_radar_option(d, "the scene's preset")
     d.add_argument("--gnn", action="store_true",
                    help="also classify objects with the GNN (shipped checkpoint): adds "
                         "\"objects\" (class, score, rotated box, point indices) to the JSON")

@@ -24,7 +24,7 @@ from host.pointcloud import PointCloud
 from host.receiver import CUBE, RECORDS, Receiver
 from host.ros.messages import FrameStatus, missing_packets
 from model.axis_packetizer import words_to_bytes
-from model.config import PRESETS, get_preset
+from model.config import PRESETS
 from model.radar_pipeline import PipelineParams, chain_gain, dma_packets
 from model.simulate import simulate_scene
 from radar.commands.detect import add_fpga_options, detect_config_of, fpga_config
@@ -34,12 +34,15 @@ from radar.common import (
     CliError,
     add_command,
     add_detection_options,
+    add_radar_option,
     check,
+    check_source,
     count,
     detection_params,
     out_file,
     port,
     progress,
+    radar_of,
     refuse,
     refuse_detection_misfits,
     scene_of,
@@ -66,6 +69,8 @@ def cmd_capture(args: argparse.Namespace) -> int:
                "options: give them to radar receive)")
     scene = scene_of(args)
     cfg = scene.config
+    if args.radar:
+        check_source(get_source("model"), cfg, f"--radar {args.radar}", None)
     out = out_file(args.out, ".dmacap", "--out")
     count(args.frames, "--frames", MAX_CAPTURE_FRAMES)
     fit = max_packet_words(cfg.num_rx)
@@ -95,9 +100,9 @@ def cmd_capture(args: argparse.Namespace) -> int:
     info = CaptureInfo(cfg.num_rx, pw, cfg.num_tx, cfg.n_range, cfg.n_doppler, max_det)
     n = write_capture(out, info, packets)
     what = (f"detection records, MAX_DETECTIONS {max_det}" if max_det else "radar cube")
-    print(f"wrote {out}: {args.frames} frame(s), {n} packets of {pw} payload words (preset "
-          f"{cfg.name}, {what}; bit-accurate model of the FPGA chain, cube gain "
-          f"{chain_gain(cfg, chain):g} over 1/N per FFT)")
+    print(f"wrote {out}: {args.frames} frame(s), {n} packets of {pw} payload words "
+          f"({'preset' if scene.radar is None else 'radar'} {cfg.name}, {what}; bit-accurate "
+          f"model of the FPGA chain, cube gain {chain_gain(cfg, chain):g} over 1/N per FFT)")
     return 0
 
 
@@ -115,7 +120,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
         if not packets:
             raise ValueError(f"{args.capture}: the capture has a header but no packet: "
                              f"nothing to replay")
-        cfg = info.config(PRESETS.values())
         imp = Impairments(loss=args.loss, duplicate=args.duplicate, reorder=args.reorder,
                           seed=args.seed)
         with UdpSender(args.host, args.port, rate * 1e6 if rate else None, imp) as tx:
@@ -127,7 +131,10 @@ def cmd_replay(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise CliError(str(exc)) from None
     kind = f"records, MAX_DETECTIONS {info.max_detections}" if info.records else "cube"
-    print(f"sent {log.sent} datagrams ({cfg.name} {kind}, {info.packet_words} payload words "
+    # a preset's name, or the geometry of a radar profile's capture (radar capture --radar)
+    radar = next((c.name for c in PRESETS.values() if info.matches(c)),
+                 f"{info.num_tx} TX x {info.num_rx} RX, {info.n_range} x {info.n_doppler}")
+    print(f"sent {log.sent} datagrams ({radar} {kind}, {info.packet_words} payload words "
           f"each) to "
           f"{args.host}:{args.port} ({len(log.dropped)} dropped, {len(log.duplicated)} "
           f"duplicated, {len(log.reordered)} reordered on purpose)")
@@ -147,7 +154,9 @@ def cmd_receive(args: argparse.Namespace) -> int:
         check_seconds(args.timeout, "--timeout")
     except ValueError as exc:
         raise CliError(str(exc)) from None
-    fixed = get_preset(args.preset) if args.preset else None
+    fixed = radar_of(args)
+    if args.radar:
+        check_source(get_source("model"), fixed, f"--radar {args.radar}", None)
     params = detection_params(args, cfg=fixed)
 
     records = args.detect == "fpga"
@@ -235,7 +244,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     damaged = sum(not f.complete for f in frames)
     print(f"{len(frames)} frame(s) ({damaged} damaged), {len(cloud)} points -> {out}"
           + (f" (preset {cfg.name}, {decoder.packet_words} payload words per packet learnt "
-             f"from the stream)" if decoder and not args.preset else ""))
+             f"from the stream)" if decoder and fixed is None else ""))
     for f in frames:
         for p in f.problems[:5]:
             print(f"  {p}")
@@ -245,7 +254,9 @@ def cmd_receive(args: argparse.Namespace) -> int:
         return 130
     if not clouds:
         why = ("no datagram arrived" if not rx.datagrams else
-               "no datagram was a DMA packet of a known preset" + (
+               "no datagram was a DMA packet of " + (
+                   f"radar {fixed.name}" if fixed else
+                   "a known preset (another radar's stream: give its --radar)") + (
                    f" ({rx.unusable[0][:300]})" if rx.unusable else "") if not decoder else
                "every frame was damaged (see --use-damaged)")
         print(f"radar receive: error: no usable frame: {why} within {args.timeout:g} s",
@@ -277,6 +288,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "one UDP datagram of 65507 bytes with the header and CRC words: 1021 for "
                         "the 16 lanes of full, 4092 for the 4 of paper-fpga)")
     c.add_argument("--preset", choices=presets, default=None, help="override the preset")
+    add_radar_option(c, "the scene's preset (one the FPGA chain runs)")
     c.add_argument("--detect", choices=("host", "fpga"), default="host",
                    help="host: capture the radar cube stream (default); fpga: the on-chip "
                         "detector's record stream (OUTPUT_MODE = 1), a record capture")
@@ -307,6 +319,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
         frame.""")
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: learnt from the first packet's header)")
+    add_radar_option(v, "a preset learnt from the stream (one the FPGA chain runs)")
     v.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     v.add_argument("--port", type=int, default=0, help="UDP port (default: any free port, "
                                                        "printed)")

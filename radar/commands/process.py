@@ -13,16 +13,18 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from host.adc_capture import open_capture
-from host.params import default_max_speed_mps
+from host.adc_capture import NpyCapture, open_capture
+from host.calibration import check_calibration, load_calibration
+from host.dca1000 import Dca1000Capture
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
 from model.array import has_vertical_extent
-from model.profile import Profile, load_profile
+from model.profile import Calibration, Profile, load_profile
 from model.reference import radar_cube
 from radar.common import (
     CliError,
@@ -76,6 +78,43 @@ def profile_of(spec: str) -> Profile:
     return profile
 
 
+PROFILE_CALIBRATION = "compRangeBiasAndRxChanPhase"
+"""What the output calls a TI ``.cfg``'s calibration."""
+
+
+def calibration_of(path: str | None, profile: Profile, use_profile: bool = True
+                   ) -> tuple[Calibration | None, str]:
+    """The calibration ``radar process`` applies and its name for the output: the file
+    ``path`` (``--calibration``), else the profile's own (a TI ``.cfg``'s
+    ``compRangeBiasAndRxChanPhase``) when ``use_profile``, else none. CliError (one line)
+    for a file that is missing, malformed or of another array."""
+    cfg = profile.config
+    try:
+        if path is not None:
+            return load_calibration(path, cfg), path
+        if use_profile and profile.calibration is not None:
+            check_calibration(profile.calibration, cfg, f"{profile.source}: "
+                                                       f"{PROFILE_CALIBRATION}")
+            return profile.calibration, f"{PROFILE_CALIBRATION} of {profile.source}"
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    return None, "none"
+
+
+def capture_of(args: argparse.Namespace, profile: Profile, command: str
+               ) -> tuple[Dca1000Capture | NpyCapture, range]:
+    """The capture of ``--capture`` in ``profile``'s format and its frames of ``--frames``;
+    a truncated capture warned about (``radar <command>``); CliError (one line) for a file
+    that does not fit the profile or frames outside it."""
+    try:
+        capture = open_capture(args.capture, profile)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    if capture.dropped_bytes:
+        warn([capture.report()], command)
+    return capture, frame_range(args.frames, capture.n_frames)
+
+
 def clipped_samples(frame: np.ndarray, full_scale: int) -> int:
     """ADC values (I and Q counted apart) of a frame, complex or real integer codes, at or
     beyond full scale (+full_scale or -full_scale - 1): clipped, so the echo's harmonics
@@ -95,16 +134,10 @@ def cmd_process(args: argparse.Namespace) -> int:
                        f"{', '.join(BACKENDS)} for now")
     profile = profile_of(args.radar)
     cfg = profile.config
-    if args.max_speed is None:
-        args.max_speed = default_max_speed_mps(cfg)
     params = detection_params(args, cfg=cfg)
-    try:
-        capture = open_capture(args.capture, profile)
-    except ValueError as exc:
-        raise CliError(str(exc)) from None
-    if capture.dropped_bytes:
-        warn([capture.report()], "process")
-    frames = frame_range(args.frames, capture.n_frames)
+    calibration, cal_name = calibration_of(args.calibration, profile)
+    params = replace(params, calibration=calibration)
+    capture, frames = capture_of(args, profile, "process")
     t0 = time.perf_counter()
     clouds, per_frame, clipped = [], [], []
     cube = None
@@ -143,13 +176,14 @@ def cmd_process(args: argparse.Namespace) -> int:
                                              has_vertical_extent(cfg.virtual_positions_hw))
     doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
+                "calibration": cal_name,
                 "max_speed_mps": params.max_speed_mps,
                 "min_detection_range_m": cfg.min_detection_range_m,
                 "frame_info": per_frame})
     doc.update(stop_fields(stopped, len(frames)))
     out.write_text(json.dumps(doc, indent=1))
     print(f"{len(cloud)} points in {done} frame(s) of {args.capture} "
-          f"({time.perf_counter() - t0:.2f} s) -> {out}")
+          f"({time.perf_counter() - t0:.2f} s, calibration: {cal_name}) -> {out}")
     code = stop_exit(stopped, done, len(frames), out, "process")
     if code is not None:
         return code
@@ -174,6 +208,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     p.add_argument("--remove-static", action="store_true",
                    help="subtract each range bin's mean over the frame's chirps, per channel, "
                         "before the Doppler FFT (static clutter and TX-RX leakage)")
+    p.add_argument("--calibration", default=None, metavar="CAL.json",
+                   help="calibration file (`radar calibrate`) applied before the angle "
+                        "estimation (default: the TI .cfg's compRangeBiasAndRxChanPhase if "
+                        "it has one, else none)")
     p.add_argument("--backend", default="float",
                    help="frame source: float, the float64 reference of the chain (the only "
                         "one for now: model and rtl process presets in `radar detect`)")
@@ -181,6 +219,5 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="folder for the last frame's range-Doppler map with its detections, "
                         "range-azimuth map and x-y point cloud")
     add_mcap_options(p)
-    add_detection_options(p, max_speed_default="the profile's max_speed_mps: its unambiguous "
-                                              "speed unless it says; 100 for the presets")
+    add_detection_options(p)
     p.set_defaults(func=cmd_process)

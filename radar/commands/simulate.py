@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Iterator
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,36 +13,23 @@ from host.adc_capture import write_npy
 from host.dca1000 import write_dca1000
 from host.params import default_max_speed_mps
 from model.observability import scene_report
-from model.profile import Profile, load_profile, preset_profile
 from model.simulate import MAX_FRAME_INDEX, check_frame_index, simulate_scene
-from radar.common import CliError, add_command, count, out_file, scene_of, warn
+from radar.common import (
+    CliError,
+    add_command,
+    add_radar_option,
+    count,
+    out_file,
+    scene_profile,
+    warn,
+)
 
 OUT_SUFFIXES = (".npy", ".bin")
 """What ``--out`` may write: a .npy array or a DCA1000 .bin capture."""
 
 
-def _profile(args: argparse.Namespace) -> Profile | None:
-    """The profile of ``--radar`` (None: the scene's preset); CliError (one line) if bad."""
-    if args.radar is None:
-        return None
-    if args.preset is not None:
-        raise CliError("--radar and --preset: give one of them")
-    try:
-        return load_profile(args.radar)
-    except ValueError as exc:
-        raise CliError(str(exc)) from None
-
-
 def cmd_simulate(args: argparse.Namespace) -> int:
-    profile = _profile(args)
-    scene = scene_of(args)
-    if profile is not None:
-        try:
-            scene = replace(scene, radar=profile.config)
-        except ValueError as exc:       # impairments the radar cannot have
-            raise CliError(str(exc)) from None
-    else:
-        profile = preset_profile(scene.preset)
+    scene, profile = scene_profile(args)
     cfg = scene.config
     if Path(args.out).suffix not in OUT_SUFFIXES:
         raise CliError(f"--out: {args.out} must end in {' or '.join(OUT_SUFFIXES)}")
@@ -110,9 +96,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                    help="output .npy (ADC frames) or .bin (DCA1000 capture)")
     s.add_argument("--preset", choices=presets, default=None,
                    help="override the scene's radar preset")
-    s.add_argument("--radar", default=None, metavar="PROFILE",
-                   help="simulate this radar instead of the scene's preset: a preset name, a "
-                        "TOML profile or a TI .cfg (docs/profiles.md)")
+    add_radar_option(s, "the scene's preset")
     s.add_argument("--frame", type=int, default=0,
                    help=f"frame index 0..{MAX_FRAME_INDEX} (the first, with --frames): targets "
                         f"move v*frame*frame_period, fresh noise (default 0)")

@@ -2,8 +2,8 @@
 capture or a scene.
 
     radar view --replay FILE.dmacap [--fps 20] [--loss P]   a capture, looped
-    radar view --udp-port P [--preset P]                    what `radar replay`/the board sends
-    radar view --scene table1 [--preset paper-fpga]          simulated frames
+    radar view --udp-port P [--preset P | --radar PROFILE]  what `radar replay`/the board sends
+    radar view --scene table1 [--preset P | --radar PROFILE] simulated frames
     ... [--host 127.0.0.1] [--port 8050] [--gnn] [--foxglove [PORT]]
 
 The stream is the radar cube or, with on-chip detection (``OUTPUT_MODE = 1``), the
@@ -33,19 +33,22 @@ from host.receiver import CUBE, RECORDS
 from host.udp import UdpReceiver
 from model.config import PRESETS, RadarConfig, get_preset
 from model.radar_pipeline import PipelineParams
-from model.scene import load_scene
 from model.simulate import simulate_scene
 from radar import common
 from radar.commands.detect import add_fpga_options, detect_config_of
 from radar.common import (
     CliError,
     add_detection_options,
+    add_radar_option,
     check,
+    check_source,
     count,
     detection_params,
     ego_speed_mps,
     port,
+    radar_of,
     refuse,
+    scene_of,
 )
 from radar.sources import get_source
 from radar.view.feed import Feed
@@ -87,7 +90,8 @@ def preset_of_capture(path: Path) -> RadarConfig:
         cfg = get_preset(name)
         if info.matches(cfg):
             return cfg
-    raise ValueError(f"{path}: no preset has the capture's geometry {info}")
+    raise ValueError(f"{path}: no preset has the capture's geometry {info} (a radar "
+                     f"profile's capture: give its --radar)")
 
 
 def _kind_of_replay(args: argparse.Namespace, path: Path) -> str:
@@ -148,33 +152,39 @@ def build(args: argparse.Namespace, stop: threading.Event
         count(args.packet_words, "--packet-words", 65535, lo=2)
     kind: str | None = {"host": CUBE, "fpga": RECORDS, None: None}[args.detect]
     detect_config = detect_config_of(args)
+    fixed = None if args.scene else radar_of(args)  # a stream's radar, if given
+    if args.radar and fixed is not None:            # a stream the FPGA chain sends
+        check_source(get_source("model"), fixed, f"--radar {args.radar}", None)
     try:
         if args.replay:
             path = Path(args.replay)
             kind = _kind_of_replay(args, path)
-            cfg = get_preset(args.preset) if args.preset else preset_of_capture(path)
+            cfg = fixed or preset_of_capture(path)
             frame_words = detect_config(cfg).frame_words if kind == RECORDS else None
             packet_words, frames = load_replay(path, cfg, frame_words)
             desc = f"replay {path.name}" + (" (records)" if kind == RECORDS else "")
         elif args.scene:
-            scene = load_scene(args.scene, args.preset)
+            scene = scene_of(args)
             cfg = scene.config
             desc = f"scene {scene.name}" + (" (on-chip detection)" if kind == RECORDS else "")
             kind = kind or CUBE
+            check_source(get_source(args.backend or ("float" if kind == CUBE else "model")),
+                         cfg, alternative="--backend float" if kind == CUBE else None)
             if kind == RECORDS:
                 detect_config(cfg)  # the detector options fit the preset
         else:
-            cfg = get_preset(args.preset or "full")
+            cfg = fixed or get_preset("full")
             packet_words = args.packet_words
             desc = f"UDP {args.udp_host}:{args.udp_port}"
             if kind == RECORDS:
-                for c in [cfg] if args.preset else PRESETS.values():
+                for c in [cfg] if fixed else PRESETS.values():
                     detect_config(c)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from None
     # --ego-speed (checked), else the scene's (Table I: 100 km/h); a capture or a link: 0
     ego = ego_speed_mps(args, scene if args.scene else None)
-    processor = Processor(cfg, feed, health, detection_params(args), _gnn(args), ego, source=desc)
+    processor = Processor(cfg, feed, health, detection_params(args, cfg=cfg), _gnn(args), ego,
+                          source=desc)
     threads = [threading.Thread(target=processor.run, args=(stop,), name="view-process",
                                 daemon=True)]
     if args.frames < 1:
@@ -204,8 +214,8 @@ def build(args: argparse.Namespace, stop: threading.Event
                   True, args.loss, args.seed)))
         return feed, health, threads, desc
     try:
-        # a UDP stream without --preset: the preset is learnt from the packet headers too
-        learn = None if args.replay or args.preset else list(PRESETS.values())
+        # a UDP stream without --preset/--radar: the preset is learnt from the packet headers
+        learn = None if args.replay or fixed else list(PRESETS.values())
         ingest = packet_ingest(cfg, packet_words, health, processor, configs=learn,
                                kind=kind, detect_config=detect_config)
     except ValueError as exc:
@@ -299,6 +309,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     v.add_argument("--preset", choices=presets, default=None,
                    help="radar preset (default: the capture's geometry, the scene's preset, "
                         "or for UDP learnt from the packet headers)")
+    add_radar_option(v, "a preset (a capture's or stream's: one the FPGA chain runs)")
     v.add_argument("--packet-words", type=int, default=None,
                    help="PACKET_WORDS of a UDP stream (default: learnt from the packet "
                         "headers, as radar receive does)")

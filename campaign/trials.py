@@ -1,0 +1,232 @@
+"""Trial functions of the campaigns (``campaign.runner``): each takes (params, trial
+indices, campaign seed, group) and returns counts and sums that add up across tasks.
+Trial ``i`` draws from ``numpy.random.default_rng([seed, group, i])``.
+
+- ``detection``: one synthetic range-Doppler map per trial (``campaign.maps``), every
+  detector of :data:`DETECTORS` at every Pfa of ``params["pfas"]``; counts of detections at
+  the target cells (Pd) or, for a noise-only map (``cell_snr_db`` None), over all cells
+  (Pfa).
+- ``estimation``: one target per trial in the float chain's cells around it (and those cells
+  rounded to the FPGA's integer LSB); squared errors of range, radial velocity and azimuth
+  from the host's estimators.
+- ``resolution``: two equal targets in one cell, ``sep_bw`` beamwidths apart; how often the
+  host's angle estimator resolves them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from campaign import maps
+from host.angle import AngleParams, estimate_angles
+from host.cells import neighbour_offsets
+from host.cfar import CfarParams, cfar_threshold
+from model import cfar_2d
+from model.config import PRESETS, RadarConfig
+from model.detect_chain import DetectConfig
+from model.radar_pipeline import PipelineParams, chain_gain
+
+DETECTORS = (("host", "ca"), ("host", "os"), ("fpga", "ca"), ("fpga", "go"), ("fpga", "so"))
+"""(path, kind) of every detector the detection curves run: the host CFAR
+(``host.cfar``: CA and OS) and the FPGA detector's bit-accurate model (``model.cfar_2d``:
+CA, GO, SO)."""
+GUARD, TRAIN = (2, 2), (4, 8)
+"""The CFAR window of the curves: the host's and the FPGA's default, cells per side."""
+PRESET = "full"
+"""The radar whose FFT sizes, channel count and FPGA noise level the curves use."""
+
+TrialFn = Callable[[dict[str, Any], range, int, int], dict[str, Any]]
+
+
+def rng_of(seed: int, group: int, trial: int) -> np.random.Generator:
+    """The random generator of one trial."""
+    return np.random.default_rng([seed, group, trial])
+
+
+def fpga_noise_lsb(cfg: RadarConfig) -> float:
+    """RMS noise per channel of a Hann-windowed cell at the FPGA detector's input, LSB:
+    the ADC noise through both 1/N-scaled windowed FFTs (3/8 of the power per axis, over
+    N) and the fixed-point chain's gain (``model.radar_pipeline.chain_gain``)."""
+    power = (cfg.noise_power_lsb2 * maps.HANN_NOISE_GAIN ** 2 / (cfg.n_range * cfg.n_doppler)
+             * chain_gain(cfg, PipelineParams()) ** 2)
+    return float(np.sqrt(power))
+
+
+@lru_cache(maxsize=64)
+def fpga_cfar(shape: tuple[int, int], kind: str, pfa: float, n_channels: int
+          ) -> tuple[cfar_2d.Cfar2dConfig, np.ndarray]:
+    """The FPGA CFAR configuration and scale table for a map of ``shape``."""
+    num_tx = 4 if n_channels % 4 == 0 else 1
+    d = DetectConfig(num_tx=num_tx, num_rx=n_channels // num_tx, n_range=shape[0],
+                     n_doppler=shape[1], guard=GUARD, train=TRAIN, kind=kind, pfa=pfa)
+    return d.cfar, d.scale()
+
+
+def detect_all(cube: np.ndarray, pfas: list[float], fpga_lsb: float
+               ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(detections bool, threshold float) maps (n_range, n_doppler) of every (detector, Pfa),
+    detector-major (:data:`DETECTORS`, then ``pfas``), for a cube complex (L, n_range,
+    n_doppler) with unit noise per channel and cell. The FPGA model gets the cube in LSB
+    (noise ``fpga_lsb`` RMS per channel), I and Q rounded to integers, integrated exactly;
+    its threshold (in LSB^2: the cell detects when its power exceeds it) is the training sum
+    times the row's scale over 2^scale_frac (every row may detect here)."""
+    n_channels, shape = cube.shape[0], cube.shape[1:]
+    nci = np.sum(cube.real ** 2 + cube.imag ** 2, axis=0)
+    q = cube * fpga_lsb
+    power = np.sum(np.rint(q.real).astype(np.int64) ** 2 + np.rint(q.imag).astype(np.int64)
+                   ** 2, axis=0)
+    out = []
+    for path, kind in DETECTORS:
+        for pfa in pfas:
+            if path == "host":
+                thr, _ = cfar_threshold(nci, n_channels, CfarParams(
+                    pfa=pfa, guard=GUARD, train=TRAIN, kind=kind), (True, True))
+                out.append((nci > thr, thr))
+            else:
+                cfg, scale = fpga_cfar(tuple(shape), kind, pfa, n_channels)
+                cells = cfar_2d.cfar_2d(power, cfg, scale)
+                row_scale = np.array([scale[cfar_2d.edge_index(r, cfg)]
+                                      for r in range(shape[0])], float)
+                thr = cells.train_sum * row_scale[:, None] / (1 << cfg.scale_frac)
+                out.append((cells.detect, thr))
+    return out
+
+
+def detection(params: dict[str, Any], trials: range, seed: int, group: int
+              ) -> dict[str, Any]:
+    """params: ``swerling`` 0/1, ``cell_snr_db`` (None: noise only), ``pfas`` list,
+    ``shape`` [n_range, n_doppler] of the maps. Returns ``cells`` (tested cells) and
+    ``hits`` (detections per (detector, Pfa), :func:`detect_all` order); for noise-only maps
+    also ``pfa_sum``: the sum over the cells of P(X > the cell's threshold) for X the cell
+    under test's noise-only statistic, independent of its training cells (conditional Monte
+    Carlo: its mean is the Pfa, with far less spread than counting false alarms). X is
+    Gamma(L, 1) for the host; for the FPGA, Gamma(L, noise) with noise = fpga_lsb^2 + 1/6
+    LSB^2 per channel (the rounding's mean; an approximation of the rounded values' sum)."""
+    cfg = PRESETS[PRESET]
+    shape = tuple(params["shape"])
+    snr_db = params["cell_snr_db"]
+    targets = maps.target_grid(shape, (GUARD[0] + TRAIN[0], GUARD[1] + TRAIN[1]))
+    hits = np.zeros(len(DETECTORS) * len(params["pfas"]), np.int64)
+    pfa_sum = np.zeros(len(hits))
+    cells = 0
+    lsb = fpga_noise_lsb(cfg)
+    for t in trials:
+        rng = rng_of(seed, group, t)
+        snr = 0.0 if snr_db is None else 10 ** (snr_db / 10)
+        cube = maps.detection_map(rng, cfg.n_virtual, shape, targets, snr, params["swerling"])
+        dets = detect_all(cube, params["pfas"], lsb)
+        if snr_db is None:
+            hits += [int(d.sum()) for d, _ in dets]
+            cells += shape[0] * shape[1]
+            paths = [path for path, _ in DETECTORS for _ in params["pfas"]]
+            for i, ((_, thr), path) in enumerate(zip(dets, paths, strict=True)):
+                theta = 1.0 if path == "host" else lsb ** 2 + 1 / 6
+                pfa_sum[i] += float(np.sum(stats.gamma.sf(thr, cfg.n_virtual, scale=theta)))
+        else:
+            hits += [int(d[targets[:, 0], targets[:, 1]].sum()) for d, _ in dets]
+            cells += len(targets)
+    out = {"cells": cells, "hits": hits.tolist()}
+    if snr_db is None:
+        out["pfa_sum"] = pfa_sum.tolist()
+    return out
+
+
+def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(range bins, Doppler bins, sin(az)) estimated from cells complex (n, L, 2 half + 1,
+    2 half + 1) around each target (noise power ``noise`` per channel and cell): the cell of
+    the integrated map's maximum among the 3 x 3 around the centre, the host's Gaussian
+    interpolation (``host.cells``) and angle estimator (``host.angle``, strongest component);
+    bins relative to the centre cell."""
+    n = len(cube)
+    nci = np.sum(cube.real ** 2 + cube.imag ** 2, axis=1)
+    centre = nci[:, half - 1:half + 2, half - 1:half + 2].reshape(n, 9).argmax(axis=1)
+    pr, pd = centre // 3 + half - 1, centre % 3 + half - 1
+    idx = np.arange(n)
+    logp = np.log(np.maximum(nci, 1e-300))
+    nb = np.stack([logp[idx, pr - 1, pd], logp[idx, pr + 1, pd], logp[idx, pr, pd - 1],
+                   logp[idx, pr, pd + 1]], axis=1)
+    off = neighbour_offsets(logp[idx, pr, pd], nb, np.ones(n, bool))
+    got = estimate_angles(cube[idx, :, pr, pd], np.full(n, noise), AngleParams())
+    first = np.searchsorted(got.cell, idx)                 # strongest component of each row
+    return pr - half + off[:, 0], pd - half + off[:, 1], got.sin_az[first]
+
+
+def estimation(params: dict[str, Any], trials: range, seed: int, group: int
+               ) -> dict[str, Any]:
+    """params: ``snr_db`` per-channel per-sample SNR, ``azimuth_deg``, ``chains`` (a list
+    of ``float``, ``quantised``). One target per trial at a random sub-bin position (and
+    azimuth within half a beamwidth of ``azimuth_deg``), estimated by :func:`_estimate` from
+    the float chain's cells and, for ``quantised``, from the same cells in the FPGA's LSB
+    (:func:`fpga_noise_lsb`) with I and Q rounded to integers. Returns ``trials`` and per
+    chain the sums of squared errors ``<chain>:se_range_m``, ``<chain>:se_velocity_mps``,
+    ``<chain>:se_azimuth_deg``."""
+    cfg = PRESETS[PRESET]
+    n = len(trials)
+    rngs = [rng_of(seed, group, t) for t in trials]
+    draws = np.array([r.random(4) for r in rngs])                       # (n, 4)
+    offsets = draws[:, :2] - 0.5
+    bw = cfg.angle_resolution_rad
+    sin_az = np.sin(np.radians(params["azimuth_deg"]) + (draws[:, 2] - 0.5) * bw)
+    half = 2
+    cube = np.concatenate([maps.tone_patch(r, cfg.n_range, cfg.n_doppler, cfg.n_virtual,
+                                           10 ** (params["snr_db"] / 10), offsets[i:i + 1],
+                                           sin_az[i:i + 1], half)
+                           for i, r in enumerate(rngs)])               # (n, L, 5, 5)
+    noise = maps.patch_noise_per_channel(cfg.n_range, cfg.n_doppler)
+    out: dict[str, Any] = {"trials": n}
+    for chain in params["chains"]:
+        if chain == "float":
+            est = _estimate(cube, noise, half, cfg)
+        else:
+            lsb = fpga_noise_lsb(cfg)
+            q = cube * (lsb / np.sqrt(noise))
+            est = _estimate(np.rint(q.real) + 1j * np.rint(q.imag), lsb ** 2 + 1 / 6, half,
+                            cfg)
+        az = np.degrees(np.arcsin(np.clip(est[2], -1.0, 1.0)))
+        out[f"{chain}:se_range_m"] = float(np.sum(((est[0] - offsets[:, 0])
+                                                   * cfg.range_bin_m) ** 2))
+        out[f"{chain}:se_velocity_mps"] = float(np.sum(((est[1] - offsets[:, 1])
+                                                        * cfg.velocity_bin_mps) ** 2))
+        out[f"{chain}:se_azimuth_deg"] = float(np.sum((az - np.degrees(np.arcsin(sin_az)))
+                                                      ** 2))
+    return out
+
+
+def resolution(params: dict[str, Any], trials: range, seed: int, group: int
+               ) -> dict[str, Any]:
+    """params: ``sep_bw`` separation in beamwidths (2 / n_channels in sin(az)),
+    ``cell_snr_db`` per-channel SNR of each target in the cell. Resolved: the estimator
+    returns two or more components and the two strongest are each within half the
+    separation of a different target. Returns ``trials`` and ``resolved``."""
+    n_ch = PRESETS[PRESET].n_virtual
+    sep = params["sep_bw"] * 2.0 / n_ch
+    amp = np.sqrt(10 ** (params["cell_snr_db"] / 10))
+    v = np.arange(n_ch)
+    rows, truth = [], []
+    for t in trials:
+        rng = rng_of(seed, group, t)
+        s0 = rng.uniform(-0.3, 0.3)
+        s = np.array([s0 - sep / 2, s0 + sep / 2])
+        ph = np.exp(2j * np.pi * rng.random(2))
+        x = (amp * ph[:, None] * np.exp(-1j * np.pi * np.outer(s, v))).sum(axis=0)
+        rows.append(x + maps.complex_normal(rng, (n_ch,)))
+        truth.append(s)
+    got = estimate_angles(np.array(rows), np.ones(len(rows)), AngleParams())
+    resolved = 0
+    for i, s in enumerate(truth):
+        est = got.sin_az[got.cell == i][:2]
+        if len(est) == 2:
+            est = np.sort(est)
+            resolved += int(np.all(np.abs(est - s) < sep / 2))
+    return {"trials": len(truth), "resolved": resolved}
+
+
+TRIALS: dict[str, TrialFn] = {"detection": detection, "estimation": estimation,
+                              "resolution": resolution}
+"""Trial functions by the name a :class:`campaign.runner.Task` gives."""
