@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
-from dataclasses import fields
+from dataclasses import MISSING, fields
 from pathlib import Path
 
 import numpy as np
@@ -96,7 +96,8 @@ def load_frames(path: Path) -> tuple[list[Frame], dict[str, str]]:
         z = np.load(path)
         po, bo = z["point_offsets"], z["box_offsets"]
         meta = dict(zip(z["meta_keys"].tolist(), z["meta_values"].tolist(), strict=True))
-        pc = {fl.name: z[f"pc_{fl.name}"] for fl in fields(PointCloud)}
+        pc = {fl.name: z[f"pc_{fl.name}"] for fl in fields(PointCloud)
+              if fl.default is MISSING or f"pc_{fl.name}" in z.files}  # older files: no z
         pcls, pobj, boxes, bcls, ego = (z[k] for k in ("point_class", "point_object", "boxes",
                                                        "box_class", "ego_speed"))
     except (KeyError, OSError, ValueError, EOFError) as exc:

@@ -4,7 +4,8 @@ the screen for a second one, and RELAX on the rows that hold several.
 - :func:`first_components`: each row's TDM-compensated vector, the amplitude and power of
   its first component at a given sin(az), and the Cauchy-Schwarz screen: the residual r
   after the first component can hold a second one only if |s^H r / n|^2 <= ||r||^2 / n
-  (|s_v| = 1) passes both gates of ``host.angle.AngleParams``.
+  (|s_v| = 1) passes the three gates of ``host.angle.AngleParams`` (SNR, dynamic range,
+  model order: ``host.angle`` module docstring).
 - :func:`steering_rows`: exp(-j pi v s) per row, from two sines and cosines per row.
 - :func:`relax_rows`: RELAX-style sequential estimation (``host.angle`` module docstring),
   every pass's batch of rows through the peak search of ``host._angle_peaks``.
@@ -79,10 +80,11 @@ def steering_rows(s: np.ndarray, n: int) -> np.ndarray:
 
 @njit(fastmath=True)
 def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.ndarray,
-                      snr_lin: float, dyn_lin: float, screen: bool, out: np.ndarray,
-                      a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray) -> None:
-    """:func:`first_components` (x, ph, out complex128; snr_lin, dyn_lin: the gates as
-    power ratios)."""
+                      snr_lin: float, dyn_lin: float, err_lin: float, screen: bool,
+                      out: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray
+                      ) -> None:
+    """:func:`first_components` (x, ph, out complex128; snr_lin, dyn_lin, err_lin: the
+    gates as power ratios)."""
     n_rows, nv = x.shape
     ntx = ph.shape[1]
     nrx = nv // ntx
@@ -122,13 +124,14 @@ def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.n
                 e += rr * rr + ri * ri
             bound = e * (1.0 + 1e-9) / nv
             maybe[i] = (bound * nv >= snr_lin * noise[i]) and (
-                p1[i] <= dyn_lin * max(bound, 1e-300))
+                p1[i] <= dyn_lin * max(bound, 1e-300)) and (
+                bound >= noise[i] + err_lin * p1[i])
 
 
 
 def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
                      noise_per_channel: np.ndarray, min_snr_db: float,
-                     dynamic_range_db: float, screen: bool = True
+                     dynamic_range_db: float, array_error_db: float, screen: bool = True
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The first angle component of each TDM-compensated snapshot and the screen for a
     second (module docstring):
@@ -137,8 +140,9 @@ def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
 
     x: complex (n, num_tx * num_rx); phasors: complex (n, num_tx) per TX
     (``host.tdm.tx_phasors``); first_sin: float (n,) sin(az) of the row's peak;
-    noise_per_channel: float (n,) (clamped to >= 1e-30 as there); ``screen`` False: no
-    second-component screen (``maybe`` all False)."""
+    noise_per_channel: float (n,) (clamped to >= 1e-30 as there); min_snr_db,
+    dynamic_range_db, array_error_db: the gates of ``host.angle.AngleParams``; ``screen``
+    False: no second-component screen (``maybe`` all False)."""
     n = len(x)
     if x.ndim != 2 or phasors.shape[0] != n or x.shape[1] % max(phasors.shape[1], 1):
         raise ValueError(f"first_components: snapshots {x.shape}, phasors {phasors.shape}")
@@ -149,7 +153,7 @@ def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
         _first_components(_c128(x), _c128(phasors),
                           np.ascontiguousarray(first_sin, dtype=float),
                           noise, 10 ** (min_snr_db / 10), 10 ** (dynamic_range_db / 10),
-                          screen, out, a1, p1, maybe)
+                          10 ** (array_error_db / 10), screen, out, a1, p1, maybe)
     return out, a1, p1, maybe
 
 
@@ -173,12 +177,13 @@ def _project(s: float, row: np.ndarray, str_: np.ndarray, sti: np.ndarray, lor: 
 
 @njit(fastmath=True, error_model="numpy")
 def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
-           dyn_db: float, n_fft: int, second_lobe: float, wr: np.ndarray, wi: np.ndarray,
-           rank: np.ndarray, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
+           dyn_db: float, err_lin: float, n_fft: int, second_lobe: float, wr: np.ndarray,
+           wi: np.ndarray, rank: np.ndarray, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
            os_: np.ndarray, s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray) -> None:
     """:func:`relax_rows` into s_c, a_c, count (float, complex (m, k), int (m,); zeros
     in): RELAX's passes, the peak search of each batch of
-    live rows by :func:`_class_peaks` (unit phasors), steering by :func:`_steer_row`."""
+    live rows by :func:`_class_peaks` (unit phasors), steering by :func:`_steer_row`;
+    err_lin: the array-error floor as a power ratio."""
     m, n = xs.shape
     kmax = s_c.shape[1]
     b0 = int(math.ceil(math.sqrt(n)))
@@ -212,6 +217,11 @@ def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
             if t:
                 snr_db = 10 * np.log10(power * n / noise[i])
                 if snr_db < min_snr_db or 10 * np.log10(first[i] / power) > dyn_db:
+                    continue
+                held = 0.0                  # the model order: beyond noise and array error
+                for q in range(t):
+                    held += a_c[i, q].real ** 2 + a_c[i, q].imag ** 2
+                if power < noise[i] + err_lin * held:
                     continue
             s_c[i, t] = s
             a_c[i, t] = a
@@ -252,12 +262,14 @@ def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
 
 
 def relax_rows(x: np.ndarray, noise: np.ndarray, n_fft: int, max_targets: int,
-               refine_iterations: int, min_snr_db: float, dynamic_range_db: float
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               refine_iterations: int, min_snr_db: float, dynamic_range_db: float,
+               array_error_db: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """RELAX on the rows of x, complex (m, n) (TDM-compensated), noise float (m,) per
     channel (>= 1e-30): components found strongest first, each further one while its
-    coherent SNR reaches ``min_snr_db`` and it is within ``dynamic_range_db`` of the first,
-    every component re-estimated ``refine_iterations`` times with the others removed
+    coherent SNR reaches ``min_snr_db``, it is within ``dynamic_range_db`` of the first and
+    its power |a|^2 reaches noise + 10^(array_error_db / 10) sum |a_j|^2 over the components
+    held (the model-order test, ``host.angle`` module docstring), every component
+    re-estimated ``refine_iterations`` times with the others removed
     (``host.angle.AngleParams``). Returns (sin(az) float (m, max_targets), amplitude complex
     (m, max_targets), count int (m,): the first count slots of each row are valid)."""
     xs = _c128(x)
@@ -273,8 +285,8 @@ def relax_rows(x: np.ndarray, noise: np.ndarray, n_fft: int, max_targets: int,
     if m:
         wr, wi, rank, dmr, dmi, oc, os_ = _tables(n, n_fft)
         _relax(xs, np.ascontiguousarray(noise, dtype=float), refine_iterations, min_snr_db,
-               dynamic_range_db, n_fft, SECOND_LOBE, wr, wi, rank, dmr, dmi, oc, os_, s_c,
-               a_c, count)
+               dynamic_range_db, 10 ** (array_error_db / 10), n_fft, SECOND_LOBE, wr, wi, rank,
+               dmr, dmi, oc, os_, s_c, a_c, count)
     return s_c, a_c, count
 
 
@@ -283,4 +295,4 @@ def _warm_up() -> None:
     """RELAX and the steering rows (reached only by cells with several targets) on one row:
     the argument types of ``host.angle`` and its default ``AngleParams``."""
     steering_rows(np.zeros(1), 8)
-    relax_rows(np.zeros((1, 8), np.complex128), np.ones(1), 1024, 3, 2, 12.0, 20.0)
+    relax_rows(np.zeros((1, 8), np.complex128), np.ones(1), 1024, 3, 2, 12.0, 20.0, -10.0)

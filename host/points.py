@@ -6,9 +6,12 @@ FPGA's records (``host.record_points``) take (``host.pipeline`` module docstring
    for each alias class that holds one of its velocity hypotheses (``host.angle.
    peak_powers``), then the decision of every cell (``host.tdm.choose_folds``).
 2. Angles (``host.angle.estimate_angles``) of each cell's vector compensated for its chosen
-   alias order; the chosen class's peak is the first component's.
+   alias order; the chosen class's peak is the first component's. The contiguous lambda/2
+   ULA (``RadarConfig.uniform_linear_array``) takes the angle FFT's fast path, any other
+   virtual array the steering vectors of its positions (azimuth, and elevation where it
+   has vertical extent).
 3. One point per angle component (:func:`cloud`): range corrected for range-Doppler
-   coupling, x/y, velocity, power, coherent SNR and an RCS estimate from the radar equation
+   coupling, x/y/z, velocity, power, coherent SNR and an RCS estimate from the radar equation
    with the window's scalloping and coherent gain undone.
 """
 
@@ -44,26 +47,31 @@ def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
     sb = signed_bins(nd)[np.asarray(cells.doppler_bin)].astype(np.int64)
     snr_db = cell_snr_db(np.asarray(cells.power, dtype=float), noise, nv)
     measured = (sb + cells.offsets[:, 1]) * cfg.velocity_bin_mps
+    positions = None if cfg.uniform_linear_array else cfg.virtual_positions_hw
     first_sin = None
     if ntx > 1 and params.unfold_velocity:
         # (cell, class) pairs of the classes that hold a hypothesis: only these enter the
         # decision; the others' power stays 0 (choose_folds masks them)
         ci, cc = np.nonzero(hypothesis_classes(cfg, measured, params.max_speed_mps))
-        pw, sn = peak_powers(x, params.angle.n_fft, tx_phasors(cfg, sb[ci] + cc * nd), ci)
+        pw, sn = peak_powers(x, params.angle.n_fft, tx_phasors(cfg, sb[ci] + cc * nd), ci,
+                             positions)
         class_power = np.zeros((n, ntx))
         class_power[ci, cc] = pw
         pair = np.full((n, ntx), -1, np.int64)
         pair[ci, cc] = np.arange(len(ci))
         fold, ambiguous = choose_folds(class_power, cfg, measured, snr_db, params)
-        # the fold's class always holds a hypothesis: its peak was computed
-        first_sin = sn[pair[np.arange(n), fold % ntx]]
+        # the fold's class always holds a hypothesis: its peak was computed (the ULA's
+        # sin(az) is the first component's)
+        if positions is None:
+            first_sin = sn[pair[np.arange(n), fold % ntx]]
     else:
         fold, ambiguous = choose_folds(np.zeros((n, 0)), cfg, measured, snr_db, params)
     k = sb + fold * nd
-    ang = estimate_angles(x, noise / nv, params.angle, tx_phasors(cfg, k), first_sin)
+    ang = estimate_angles(x, noise / nv, params.angle, tx_phasors(cfg, k), first_sin,
+                          positions)
     return cloud(cfg, params, np.asarray(cells.range_bin), cells.offsets, k, ambiguous,
                  ang.cell, ang.azimuth_deg, ang.amplitude, ang.snr_db, frame,
-                 cells.range_bias_m)
+                 ang.elevation_deg, cells.range_bias_m)
 
 
 def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndarray:
@@ -77,7 +85,8 @@ def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndar
 
 def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.ndarray,
           k: np.ndarray, ambiguous: np.ndarray, cell: np.ndarray, az: np.ndarray,
-          amplitude: np.ndarray, snr_db: np.ndarray, frame: int, range_bias_m: float = 0.0
+          amplitude: np.ndarray, snr_db: np.ndarray, frame: int,
+          elevation_deg: np.ndarray | float = 0.0, range_bias_m: float = 0.0
           ) -> PointCloud:
     """Step 3 of the module docstring, one point per angle component: range (Doppler
     coupling removed), velocity of the unfolded bin ``k``, power and RCS (window
@@ -85,8 +94,8 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
 
     Per cell (n,): r range bin, k unfolded signed Doppler bin, ambiguous flag; offsets
     float (n, 2) bins. Per component (m,): ``cell`` its cell index, ``az`` deg,
-    ``amplitude`` complex (LSB), ``snr_db``; ``range_bias_m`` is subtracted from the
-    range (calibration)."""
+    ``amplitude`` complex (LSB), ``snr_db``, ``elevation_deg`` (or a scalar);
+    ``range_bias_m`` is subtracted from the range (calibration)."""
     nr, nd = cfg.n_range, cfg.n_doppler
     dr, dd = offsets[:, 0], offsets[:, 1]
     velocity = (k + dd) * cfg.velocity_bin_mps
@@ -102,7 +111,8 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
     rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
     return PointCloud.from_polar(
         range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr_db,
-        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame)
+        rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame,
+        elevation_deg=elevation_deg)
 
 
 def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:

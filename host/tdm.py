@@ -1,13 +1,15 @@
 """TDM-MIMO Doppler: the per-TX phase compensation of a cell's channel vector and the
 velocity-unfolding decision (``host.pipeline`` module docstring, step 3).
 
-With num_tx TX slots per chirp period, TX t transmits t slots after TX 0, so a target of
-signed Doppler bin k (cycles per n_doppler same-TX chirps) has advanced k t / (n_doppler
-num_tx) turns on TX t's channels: :func:`tx_phasors` undoes that. The measured Doppler fixes
-the velocity only modulo the alias period 2 vmax; the hypotheses are the alias orders m with
-|v + 2 m vmax| <= max_speed (:func:`alias_orders`). Compensation for the wrong order blurs
-the angle spectrum unless the orders differ by a multiple of num_tx: the alias *classes*
-c = m mod num_tx are told apart by the angle spectrum's peak power (:func:`choose_folds`).
+With num_tx chirp slots per loop, TX t transmits in slot q_t (``model.array.tx_slots``:
+the firing order ``cfg.tx_sequence``), q_t slots after the loop's first chirp, so a target
+of signed Doppler bin k (cycles per n_doppler same-TX chirps) has advanced k q_t /
+(n_doppler num_tx) turns on TX t's channels: :func:`tx_phasors` undoes that. The measured
+Doppler fixes the velocity only modulo the alias period 2 vmax; the hypotheses are the alias
+orders m with |v + 2 m vmax| <= max_speed (:func:`alias_orders`). Compensation for the
+wrong order blurs the angle spectrum unless the orders differ by a multiple of num_tx: the
+alias *classes* c = m mod num_tx are told apart by the angle spectrum's peak power
+(:func:`choose_folds`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from typing import Protocol
 import numpy as np
 
 from host.kernels import njit
+from model.array import tx_slots
 from model.config import RadarConfig
 from model.reference import signed_bin
 
@@ -42,15 +45,15 @@ def _unit_circle(n: int) -> np.ndarray:
 def tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     """TDM compensation phasors per TX, complex (..., num_tx), for the *unfolded* signed
     Doppler bins k (any integers, int (...)): TX t's channels are multiplied by
-    exp(-2 pi j k t / (n_doppler num_tx)) (``model.reference.tdm_phase_compensation``'s
-    phase, one value per TX, looked up on the unit circle). The phase has period
-    num_tx n_doppler in k; k >= n_doppler / 2 is shifted by that period, not by n_doppler
-    (which would undo an unfolding by +1)."""
+    exp(-2 pi j k q_t / (n_doppler num_tx)), q_t its slot in the loop
+    (``model.reference.tdm_phase_compensation``'s phase, one value per TX, looked up on the
+    unit circle). The phase has period num_tx n_doppler in k; k >= n_doppler / 2 is
+    shifted by that period, not by n_doppler (which would undo an unfolding by +1)."""
     k = np.asarray(k)
     k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     k = signed_bin(k, cfg.n_doppler)
     n = cfg.n_doppler * cfg.num_tx
-    m = np.multiply.outer(k, np.arange(cfg.num_tx))
+    m = np.multiply.outer(k, tx_slots(cfg))
     return _unit_circle(n)[m & (n - 1) if n & (n - 1) == 0 else m % n]   # & : mod 2^b
 
 

@@ -52,6 +52,13 @@ def cartesian(range_m: np.ndarray, azimuth_rad: np.ndarray, elevation_rad: np.nd
     return r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), r * np.sin(el)
 
 
+def has_vertical_extent(positions_hw: np.ndarray) -> bool:
+    """Whether an array (positions float (n, 2), half-wavelengths) has elements at more than
+    one height, so that it measures elevation (a planar array's points have el = 0)."""
+    v = np.asarray(positions_hw, dtype=float)[:, 1]
+    return bool(v.size and np.ptp(v) > 0)
+
+
 def tx_slots(cfg: RadarConfig) -> np.ndarray:
     """Chirp slot (0..num_tx-1) of each TX index within a loop, int (num_tx,): the inverse
     permutation of ``cfg.tx_sequence``."""

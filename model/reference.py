@@ -202,13 +202,14 @@ def range_doppler_power(cube: np.ndarray) -> np.ndarray:
 def tdm_phase_compensation(cfg: RadarConfig, doppler_bin: np.ndarray | int) -> np.ndarray:
     """Phasors that undo the TDM slot delay, complex (..., n_virtual).
 
-    TX t fires t * Tc after TX 0 of the same slow-time sample, so a target in signed Doppler
-    bin k picks up exp(j 2 pi k t / (n_doppler * num_tx)) on TX t's channels; multiply by the
-    returned conjugate phasor. ``doppler_bin`` is the natural-order bin (converted to signed).
+    TX t fires in slot q = ``model.array.tx_slots(cfg)[t]`` of its loop, q * Tc after the
+    loop's first chirp, so a target in signed Doppler bin k picks up
+    exp(j 2 pi k q / (n_doppler * num_tx)) on TX t's channels; multiply by the returned
+    conjugate phasor. ``doppler_bin`` is the natural-order bin (converted to signed).
     """
     k = signed_bin(doppler_bin, cfg.n_doppler)
-    tx_of_v = np.arange(cfg.n_virtual) // cfg.num_rx
-    return np.exp(-2j * np.pi * np.multiply.outer(k, tx_of_v) / (cfg.n_doppler * cfg.num_tx))
+    slot_of_v = tx_slots(cfg)[np.arange(cfg.n_virtual) // cfg.num_rx]
+    return np.exp(-2j * np.pi * np.multiply.outer(k, slot_of_v) / (cfg.n_doppler * cfg.num_tx))
 
 
 def angle_spectrum(channels: np.ndarray, n_fft: int = 256, window: bool = False

@@ -123,9 +123,9 @@ def test_kernel_inputs_are_checked() -> None:
         class_peaks(np.zeros((2, 64), complex), np.zeros(3, np.int64), np.ones((2, 4)), 1024)
     with pytest.raises(ValueError, match="phasors"):
         first_components(np.zeros((2, 64), complex), np.ones((2, 3)), np.zeros(2),
-                         np.ones(2), 12.0, 20.0)
+                         np.ones(2), 12.0, 20.0, -10.0)
     with pytest.raises(ValueError, match="exceed the coarse FFT"):
-        relax_rows(np.zeros((2, 64), complex), np.ones(2), 32, 3, 2, 12.0, 20.0)
+        relax_rows(np.zeros((2, 64), complex), np.ones(2), 32, 3, 2, 12.0, 20.0, -10.0)
     with pytest.raises(ValueError, match="at most 128"):
         estimate_angles(np.zeros((2, 256), complex), np.ones(2), AngleParams())
     with pytest.raises(ValueError, match="at most 128"):
@@ -152,14 +152,16 @@ def test_first_components_are_the_screened_ones() -> None:
     s1, _ = peak_sin_fast(xc, 1024)
     noise = rng.uniform(0.5, 2, n)
     p = AngleParams()
-    xs, a1, p1, maybe = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db)
+    xs, a1, p1, maybe = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db,
+                                         p.array_error_db)
     np.testing.assert_allclose(xs, xc, rtol=1e-12, atol=1e-9)
     want_a, want_p, want_maybe = first_component_screen(xc, noise, p, s1)
     np.testing.assert_allclose(a1, want_a, rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(p1, want_p, rtol=1e-9)
     np.testing.assert_array_equal(maybe, want_maybe)
     assert 0 < maybe.sum() < n
-    none = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db, screen=False)
+    none = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db,
+                            p.array_error_db, screen=False)
     assert not none[3].any()
     # and the components that follow: the numpy screened estimator's
     got = estimate_angles(x, noise, p, tx_phasors=ph, first_sin=s1)
@@ -193,7 +195,8 @@ def test_relax_rows_is_estimate_angles_rows(n: int) -> None:
     x[10:13] = 0.0
     noise = rng.uniform(0.5, 2.0, 200)
     for p in (AngleParams(), AngleParams(max_targets=2, refine_iterations=1, n_fft=256),
-              AngleParams(max_targets=4, refine_iterations=0, min_snr_db=6.0)):
+              AngleParams(max_targets=4, refine_iterations=0, min_snr_db=6.0,
+                          array_error_db=-np.inf)):
         for rows in (slice(None), slice(5, 6)):
             got = _relax(x[rows], noise[rows], p)
             want = estimate_angles_rows(x[rows], noise[rows], p, peaks=peak_sins,

@@ -117,10 +117,11 @@ def header(t_ns: int, frame_id: str = RADAR_FRAME) -> dict[str, Any]:
 
 
 def cloud_points(cloud: PointCloud) -> np.ndarray:
-    """The cloud's points as :data:`POINT_DTYPE` (n,): float fields as float32, azimuth in
-    rad, z and elevation 0 (the planar array measures no elevation)."""
+    """The cloud's points as :data:`POINT_DTYPE` (n,): float fields as float32, azimuth and
+    elevation in rad (z and elevation 0 from an array without vertical extent)."""
     pts = np.zeros(len(cloud), POINT_DTYPE)
-    pts["x"], pts["y"] = cloud.x_m, cloud.y_m
+    pts["x"], pts["y"], pts["z"] = cloud.x_m, cloud.y_m, cloud.z_m
+    pts["elevation"] = np.radians(cloud.elevation_deg)
     pts["doppler_velocity"] = cloud.radial_velocity_mps
     pts["intensity"], pts["snr"], pts["rcs"] = cloud.power_db, cloud.snr_db, cloud.rcs_dbsm
     pts["range"], pts["azimuth"] = cloud.range_m, np.radians(cloud.azimuth_deg)

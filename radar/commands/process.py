@@ -24,6 +24,7 @@ from host.dca1000 import Dca1000Capture
 from host.params import DetectionParams
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
+from model.array import has_vertical_extent
 from model.config import RadarConfig
 from model.profile import Calibration, Profile, load_profile
 from model.reference import radar_cube
@@ -190,7 +191,8 @@ def cmd_process(args: argparse.Namespace) -> int:
     warn_clipped(clipped, "process")
     done = len(per_frame)
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped,
+                                             has_vertical_extent(cfg.virtual_positions_hw))
     doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
                 "calibration": cal_name,

@@ -43,6 +43,16 @@ def steering(n: int, sin_az: float) -> np.ndarray:
     return np.exp(-1j * np.pi * np.arange(n) * sin_az)
 
 
+def beyond_model_error(power: np.ndarray | float, held: np.ndarray | float,
+                       noise: np.ndarray | float, params: AngleParams) -> np.ndarray:
+    """The model-order test (``host.angle`` module docstring): a further component of power
+    |a|^2 (``power``) is supported where it reaches noise + 10^(array_error_db / 10) times
+    ``held``, the power sum_j |a_j|^2 of the components already held (per channel, float
+    arrays or scalars); bool of the broadcast shape."""
+    return np.asarray(power) >= np.asarray(noise) + 10 ** (params.array_error_db / 10) * \
+        np.asarray(held)
+
+
 def peak_sin(x: np.ndarray, n_fft: int) -> tuple[float, float]:
     """Strongest peak of the angle spectrum of ``x`` (complex (n,)): (sin(az), |peak|^2),
     parabolic interpolation of the magnitude around the zero-padded FFT maximum."""
@@ -299,7 +309,8 @@ def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: A
         with np.errstate(divide="ignore"):
             snr2 = 10 * np.log10(p2 * n / noise)
             more = (snr2 >= params.min_snr_db) & (
-                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db) & \
+                beyond_model_error(p2, p1, noise, params)
     return _components(xs, noise, params, s1, a1, p1, more)
 
 
@@ -343,7 +354,8 @@ def first_component_screen(xs: np.ndarray, noise: np.ndarray, params: AngleParam
         bound *= (1.0 + 1e-9) / n
         with np.errstate(divide="ignore", invalid="ignore"):
             maybe = (10 * np.log10(bound * n / noise) >= params.min_snr_db) & (
-                10 * np.log10(p1 / np.maximum(bound, 1e-300)) <= params.dynamic_range_db)
+                10 * np.log10(p1 / np.maximum(bound, 1e-300)) <= params.dynamic_range_db) & \
+                beyond_model_error(bound, p1, noise, params)
     return a1, p1, maybe
 
 
@@ -374,7 +386,8 @@ def screened_components(xs: np.ndarray, noise: np.ndarray, params: AngleParams,
             snr2 = 10 * np.log10(p2 * n / noise[rows])
             more[rows] = (snr2 >= params.min_snr_db) & (
                 10 * np.log10(p1[rows] / np.maximum(p2, 1e-300))
-                <= params.dynamic_range_db)
+                <= params.dynamic_range_db) & beyond_model_error(p2, p1[rows], noise[rows],
+                                                                  params)
     return _components(xs, noise, params, s1, a1, p1, more, batched=True, peaks=peaks,
                        steer=steer, relax=relax)
 
@@ -404,7 +417,8 @@ def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: 
         with np.errstate(divide="ignore"):
             snr2 = 10 * np.log10(p2 * n / noise)
             more = (snr2 >= params.min_snr_db) & (
-                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db) & \
+                beyond_model_error(p2, p1, noise, params)
     snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
     out: list[list[AngleComponent]] = []
     for i in range(n_rows):
@@ -457,8 +471,10 @@ def estimate_angles_rows(x: np.ndarray, noise_per_channel: np.ndarray, params: A
             snr_db = 10 * np.log10(power * n / noise[live])
             stop = np.zeros(len(live), bool)
             if t:
+                held = np.sum(np.abs(a_c[live, :t]) ** 2, axis=1)
                 stop = (snr_db < params.min_snr_db) | (
-                    10 * np.log10(first[live] / power) > params.dynamic_range_db)
+                    10 * np.log10(first[live] / power) > params.dynamic_range_db) | \
+                    ~beyond_model_error(power, held, noise[live], params)
             keep = ~stop
             live, s, a, power = live[keep], s[keep], a[keep], power[keep]
             s_c[live, t], a_c[live, t], st_c[live, t] = s, a, st[keep]
@@ -498,7 +514,8 @@ def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
 
     ``noise_per_channel``: noise power per channel in the same units as |x|^2. Components are
     found strongest first; the first is always returned, each further one while its
-    coherent SNR reaches ``min_snr_db`` and it is within ``dynamic_range_db`` of the first.
+    coherent SNR reaches ``min_snr_db``, it is within ``dynamic_range_db`` of the first and
+    it passes the model-order test (:func:`beyond_model_error`) against those held.
     """
     n = x.shape[0]
     noise = max(noise_per_channel, 1e-30)
@@ -514,6 +531,9 @@ def estimate_angles(x: np.ndarray, noise_per_channel: float, params: AngleParams
             break
         if first_power is not None and 10 * np.log10(first_power / power) > \
                 params.dynamic_range_db:
+            break
+        if comps and not beyond_model_error(power, sum(abs(a_) ** 2 for _, a_ in comps),
+                                            noise, params):
             break
         comps.append((s, a))
         first_power = first_power or power
