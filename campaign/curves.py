@@ -24,6 +24,7 @@ from host.cfar import CfarParams, effective_cells
 from model import cfar_2d, cfar_stats
 from model import detection_theory as dt
 from model.config import PRESETS, RadarConfig
+from model.reference import fft_axes
 
 MAP_SHAPE = (64, 128)
 """(range, Doppler) cells of each synthetic detection map."""
@@ -225,6 +226,7 @@ def estimation_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> lis
     gain = cell_gain_db(cfg)
     nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
     cos_az = math.cos(math.radians(plan.azimuth_deg))
+    axes = fft_axes(cfg)
     specs = (  # quantity, unit, result key, aperture, looks, cycles -> unit
         ("range", "m", "se_range_m", nr, nd * nv, nr * cfg.range_bin_m),
         ("radial_velocity", "m/s", "se_velocity_mps", nd, nr * nv, nd * cfg.velocity_bin_mps),
@@ -239,11 +241,17 @@ def estimation_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> lis
                "n_elements" if quantity == "azimuth" else "n_samples": n, "looks": looks,
                "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],
                "excess_db": _excess(rmse, crb), "trials": res[0]["trials"]}
-        bound = crb
         if quantity == "azimuth":      # the array's bound for the one-cell snapshot
             bound = [dt.tone_frequency_crb(10 ** ((s + gain) / 10), n) * to_unit for s in snr]
             row["crb_array"] = [float(f"{v:.5g}") for v in bound]
             row["excess_array_db"] = _excess(rmse, bound)
+        else:                          # the bound of the three cells the interpolator reads
+            ax = axes if quantity == "range" else axes[::-1]
+            bound = [dt.three_cell_crb(10 ** (s / 10), (ax[0].window(), ax[0].n_fft),
+                                       (ax[1].window(), ax[1].n_fft), nv) * to_unit
+                     for s in snr]
+            row["crb_cells"] = [float(f"{v:.5g}") for v in bound]
+            row["excess_cells_db"] = _excess(rmse, bound)
         row.update(_threshold(snr, _excess(rmse, bound)))
         rows.append(row)
     return rows
@@ -256,7 +264,8 @@ def _excess(rmse: list[float], bound: list[float]) -> list[float]:
 
 def _threshold(snr: list[float], excess: list[float]) -> dict[str, float | None]:
     """``threshold_snr_db``: the lowest grid SNR from which on every point is within 3 dB
-    (MSE) of the bound; ``excess_above_threshold_db``: the median excess there."""
+    (MSE) of the bound (the array's for azimuth, the three cells' for range and velocity);
+    ``excess_above_threshold_db``: the median excess there."""
     thr = None
     for i in range(len(snr) - 1, -1, -1):
         if excess[i] > 3.0:

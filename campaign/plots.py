@@ -59,6 +59,9 @@ def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
         if "crb_array" in r:
             ax.semilogy(r["snr_db"], r["crb_array"], "k:", lw=1,
                         label="array CRB of the cell snapshot")
+        if "crb_cells" in r:
+            ax.semilogy(r["snr_db"], r["crb_cells"], "k:", lw=1,
+                        label="CRB of the three cells interpolated")
         if r["threshold_snr_db"] is not None:
             ax.axvline(r["threshold_snr_db"], color="grey", lw=0.8, ls=":",
                        label="threshold (within 3 dB from here)")

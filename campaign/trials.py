@@ -30,6 +30,7 @@ from model import cfar_2d
 from model.config import PRESETS, RadarConfig
 from model.detect_chain import DetectConfig
 from model.radar_pipeline import PipelineParams, chain_gain
+from model.reference import fft_axes
 
 DETECTORS = (("host", "ca"), ("host", "os"), ("fpga", "ca"), ("fpga", "go"), ("fpga", "so"))
 """(path, kind) of every detector the detection curves run: the host CFAR
@@ -140,7 +141,7 @@ def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(range bins, Doppler bins, sin(az)) estimated from cells complex (n, L, 2 half + 1,
     2 half + 1) around each target (noise power ``noise`` per channel and cell): the cell of
-    the integrated map's maximum among the 3 x 3 around the centre, the host's Gaussian
+    the integrated map's maximum among the 3 x 3 around the centre, the host's peak
     interpolation (``host.cells``) and angle estimator (``host.angle``, strongest component);
     bins relative to the centre cell."""
     n = len(cube)
@@ -148,10 +149,9 @@ def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
     centre = nci[:, half - 1:half + 2, half - 1:half + 2].reshape(n, 9).argmax(axis=1)
     pr, pd = centre // 3 + half - 1, centre % 3 + half - 1
     idx = np.arange(n)
-    logp = np.log(np.maximum(nci, 1e-300))
-    nb = np.stack([logp[idx, pr - 1, pd], logp[idx, pr + 1, pd], logp[idx, pr, pd - 1],
-                   logp[idx, pr, pd + 1]], axis=1)
-    off = neighbour_offsets(logp[idx, pr, pd], nb, np.ones(n, bool))
+    nb = np.stack([nci[idx, pr - 1, pd], nci[idx, pr + 1, pd], nci[idx, pr, pd - 1],
+                   nci[idx, pr, pd + 1]], axis=1)
+    off = neighbour_offsets(nci[idx, pr, pd], nb, np.ones(n, bool), fft_axes(cfg))
     got = estimate_angles(cube[idx, :, pr, pd], np.full(n, noise), AngleParams())
     first = np.searchsorted(got.cell, idx)                 # strongest component of each row
     return pr - half + off[:, 0], pd - half + off[:, 1], got.sin_az[first]

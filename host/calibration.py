@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from host.cells import Cells, gaussian_offset
+from host.cells import Cells, axis_offsets
 from model.array import direction_cosines, steering
 from model.config import RadarConfig
 from model.profile import Calibration
@@ -122,8 +122,7 @@ def estimate_calibration(cubes: Iterable[np.ndarray], cfg: RadarConfig, range_m:
     power = sum(np.sum(np.abs(z) ** 2, axis=0) for z in zero)
     r = _reflector_bin(power, cfg, range_m)
     snaps = np.stack([z[:, r] for z in zero])                           # (frames, n_v)
-    logp = np.log(np.maximum(power[r - 1:r + 2], 1e-300))
-    offset = float(gaussian_offset(logp[0], logp[1], logp[2]))
+    offset = float(axis_offsets(power[r - 1], power[r], power[r + 1], fft_axes(cfg)[0]))
     measured = (r + offset) * cfg.range_bin_m
     u, w = direction_cosines(math.radians(azimuth_deg), math.radians(elevation_deg))
     a = steering(cfg.virtual_positions_hw, u, w)                          # (n_v,)

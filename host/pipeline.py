@@ -7,7 +7,8 @@ Steps (docs/design.md section 1, host side):
    0; peak grouping keeps local maxima; only ``RadarConfig.detection_bins`` are reported
    (the top range bins are negative beat frequencies), and cells within
    ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
-2. Range and Doppler refined by log-parabolic (Gaussian) interpolation around each peak.
+2. Range and Doppler refined by interpolation around each peak over the three integrated
+   powers along each axis, matched to the axis' window and padding (``host.cells``).
 3. TDM Doppler phase compensation per TX slot, with velocity unfolding. The measured
    Doppler fixes the velocity only modulo the alias period 2 vmax: the hypotheses are
    v + 2 m vmax for every integer m with |v + 2 m vmax| <= ``max_speed_mps`` (the fastest
@@ -102,7 +103,8 @@ def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     cells, noise, nci = detect_cells(cube, cfg, params)
     if not np.isfinite(nci).all():         # NaN / inf anywhere in the cube reach the map
         raise ValueError("cube: contains NaN or infinite values")
-    offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
+    offsets = peak_offsets(nci, cells, fft_axes(cfg, params.range_window,
+                                                params.doppler_window))
     r, d = cells[:, 0], cells[:, 1]
     found = Cells(r, d, nci[r, d], noise, offsets, cube[:, r, d].T)
     return points_from_cells(found, cfg, params, frame), nci

@@ -14,10 +14,10 @@ own CFAR (``host.pipeline`` module docstring), on the records alone:
 3. sidelobe masking against stronger *detected* cells in the same row and column
    (``host.cfar.sidelobe_masked``; a cell strong enough to throw sidelobes above the
    threshold is always detected itself);
-4. peak offsets: Gaussian interpolation over the 3 log powers along each axis, from the
-   four neighbour powers every record carries (``host.cells.neighbour_offsets``, the
-   cube path's interpolation on the same values: detected or not, the neighbours' powers
-   come from the FPGA's map);
+4. peak offsets: the interpolation over the 3 powers along each axis matched to the
+   axis' window and padding, from the four neighbour powers every record carries
+   (``host.cells.neighbour_offsets``, the cube path's interpolation on the same values:
+   detected or not, the neighbours' powers come from the FPGA's map);
 5. TDM compensation, velocity unfolding, angle estimation and the point cloud: the cube
    path's code, ``host.points.points_from_cells``, on the selected records as
    ``host.cells.Cells``.
@@ -42,18 +42,19 @@ from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from host.records import RecordArrays, outside_map
 from model.config import RadarConfig
+from model.reference import fft_axes
 
 
 def record_offsets(power: np.ndarray, neighbours: np.ndarray, range_bin: np.ndarray,
-                   n_range: int) -> np.ndarray:
+                   cfg: RadarConfig, params: DetectionParams) -> np.ndarray:
     """Fractional (range, Doppler) peak offsets, float (n, 2) bins, of records (step 4 of
     the module docstring): power float (n,), neighbours float (n, 4)
     (``host.records.RecordArrays``), range_bin int (n,); the cube path's interpolation
-    (``host.cells.peak_offsets``) on the same powers."""
-    logc = np.log(np.maximum(power, 1e-30))
-    lognb = np.log(np.maximum(neighbours, 1e-30))
+    (``host.cells.peak_offsets``) on the same powers, for ``cfg``'s axes with the windows
+    of ``params``."""
     r = np.asarray(range_bin)
-    return neighbour_offsets(logc, lognb, (r > 0) & (r < n_range - 1))
+    return neighbour_offsets(power, neighbours, (r > 0) & (r < cfg.n_range_bins - 1),
+                             fft_axes(cfg, params.range_window, params.doppler_window))
 
 
 @lru_cache(maxsize=16)
@@ -135,7 +136,7 @@ def record_cells(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams) -
     _check_records(arr, cfg)
     idx = select_records(arr, cfg, params)
     r = arr.range_bin[idx]
-    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg.n_range_bins)
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg, params)
     return Cells(r, arr.doppler_bin[idx], arr.power[idx], arr.noise[idx], offsets,
                  arr.snapshot[idx])
 

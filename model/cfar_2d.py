@@ -24,7 +24,7 @@ Output word of the RTL (one per cell, LSB first): power ``pow_w`` bits, training
 ``sum_w`` bits, training cell count ``cnt_w`` bits, detect 1 bit, then the powers of the
 cell's four neighbours, ``pow_w`` bits each, in the order of :data:`NEIGHBOURS` (range - 1,
 range + 1, Doppler - 1, Doppler + 1; Doppler circular, 0 outside the map in range): what the
-host's Gaussian peak interpolation needs, so the records give the cube path's range and
+host's peak interpolation needs, so the records give the cube path's range and
 Doppler offsets; tuser ``{r, d}``; order per row: d = PD..n_doppler-1, 0..PD-1
 (:func:`output_order`).
 """

@@ -8,6 +8,7 @@ import pytest
 
 from model import detection_theory as dt
 from model.cfar_stats import ca_factor, go_so_factor, os_factor
+from model.reference import hann_periodic
 
 L, N, PFA, DRAWS = 4, 16, 1e-2, 60_000
 
@@ -85,3 +86,27 @@ def test_tone_crb_against_least_squares_estimates() -> None:
     assert rmse == pytest.approx(dt.tone_frequency_crb(snr, n), rel=0.08)
     assert dt.tone_frequency_crb(snr, n, looks=4) == pytest.approx(
         dt.tone_frequency_crb(snr, n) / 2)
+
+
+def test_three_cell_bound_against_least_squares_estimates() -> None:
+    """ML (least-squares) offsets from the three Hann-windowed DFT cells of a tone reach
+    :func:`three_cell_information`'s bound at high SNR; the cell gain at the centre is
+    (sum w)^2 / sum w^2 = 2N/3; :func:`three_cell_crb` lies above the whole data's bound."""
+    rng = np.random.default_rng(4)
+    n, snr, trials, off = 32, 10.0, 3000, 0.2
+    w = hann_periodic(n)
+    t = np.arange(n)
+    e = w * np.exp(-2j * np.pi * np.outer([-1.0, 0.0, 1.0], t) / n)          # (3, n)
+    x = np.exp(2j * np.pi * off * t / n) + (rng.standard_normal((trials, n)) + 1j *
+                                           rng.standard_normal((trials, n))) / np.sqrt(2 * snr)
+    y = x @ e.T                                                          # (trials, 3)
+    ci = np.linalg.inv(e @ e.conj().T)
+    grid = off + np.linspace(-0.1, 0.1, 1001)
+    s = np.exp(2j * np.pi * np.outer(grid, t) / n) @ e.T                 # (grid, 3)
+    fit = np.abs(y.conj() @ ci @ s.T) ** 2 / np.einsum("gi,ij,gj->g", s.conj(), ci, s).real
+    rmse = np.sqrt(np.mean((grid[np.argmax(fit, axis=1)] - off) ** 2))
+    bound = 1 / np.sqrt(snr * dt.three_cell_information(w, n, np.array([off]))[0])
+    assert rmse == pytest.approx(bound, rel=0.08)
+    assert dt.cell_snr_gain(w, n, np.zeros(1))[0] == pytest.approx(2 * n / 3)
+    hann = (hann_periodic(256), 256)
+    assert dt.three_cell_crb(1.0, hann, hann, 64) > dt.tone_frequency_crb(1.0, 256, 256 * 64)

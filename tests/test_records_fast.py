@@ -39,7 +39,7 @@ from model.detect_records import (
     record_words,
 )
 from model.radar_pipeline import PipelineParams, chain_gain, run_chain
-from model.reference import radar_cube
+from model.reference import fft_axes, radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
 from tests.oracles.angle import estimate_angles as estimate_angles_row
@@ -345,7 +345,7 @@ def test_table1_full_cells_as_records() -> None:
     new = process_records(arr, cfg, params)
     assert len(new) >= 4
     assert_same_cloud(new, process_records_reference(arr, cfg, params))
-    off = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
+    off = peak_offsets(nci, cells, fft_axes(cfg))
     cube_cells = Cells(cells[:, 0], cells[:, 1], arr.power, noise, off, arr.snapshot)
     assert_same_cloud(points_from_cells(cube_cells, cfg, params),
                 points_from_cells_numpy(cells, arr.snapshot, arr.power, noise, off, cfg,

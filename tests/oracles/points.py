@@ -29,7 +29,7 @@ from host.record_points import _check_records, _neighbours, record_offsets
 from host.records import RecordArrays
 from host.tdm import choose_folds, tx_phasors
 from model.config import RadarConfig
-from model.reference import signed_bins, tdm_phase_compensation
+from model.reference import fft_axes, signed_bins, tdm_phase_compensation
 from tests.oracles.angle import (
     estimate_angles_batch,
     estimate_angles_fast,
@@ -221,7 +221,7 @@ def process_records_reference(arr: RecordArrays, cfg: RadarConfig,
     _check_records(arr, cfg)
     idx = select_records_reference(arr, cfg, params)[0]
     cells = np.stack([arr.range_bin[idx], arr.doppler_bin[idx]], axis=1)
-    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg.n_range)
+    offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], cells[:, 0], cfg, params)
     return points_from_cells_numpy(cells, arr.snapshot[idx], arr.power[idx],
                                    arr.noise[idx], offsets, cfg, params, frame)
 
@@ -233,7 +233,8 @@ def process_cube_reference(cube: np.ndarray, cfg: RadarConfig,
     (``host.pipeline.detect_cells``) through :func:`points_from_cells_numpy`."""
     params = params or DetectionParams()
     cells, noise, nci = detect_cells(cube, cfg, params)
-    offsets = peak_offsets(np.log(np.maximum(nci, 1e-30)), cells)
+    offsets = peak_offsets(nci, cells, fft_axes(cfg, params.range_window,
+                                                params.doppler_window))
     r, d = cells[:, 0], cells[:, 1]
     return points_from_cells_numpy(cells, cube[:, r, d].T, nci[r, d], noise, offsets, cfg,
                                    params, frame)
