@@ -60,6 +60,7 @@ two lobes are within the coarse grid's scalloping of each other (``host._angle_p
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,6 +101,10 @@ class AngleParams:
             raise ValueError(f"n_fft: must be a power of two >= 16, got {self.n_fft}")
         if self.max_targets < 1:
             raise ValueError(f"max_targets: must be >= 1, got {self.max_targets}")
+        if not math.isfinite(self.array_error_db) or self.array_error_db >= 0.0:
+            raise ValueError(f"array_error_db: must be a finite number of dB below 0 (the "
+                             f"array's model error relative to a target), got "
+                             f"{self.array_error_db}")
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from typing import TypeVar
 
 from tqdm import tqdm
 
+from host.angle import AngleParams
 from host.cfar import CfarParams
 from host.params import (
     DETECTORS,
@@ -131,7 +132,8 @@ def detection_params(args: argparse.Namespace, scene_bf: bool = True,
                           kind="os" if args.detector == "os" else "ca")
         params = DetectionParams(detector=args.detector, cfar=cfar,
                                  paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
-                                 max_speed_mps=speed)
+                                 max_speed_mps=speed,
+                                 angle=AngleParams(array_error_db=args.array_error_db))
         if cfg is not None:
             params.check(cfg)
         return params
@@ -264,6 +266,12 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
                         "explains the measurement (default: the radar profile's max_speed_mps, "
                         "its unambiguous speed unless it states one; "
                         f"{MAX_RADIAL_SPEED_MPS:g} for the presets)")
+    p.add_argument("--array-error-db", type=float, default=AngleParams.array_error_db,
+                   help="the array's model error (calibration residue) relative to a "
+                        "target, dB: a second angle component in a cell is kept only beyond "
+                        "what it and the noise explain (default "
+                        f"{AngleParams.array_error_db:g}, an uncalibrated array; about -25 "
+                        "after `radar calibrate`; docs/profiles.md \"Angles\")")
 
 
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,

@@ -118,6 +118,7 @@ BAD = [
     ["detect", "--ego-speed", "nan"], ["detect", "--ego-speed", "1e6"],
     ["detect", "--frames", "0"], ["detect", "--frames", "1000000000"],
     ["detect", "--max-speed", "nan"], ["detect", "--max-speed", "-5"],
+    ["detect", "--array-error-db", "3"], ["detect", "--array-error-db", "nan"],
     ["simulate", "--frame", "1000000000000"], ["simulate", "--frame", "-1"],
     ["receive", "--port", "70000"], ["receive", "--port", "-1"],
     ["receive", "--idle-timeout", "-1"], ["receive", "--timeout", "nan"],
