@@ -101,10 +101,10 @@ class AngleParams:
             raise ValueError(f"n_fft: must be a power of two >= 16, got {self.n_fft}")
         if self.max_targets < 1:
             raise ValueError(f"max_targets: must be >= 1, got {self.max_targets}")
-        if not math.isfinite(self.array_error_db) or self.array_error_db >= 0.0:
-            raise ValueError(f"array_error_db: must be a finite number of dB below 0 (the "
-                             f"array's model error relative to a target), got "
-                             f"{self.array_error_db}")
+        if math.isnan(self.array_error_db) or self.array_error_db >= 0.0:
+            raise ValueError(f"array_error_db: must be a number of dB below 0 (the array's "
+                             f"model error relative to a target; -inf: no model-order test), "
+                             f"got {self.array_error_db}")
 
 
 @dataclass(frozen=True)

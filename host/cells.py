@@ -84,14 +84,9 @@ def offset_statistic(lo: np.ndarray, c: np.ndarray, hi: np.ndarray, two: bool
 def tone_power(axis: FftAxis, offset: np.ndarray) -> np.ndarray:
     """|W(x)|^2 of a unit tone ``offset`` bins (float (m,)) of ``axis``' FFT from a bin
     centre: W(x) = sum_t w[t] exp(-j 2 pi x t / n_fft) over the axis' window w
-    (``model.reference.FftAxis.window``, n_samples samples), float (m,)."""
-    w = axis.window()
-    t = np.arange(axis.n_samples)
-    out = np.empty(len(offset))
-    for i in range(0, len(offset), 256):           # (256, n_samples) at a time
-        ph = 2 * np.pi * np.outer(offset[i:i + 256], t) / axis.n_fft
-        out[i:i + 256] = (np.cos(ph) @ w) ** 2 + (np.sin(ph) @ w) ** 2
-    return out
+    (``model.reference.FftAxis.window``, n_samples samples; its closed form
+    ``FftAxis.response`` times W(0) = sum(w)), float (m,)."""
+    return (axis.response(offset) * axis.window().sum()) ** 2
 
 
 @lru_cache(maxsize=32)

@@ -96,15 +96,14 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
     float (n, 2) bins. Per component (m,): ``cell`` its cell index, ``az`` deg,
     ``amplitude`` complex (LSB), ``snr_db``, ``elevation_deg`` (or a scalar);
     ``range_bias_m`` is subtracted from the range (calibration)."""
-    nr, nd = cfg.n_range, cfg.n_doppler
+    nr = cfg.n_range
     dr, dd = offsets[:, 0], offsets[:, 1]
     velocity = (k + dd) * cfg.velocity_bin_mps
     # the beat frequency includes the Doppler shift 2v/lambda: remove it from the range
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
     range_m = (r + dr - coupling) * cfg.range_bin_m - range_bias_m
     ax_r, ax_d = fft_axes(cfg, params.range_window, params.doppler_window)
-    scallop = _window_response(nr, dr, params.range_window, ax_r.n_samples) * \
-        _window_response(nd, dd, params.doppler_window, ax_d.n_samples)
+    scallop = ax_r.response(dr) * ax_d.response(dd)
     cg = ax_r.coherent_gain * ax_d.coherent_gain
     amp = np.abs(amplitude)
     amp_adc = amp / (cg * scallop[cell])
@@ -113,41 +112,6 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
         range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr_db,
         rcs, r[cell].astype(int), k[cell].astype(int), ambiguous[cell], frame=frame,
         elevation_deg=elevation_deg)
-
-
-def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:
-    """The real factor of the Dirichlet kernel D(y) = sum_{t<n} exp(-j 2 pi y t / n) =
-    exp(-j pi y (n - 1) / n) sin(pi y) / sin(pi y / n), float like y (|y| < n; n at y = 0);
-    sin_pi_y: sin(pi y), given (callers share it)."""
-    den = np.sin(np.pi * y / n)
-    small = np.abs(den) < 1e-12
-    return np.where(small, n, sin_pi_y / np.where(small, 1.0, den))
-
-
-def _window_response(n: int, offset: np.ndarray | float, windowed: bool,
-                     n_samples: int | None = None) -> np.ndarray:
-    """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar) off
-    a bin centre of an ``n``-point FFT of ``n_samples`` samples (default n; zero-padded:
-    the n_samples-point response at offset * n_samples / n), float (m,) or scalar; W is
-    the DFT of the periodic Hann window
-    (``model.reference.hann_periodic``: 0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the
-    Dirichlet kernel D) or of the rectangular one (D). The three kernels share their phase
-    up to exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
-    |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
-    R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
-    x = np.asarray(offset, dtype=float)
-    if n_samples is not None and n_samples != n:
-        x, n = x * (n_samples / n), n_samples
-    s = np.sin(np.pi * x)
-    r0 = _dirichlet_ratio(x, n, s)
-    if not windowed:
-        return np.abs(r0) / n
-    rm = _dirichlet_ratio(x - 1, n, -s)
-    rp = _dirichlet_ratio(x + 1, n, -s)
-    phi = np.pi * (n - 1) / n
-    re = 0.5 * r0 - 0.25 * np.cos(phi) * (rm + rp)
-    im = 0.25 * np.sin(phi) * (rp - rm)
-    return np.hypot(re, im) / (n / 2)
 
 
 def rcs_estimate_dbsm(cfg: RadarConfig, amplitude_adc: np.ndarray, range_m: np.ndarray,

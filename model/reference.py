@@ -51,6 +51,15 @@ def hann_periodic(n: int) -> np.ndarray:
     return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
 
 
+def _dirichlet_ratio(y: np.ndarray, n: int, sin_pi_y: np.ndarray) -> np.ndarray:
+    """The real factor of the Dirichlet kernel D(y) = sum_{t<n} exp(-j 2 pi y t / n) =
+    exp(-j pi y (n - 1) / n) sin(pi y) / sin(pi y / n), float like y (|y| < n; n at y = 0);
+    sin_pi_y: sin(pi y), given (callers share it)."""
+    den = np.sin(np.pi * y / n)
+    small = np.abs(den) < 1e-12
+    return np.where(small, n, sin_pi_y / np.where(small, 1.0, den))
+
+
 @dataclass(frozen=True)
 class FftAxis:
     """One FFT axis of the chain: ``n_samples`` inputs, periodic-Hann windowed over their own
@@ -77,6 +86,28 @@ class FftAxis:
     def window(self) -> np.ndarray:
         """The window over the samples, float64 (n_samples,)."""
         return hann_periodic(self.n_samples) if self.hann else np.ones(self.n_samples)
+
+    def response(self, offset: np.ndarray | float) -> np.ndarray:
+        """|W(offset)| / |W(0)|: amplitude of a tone ``offset`` bins (float (m,) or scalar)
+        off a bin centre of this axis' FFT, float like ``offset``. Zero-padded: the
+        n_samples-point response at offset * n_samples / n_fft. W is the DFT of the periodic
+        Hann window (0.5 D(x) - 0.25 D(x - 1) - 0.25 D(x + 1) with the Dirichlet kernel D)
+        or of the rectangular one (D). The three kernels share their phase up to
+        exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
+        |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
+        R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
+        x = np.asarray(offset, dtype=float) * (self.n_samples / self.n_fft)
+        n = self.n_samples
+        s = np.sin(np.pi * x)
+        r0 = _dirichlet_ratio(x, n, s)
+        if not self.hann:
+            return np.abs(r0) / n
+        rm = _dirichlet_ratio(x - 1, n, -s)
+        rp = _dirichlet_ratio(x + 1, n, -s)
+        phi = np.pi * (n - 1) / n
+        re = 0.5 * r0 - 0.25 * np.cos(phi) * (rm + rp)
+        im = 0.25 * np.sin(phi) * (rp - rm)
+        return np.hypot(re, im) / (n / 2)
 
     @property
     def coherent_gain(self) -> float:

@@ -14,7 +14,6 @@ import pytest
 from host.cfar import MAIN_LOBE_BINS, CfarParams, cfar_threshold, sidelobe_envelope
 from host.params import default_guard, params_for
 from host.pipeline import process_frame
-from host.points import _window_response
 from model.array import steering
 from model.cfar_stats import HANN_POWER_CORRELATION
 from model.config import PRESETS, RadarConfig
@@ -134,7 +133,7 @@ def test_window_quantities_of_padded_axes():
     assert measured == pytest.approx(rho[1], abs=0.05)
     off = np.array([0.0, 0.3, -0.5, 1.7])
     resp = np.abs([np.sum(w * np.exp(-2j * np.pi * o * np.arange(256) / 256)) for o in off])
-    assert np.allclose(_window_response(256, off, True, 200), resp / w.sum(), atol=1e-12)
+    assert np.allclose(FftAxis(256, 200).response(off), resp / w.sum(), atol=1e-12)
     env = sidelobe_envelope(256, True, 200)
     assert env[:4].max() == 0.0 and 0 < env[4] < 10 ** -2.5
     assert default_guard(replace(BASE, samples_per_chirp=200, loops=255)) == (3, 3)
