@@ -7,7 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from host.pipeline import process_cube
+from model.impairments import Ground, Impairments, Wall
+from model.radar_pipeline import PipelineParams, scaled_cube
 from model.reference import remove_static
+from model.scene import PointTarget, Scene
+from model.simulate import simulate_scene
 from model.static_removal import mean, mean_exact, remove_static_planar, static_removal
 
 
@@ -44,3 +49,48 @@ def test_zero_fill_saturation_and_bypass() -> None:
     assert np.array_equal(static_removal(words, 8, enable=False)[0], words)
     removed, _ = static_removal(words, 8)
     assert not np.array_equal(removed, words)
+
+
+def indoor_scene() -> Scene:
+    """paper-fpga in a room: three walls, the floor, eight pieces of furniture (static point
+    returns), TX-RX leakage, and three people walking (the movers, m/s radial)."""
+    imp = Impairments(
+        seed=3, leakage_dbfs=-20.0, leakage_range_m=0.3,
+        walls=(Wall(6.0, -6.0, 6.0, 6.0, rcs_m2=50.0, n_scatterers=64),
+               Wall(2.0, 3.0, 14.0, 3.5, rcs_m2=30.0, n_scatterers=64),
+               Wall(1.0, -4.0, 20.0, -4.5, rcs_m2=30.0, n_scatterers=64)),
+        ground=Ground(height_m=1.0, rcs_m2=20.0, min_range_m=1.5, max_range_m=25.0,
+                      n_scatterers=128))
+    furniture = tuple(PointTarget(r, az, 0.0, 5.0) for r, az in (
+        (4.0, -30), (7.5, 25), (11.0, -10), (16.0, 35), (21.0, 0), (27.0, -40), (33.0, 15),
+        (40.0, -5)))
+    return Scene(preset="paper-fpga", targets=furniture + MOVERS, impairments=imp, seed=5)
+
+
+MOVERS = (PointTarget(3.5, 10.0, 1.2, 1.0), PointTarget(9.0, -20.0, -2.5, 1.0),
+          PointTarget(15.0, 5.0, 4.0, 2.0))
+
+
+def test_indoor_scene_loses_its_zero_doppler_detections() -> None:
+    """The issue-31 goal on the bit-exact chain (the RTL's DMA bytes equal it:
+    tb/radar_pipeline/test_radar_pipeline_static.py): with the removal on, at least 90 % of
+    the zero-Doppler detections go and every mover is still detected in every frame."""
+    scene = indoor_scene()
+    cfg = scene.config
+    v_bin = 2 * cfg.max_velocity_mps / cfg.n_doppler
+    r_bin = cfg.max_range_m / cfg.n_range
+    zero, movers = {}, {}
+    for on in (False, True):
+        zero[on], movers[on] = 0, 0
+        for k in range(3):
+            pc = process_cube(scaled_cube(simulate_scene(scene, k).samples, cfg,
+                                          PipelineParams(static_removal=on)), cfg)
+            v, r = np.asarray(pc.radial_velocity_mps), np.asarray(pc.range_m)
+            zero[on] += int((np.abs(v) < v_bin / 2).sum())
+            movers[on] += sum(bool(((np.abs(v - m.radial_velocity_mps) < 2 * v_bin)
+                                    & (np.abs(r - m.range_m) < 2 * r_bin)).any())
+                              for m in MOVERS)
+    print(f"zero-Doppler detections {zero[False]} -> {zero[True]}, movers found "
+          f"{movers[False]} -> {movers[True]} of {3 * len(MOVERS)}")
+    assert zero[False] >= 5 and zero[True] <= 0.1 * zero[False]
+    assert movers[True] == 3 * len(MOVERS)
