@@ -11,13 +11,11 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import SMALL4, assert_packets_equal, chirp_bursts, decode
-from test_radar_pipeline import adc_frames as scene_frames
+from test_radar_pipeline import SMALL4, assert_packets_equal, decode
 from test_radar_pipeline_frame_store import CHAIN as FS_CHAIN
-from test_radar_pipeline_frame_store import attach_ram, channels, store_params
+from test_radar_pipeline_frame_store import stalled_frames, store_params
 
 from model.radar_pipeline import PipelineParams, dma_packets
-from rtlsim.axis import random_pause
 from rtlsim.pipeline import PipelineTB
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
@@ -31,17 +29,7 @@ async def static_removal_bit_exact(dut) -> None:
     store): packets bit-exact with the model, clean status; without the removal the same
     frames' packets differ."""
     tb = PipelineTB(dut)
-    if param("FRAME_STORE", 0):
-        ram = attach_ram(tb)
-        for i, ch in enumerate(channels(ram)):
-            ch.set_pause_generator(random_pause(0.3, 20 + i))
-    frames = scene_frames("small4", SMALL4, 3)
-    tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
-    tb.set_backpressure_generator(random_pause(0.3, 2))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.recv_frames(3, 4 * tb.frame_timeout_cycles())
+    frames, got = await stalled_frames(tb, external=bool(param("FRAME_STORE", 0)))
     assert_packets_equal(got, dma_packets(frames, SMALL4, CHAIN), "static removal")
     st = tb.status()
     assert st["frames_out"] == 3, st
