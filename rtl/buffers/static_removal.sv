@@ -142,7 +142,7 @@ module static_removal #(
       p = PROD_W'(s) * $signed({1'b0, RCP_W'(RECIP)});
     end
     p = p + (PROD_W'(1) <<< (SH - 1));
-    return DATA_W'(p >>> SH);
+    mean_of = DATA_W'(p >>> SH);
   endfunction
 
   always_ff @(posedge clk) begin
