@@ -24,7 +24,7 @@ module radar_pipeline_props (
   radar_pipeline #(.NUM_RX(1), .NUM_TX(1), .N_RANGE(16), .N_DOPPLER(16), .DATA_W(16),
                    .PACKET_WORDS(16), .WINDOW(1'b0), .OUT_BANKS(2)) dut (
     .clk, .rst, .s_axis_adc_tdata, .s_axis_adc_tvalid, .s_axis_adc_tready,
-    .s_axis_adc_tlast, .s_axis_adc_tuser, .cfg_cfar_scale('0),
+    .s_axis_adc_tlast, .s_axis_adc_tuser, .cfg_cfar_scale('0), .cfg_static_removal(1'b0),
     .m_axis_dma_tdata, .m_axis_dma_tvalid, .m_axis_dma_tready, .m_axis_dma_tlast,
     .m_axi_mem_awready(1'b0), .m_axi_mem_wready(1'b0), .m_axi_mem_bid(1'b0),
     .m_axi_mem_bresp(2'b00), .m_axi_mem_bvalid(1'b0), .m_axi_mem_arready(1'b0),

@@ -4,6 +4,7 @@ the block models: ADC frame in, DMA packets out, identical to the RTL for loss-f
     chirp ping-pong (pass-through when nothing is dropped)
     -> range ``fft_axis`` (Hann window, SCALE_SCH = range_scale_sch)    model.fft_axis
     -> corner turn (chirp order -> Doppler vectors)                      model.corner_turn
+    -> [static-clutter removal, ``static_removal`` only]                 model.static_removal
     -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
     -> packetizer (header, PACKET_WORDS payload words, CRC word, TLAST)  model.axis_packetizer
 
@@ -41,6 +42,7 @@ from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
 from model.hdl import hdl_parameters
 from model.profile_fields import check_preset_chain
+from model.static_removal import remove_static_planar
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
@@ -62,7 +64,9 @@ class PipelineParams:
     ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R (None:
     :meth:`store_tile_r` picks it); ``output_mode``:
     OUTPUT_MODE (0: radar cube, 1: detection records); ``detect``: the detector settings in
-    mode 1 (None: :meth:`detect_config` derives them from the RadarConfig).
+    mode 1 (None: :meth:`detect_config` derives them from the RadarConfig);
+    ``static_removal``: STATIC_REMOVAL (static-clutter removal before the Doppler FFT, on
+    for every frame: the top's ``cfg_static_removal`` driven high).
     """
 
     packet_words: int = 1024
@@ -75,6 +79,7 @@ class PipelineParams:
     fs_tile_r: int | None = None
     output_mode: int = 0
     detect: DetectConfig | None = None
+    static_removal: bool = False
 
     def detect_config(self, cfg: RadarConfig) -> DetectConfig:
         """The detector of mode 1: ``detect`` (its sizes checked against ``cfg``) or the
@@ -121,9 +126,12 @@ class PipelineParams:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
         (:func:`model.hdl.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
         schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``;
-        OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1)."""
+        OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1;
+        STATIC_REMOVAL when ``static_removal``)."""
         store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w,
                   "FS_TILE_R": self.store_tile_r(cfg)} if self.frame_store else {})
+        if self.static_removal:
+            store["STATIC_REMOVAL"] = 1
         if self.output_mode == 1:
             d = self.detect_config(cfg).hdl_parameters()
             store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
@@ -234,8 +242,11 @@ def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams
     else:
         turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
                              cfg.n_doppler, read_order=order)
-    dop_p, dop_ov = fft_fixed_planar(turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2),
-                                     window=params.window, scale_sch=params.doppler_scale_sch)
+    vectors = turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2)
+    if params.static_removal:
+        vectors = remove_static_planar(vectors)[0].astype(vectors.dtype)
+    dop_p, dop_ov = fft_fixed_planar(vectors, window=params.window,
+                                     scale_sch=params.doppler_scale_sch)
     return from_planar(dop_p).reshape(-1, cfg.num_rx), int(rng_ov.sum()), int(dop_ov.sum())
 
 

@@ -201,7 +201,8 @@ def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
                doppler_window: bool = True, remove_static_clutter: bool = False
                ) -> np.ndarray:
     """The FPGA chain in float: ADC frame -> radar cube; ``remove_static_clutter``: apply
-    :func:`remove_static` before the Doppler FFT (not a step of the FPGA chain).
+    :func:`remove_static` before the Doppler FFT (the FPGA chain's optional
+    ``static_removal`` block in fixed point: ``model.static_removal``).
 
     adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
     (n_virtual, n_range_bins, n_doppler).

@@ -40,6 +40,8 @@ class PipelineTB(AxisTB):
                             if self.output_mode == 1
                             else self.num_tx * self.n_range * self.n_doppler)
         self.dut.cfg_cfar_scale.value = 0
+        # static-clutter removal, when built in (STATIC_REMOVAL = 1), is on for every frame
+        self.dut.cfg_static_removal.value = param("STATIC_REMOVAL", 0)
         self.packets_per_frame = packets_per_frame(self.frame_words, self.packet_words)
 
     async def reset(self, cycles: int = 8) -> None:

@@ -70,6 +70,7 @@ _Q_DC = ("tb/detect_chain/test_detect_chain.py::test_detect_chain[NUM_TX4_NUM_RX
          "pfa0.01]")
 _Q_RP = "tb/radar_pipeline/test_radar_pipeline.py::test_radar_pipeline[small4]"
 _Q_RC = "tb/radar_ctrl/test_radar_ctrl.py::test_radar_ctrl[md5]"
+_Q_SR = "tb/static_removal/test_static_removal.py::test_static_removal[NUM_RX2_N_DOPPLER8_N_LOOPS8]"
 _Q_RPFS = ("tb/radar_pipeline/test_radar_pipeline_frame_store.py::"
            "test_radar_pipeline_frame_store[small4]")
 CHEAPEST: dict[str, list[str]] = {
@@ -77,7 +78,7 @@ CHEAPEST: dict[str, list[str]] = {
     "axis_packetizer": [_Q_PK], "fft_axis": [_Q_FFT], "mark_fifo": [_Q_MF],
     "frame_store_axi": [_Q_FS], "nci": [_Q_NCI], "cfar_2d": [_Q_CFAR],
     "detect_records": [_Q_REC], "detect_chain": [_Q_DC], "radar_pipeline": [_Q_RP],
-    "radar_ctrl": [_Q_RC],
+    "radar_ctrl": [_Q_RC], "static_removal": [_Q_SR],
 }
 """Testbench folder -> its cheapest parameter set (also ``tools/coverage.py --quick``)."""
 _FFT = [[_Q_FFT], ["tb/fft_axis/test_fft_axis.py"]]
@@ -96,6 +97,7 @@ TESTS: dict[str, list[list[str]]] = {
     "frame_store_fifo": _FS,
     "frame_store_gearbox": _FS,
     "nci": [[_Q_NCI], [_Q_DC]],
+    "static_removal": [[_Q_SR], ["tb/static_removal"]],
     "cfar_2d": [[_Q_CFAR], [_Q_DC]],
     "detect_records": [[_Q_REC], [_Q_DC]],
     "detect_chain": [[_Q_DC], ["tb/detect_chain"]],

@@ -18,6 +18,10 @@
 // DAMAGED/OVERFLOW flags). With FRAME_STORE = 1 the external store reads (r, t, d) too
 // (frame_store_axi READ_ORDER = 1: its on-chip buffer holds 2 x NUM_TX strips of FS_TILE_R
 // range bins, docs/frame_store.md).
+//
+// STATIC_REMOVAL = 1: static-clutter removal (static_removal, one slow-time vector of
+// latency) between the corner turn (either variant) and the Doppler FFT, switched at run time
+// by cfg_static_removal, which takes effect at the next frame out of the corner turn.
 `default_nettype none
 
 module radar_pipeline #(
@@ -61,6 +65,9 @@ module radar_pipeline #(
   parameter int FS_TILE_R = 16,
   // 0: the radar cube to the DMA (docs/design.md 3.2); 1: detection records (docs/design.md 3.4).
   parameter int OUTPUT_MODE = 0,
+  // 1: static-clutter removal before the Doppler FFT (static_removal, switched by
+  // cfg_static_removal); 0: none, cfg_static_removal unused.
+  parameter bit STATIC_REMOVAL = 1'b0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
   // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,
   // threshold-scale fixed point, records per frame at most.
@@ -91,6 +98,9 @@ module radar_pipeline #(
   // entry e at bits e*SCALE_W (model.cfar_2d.scale_table / pack_scale). A quasi-static
   // configuration register: change it only between frames. Unused in OUTPUT_MODE = 0.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_cfar_scale,
+  // Static-clutter removal on (STATIC_REMOVAL = 1; the register block's clutter_removal
+  // setting): sampled with the first word of every frame out of the corner turn.
+  input  wire logic                       cfg_static_removal,
   // DMA stream: per packet [header] + payload (for tx, range bin, Doppler bin: one word of
   // NUM_RX lanes), TLAST on the last word of every packet.
   output logic      [NUM_RX*32-1:0]       m_axis_dma_tdata,
@@ -338,6 +348,37 @@ module radar_pipeline #(
     );
   end
 
+  // ---- static-clutter removal (STATIC_REMOVAL = 1) -----------------------------------------
+  logic [WORD_W-1:0] sr_tdata;
+  logic              sr_tvalid, sr_tready, sr_tlast;
+  logic [0:0]        sr_tuser;
+  logic              sr_framing, sr_saturated;
+
+  if (STATIC_REMOVAL) begin : g_static_removal
+    static_removal #(
+      .NUM_RX(NUM_RX), .N_DOPPLER(N_DOPPLER), .N_LOOPS(N_DOPPLER), .DATA_W(DATA_W)
+    ) u_static_removal (
+      .clk, .rst, .enable(cfg_static_removal),
+      .s_axis_tdata(ct_tdata), .s_axis_tvalid(ct_tvalid), .s_axis_tready(ct_tready),
+      .s_axis_tlast(ct_tlast), .s_axis_tuser(ct_tuser),
+      .m_axis_tdata(sr_tdata), .m_axis_tvalid(sr_tvalid), .m_axis_tready(sr_tready),
+      .m_axis_tlast(sr_tlast), .m_axis_tuser(sr_tuser),
+      .status_framing_error(sr_framing), .status_saturated(sr_saturated)
+    );
+  end else begin : g_no_static_removal
+    assign sr_tdata     = ct_tdata;
+    assign sr_tvalid    = ct_tvalid;
+    assign ct_tready    = sr_tready;
+    assign sr_tlast     = ct_tlast;
+    assign sr_tuser     = ct_tuser;
+    assign sr_framing   = 1'b0;
+    assign sr_saturated = 1'b0;
+    /* verilator lint_off UNUSEDSIGNAL */
+    logic unused_sr;
+    assign unused_sr = cfg_static_removal;
+    /* verilator lint_on UNUSEDSIGNAL */
+  end
+
   // ---- Doppler FFT --------------------------------------------------------------------------
   logic [WORD_W-1:0]            df_tdata;
   logic                         df_tvalid, df_tready, df_tlast;
@@ -349,8 +390,8 @@ module radar_pipeline #(
     .SCALE_SCH(DOPPLER_SCALE_SCH)
   ) u_doppler_fft (
     .clk, .rst,
-    .s_axis_tdata(ct_tdata), .s_axis_tvalid(ct_tvalid), .s_axis_tready(ct_tready),
-    .s_axis_tlast(ct_tlast),
+    .s_axis_tdata(sr_tdata), .s_axis_tvalid(sr_tvalid), .s_axis_tready(sr_tready),
+    .s_axis_tlast(sr_tlast),
     .m_axis_tdata(df_tdata), .m_axis_tvalid(df_tvalid), .m_axis_tready(df_tready),
     .m_axis_tlast(df_tlast), .m_axis_tuser(df_tuser),
     .event_tlast_unexpected(df_ev_unexp), .event_tlast_missing(df_ev_miss),
@@ -482,7 +523,7 @@ module radar_pipeline #(
   assign status_fft_overflow = fft_ovf_q;
   assign fft_overflow_count  = fft_ovf_count_q;
   assign status_framing_error = pp_framing | ct_framing | pk_framing | fft_framing_q
-                              | det_framing_error;
+                              | det_framing_error | sr_framing;
 
   // Sum of the blocks' framing counters (each saturates; the sum is clamped).
   logic [33:0] framing_sum;
@@ -492,12 +533,14 @@ module radar_pipeline #(
 
   // Signals the chain does not need: bin indices (the order is implied), the ping-pong's
   // frame-start / discontinuity marks (its counters report drops), the corner turn's
-  // frame-start mark and output frame count, and the ping-pong's dropped-sample count
-  // (chirps dropped are reported instead). Waiver: reduced into a deliberately unused bit.
+  // frame-start mark (after static removal) and output frame count, the ping-pong's
+  // dropped-sample count (chirps dropped are reported instead), and the static removal's
+  // saturation flag (the model reports it; no status port yet). Waiver: reduced into a
+  // deliberately unused bit.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
-  assign unused_ok = ^{rf_tuser, df_tuser, ct_tuser, ct_frames_out, pp_drop_samples,
-                       dmg_count, dmg_overflow, dmg_underflow};
+  assign unused_ok = ^{rf_tuser, df_tuser, sr_tuser, ct_frames_out, pp_drop_samples,
+                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

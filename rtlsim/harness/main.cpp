@@ -141,6 +141,7 @@ class Harness {
       else if (a.cfar_scale[i]) fail(2, "--cfar-scale wider than cfg_cfar_scale");
     }
     harness::put_words(top_->cfg_cfar_scale, scale.data(), static_cast<int>(scale_words));
+    top_->cfg_static_removal = 1;  // on for every frame when built in (STATIC_REMOVAL = 1)
   }
 
   int run() {

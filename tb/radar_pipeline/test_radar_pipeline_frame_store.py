@@ -51,21 +51,29 @@ def channels(ram: AxiRam) -> list:
     return [w.aw_channel, w.w_channel, w.b_channel, r.ar_channel, r.r_channel]
 
 
-@cocotb.test()
-async def external_store_bit_exact_with_axi_stalls(dut) -> None:
-    """Three frames, ADC chirp bursts, 30 % DMA stalls, random stalls on all five AXI
-    channels: packets bit-exact with the model, clean status, no memory error."""
-    tb = PipelineTB(dut)
-    ram = attach_ram(tb)
-    for i, ch in enumerate(channels(ram)):
-        ch.set_pause_generator(random_pause(0.3, 20 + i))
+async def stalled_frames(tb: PipelineTB, external: bool) -> tuple[list[np.ndarray],
+                                                                  list[np.ndarray]]:
+    """Three small4 scene frames in ADC chirp bursts with 30 % DMA stalls and, with the
+    ``external`` frame store, an ``AxiRam`` stalling all five channels at random: (the ADC
+    frames, the DMA packets received)."""
+    if external:
+        for i, ch in enumerate(channels(attach_ram(tb))):
+            ch.set_pause_generator(random_pause(0.3, 20 + i))
     frames = scene_frames("small4", SMALL4, 3)
     tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
     tb.set_backpressure_generator(random_pause(0.3, 2))
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)
-    got = await tb.recv_frames(3, 4 * tb.frame_timeout_cycles())
+    return frames, await tb.recv_frames(3, 4 * tb.frame_timeout_cycles())
+
+
+@cocotb.test()
+async def external_store_bit_exact_with_axi_stalls(dut) -> None:
+    """Three frames, ADC chirp bursts, 30 % DMA stalls, random stalls on all five AXI
+    channels: packets bit-exact with the model, clean status, no memory error."""
+    tb = PipelineTB(dut)
+    frames, got = await stalled_frames(tb, external=True)
     # the on-chip corner turn's packets: FRAME_STORE changes nothing downstream
     want = dma_packets(frames, SMALL4, replace(CHAIN, frame_store=False))
     assert_packets_equal(got, want, "frame store")
