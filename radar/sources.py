@@ -144,7 +144,8 @@ class FloatSource(FrameSource):
     help = "its float64 reference (faster)"
 
     def cube(self, adc: np.ndarray, cfg: RadarConfig) -> np.ndarray:
-        return radar_cube(adc, cfg, self.chain.window, self.chain.window)
+        return radar_cube(adc, cfg, self.chain.window, self.chain.window,
+                          remove_static_clutter=self.chain.static_removal)
 
 
 class RtlSource(FrameSource):

@@ -27,6 +27,7 @@ from model.cfar_2d import KINDS
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.observability import scene_report
+from model.radar_pipeline import PipelineParams
 from model.simulate import simulate_scene
 from radar.common import (
     CliError,
@@ -93,7 +94,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     refuse_detection_misfits(args, args.detect == "fpga")
     scene, profile = scene_profile(args)
     cfg = scene.config
-    source = get_source(args.backend)
+    source = get_source(args.backend, PipelineParams(static_removal=args.remove_static))
     check_source(source, cfg, alternative="--backend float" if args.detect == "host"
                  else "--detect host --backend float")
     out = out_file(args.json, ".json", "--json")
@@ -176,6 +177,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     done = len(per_frame) if stopped else args.frames
     doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
+                "remove_static": args.remove_static,
                 "scene": scene.name, **({"radar": profile.source} if args.radar else {}),
                 "ego_speed_mps": ego, "max_speed_mps": params.max_speed_mps,
                 "frame_info": per_frame, **report})
@@ -236,5 +238,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(--backend model or rtl)")
     add_fpga_options(d)
     add_detection_options(d)
+    d.add_argument("--remove-static", action="store_true",
+                   help="static-clutter removal: each range bin's mean over the frame's "
+                        "chirps, per channel, subtracted before the Doppler FFT (float: "
+                        "model.reference.remove_static; model and rtl: the static_removal "
+                        "block, STATIC_REMOVAL = 1)")
     add_mcap_options(d)
     d.set_defaults(func=cmd_detect)
