@@ -208,25 +208,58 @@ module cfar_2d #(
   end
 
   // ---------------------------------------------------------------------------------------
-  // Row geometry of the tested row q = p - PR - 1, computed at the step
-  logic [NE-1:0]     rowv;       // window row k (row q-PR+k) exists
-  logic [$clog2(NE+1)-1:0] n_out, n_in;   // existing rows: whole window / guard band
-  logic [$clog2(NE)-1:0]   e_idx;
-  always_comb begin
+  // Row geometry of pass p (tested row q = p - PR - 1): which window rows exist, the edge
+  // index, whether the row may detect and has range neighbours. It changes only between passes, so the next pass's geometry is computed ahead in three
+  // register stages (a pass lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
+  localparam int E_W   = $clog2(NE);
+  localparam int NR_W  = $clog2(NE + 1);
+  localparam int GEO_W = 3 + BR + E_W + NE;   // {cut_ok, rm_ok, rp_ok, r, e, rowv}
+  // (results assigned to the function name, no `return`: Yosys reads the file as written)
+  function automatic logic [GEO_W-1:0] geo(input int p);
     int q, row, lo, hi;
-    q     = int'(p_q) - PR - 1;
-    n_out = '0;
-    n_in  = '0;
+    logic [NE-1:0] rv;
+    q = p - PR - 1;
     for (int k = 0; k < NE; k++) begin
-      row     = q - PR + k;
-      rowv[k] = (row >= 0) && (row < N_EFF);
-      if (rowv[k]) n_out = n_out + 1'b1;
-      if (rowv[k] && k >= PR - GUARD_R && k <= PR + GUARD_R) n_in = n_in + 1'b1;
+      row   = q - PR + k;
+      rv[k] = (row >= 0) && (row < N_EFF);     // window row k (row q-PR+k) exists
     end
-    lo = (q < PR) ? PR - q : 0;                         // rows cut below
+    lo = (q < PR) ? PR - q : 0;                          // rows cut below
     hi = (q + PR > N_EFF - 1) ? q + PR - (N_EFF - 1) : 0;  // rows cut above
-    if (hi > PR) hi = PR;                                 // blanked rows (not tested)
-    e_idx = $bits(e_idx)'((lo > 0) ? PR - lo : PR + hi);
+    if (hi > PR) hi = PR;                                  // blanked rows (not tested)
+    geo = {(q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI),   // may detect
+           q >= 1,                                               // row q-1 exists
+           q + 1 < N_RANGE,                                      // row q+1 exists
+           BR'(q), E_W'((lo > 0) ? PR - lo : PR + hi), rv};
+  endfunction
+  // existing rows: whole window (guard = 0) / guard band (guard = 1), an adder tree
+  function automatic logic [NR_W-1:0] n_rows(input logic [NE-1:0] rv, input bit guard);
+    logic [NR_W-1:0] t [64];
+    for (int k = 0; k < 64; k++)
+      t[k] = (k < NE && rv[k % NE] && (!guard || (k >= PR - GUARD_R && k <= PR + GUARD_R)))
+             ? NR_W'(1) : '0;
+    for (int w = 32; w >= 1; w = w / 2)
+      for (int k = 0; k < w; k++) t[k] = t[2 * k] + t[2 * k + 1];
+    n_rows = t[0];
+  endfunction
+
+  localparam logic [GEO_W-1:0] GEO0 = geo(0);
+  logic [P_W-1:0]   pn1_q;               // next pass
+  logic [GEO_W-1:0] geo_n2_q, geo_q;     // its geometry; the current pass's
+  logic [NR_W-1:0]  nout_n3_q, nin_n3_q, nout_q, nin_q;
+  always_ff @(posedge clk) begin
+    pn1_q     <= (p_q == P_W'(NPASS - 1)) ? '0 : p_q + 1'b1;
+    geo_n2_q  <= geo(int'(pn1_q));
+    nout_n3_q <= n_rows(geo_n2_q[NE-1:0], 1'b0);
+    nin_n3_q  <= n_rows(geo_n2_q[NE-1:0], 1'b1);
+    if (rst) begin
+      geo_q  <= GEO0;
+      nout_q <= n_rows(GEO0[NE-1:0], 1'b0);
+      nin_q  <= n_rows(GEO0[NE-1:0], 1'b1);
+    end else if (step && pass_end) begin
+      geo_q  <= geo_n2_q;
+      nout_q <= nout_n3_q;
+      nin_q  <= nin_n3_q;
+    end
   end
 
   // Per-cell control, carried down the pipeline (index = stage)
@@ -234,15 +267,13 @@ module cfar_2d #(
   logic [4:1]        test_q, out_q, last_q, cut_ok_q, rm_ok_q, rp_ok_q;
   logic [BR-1:0]     r_q [5:1];
   logic [BD-1:0]     d_q [5:1];
-  logic [$clog2(NE)-1:0] e_q [5:1];
+  logic [E_W-1:0]    e_q [5:1];
   logic [S_W-1:0]    s_q1, s_q2, s_q3;
   logic [NE-1:0]     rowv1_q;
-  logic [$clog2(NE+1)-1:0] n_out1_q, n_in1_q;
+  logic [NR_W-1:0]   n_out1_q, n_in1_q;
   logic [CNT_W-1:0]  cnt_q [5:2];
 
   always_ff @(posedge clk) begin
-    int q;
-    q = int'(p_q) - PR - 1;
     st_col1_q   <= col;
     st_slot1_q  <= slot_q;
     st_x1_q     <= s_axis_tdata[POW_W-1:0];
@@ -251,16 +282,11 @@ module cfar_2d #(
     test_q[1]   <= testing;
     out_q[1]    <= testing && (s_q >= S_W'(2 * PD));
     last_q[1]   <= pass_end;
-    cut_ok_q[1] <= (q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI);
-    rm_ok_q[1]  <= (q >= 1);                 // row q-1 exists
-    rp_ok_q[1]  <= (q + 1 < N_RANGE);        // row q+1 exists
-    r_q[1]      <= BR'(q);
+    {cut_ok_q[1], rm_ok_q[1], rp_ok_q[1], r_q[1], e_q[1], rowv1_q} <= geo_q;
     d_q[1]      <= BD'(s_q - S_W'(PD));      // centre column (mod N_DOPPLER)
-    e_q[1]      <= e_idx;
     s_q1        <= s_q;
-    rowv1_q     <= rowv;
-    n_out1_q    <= n_out;
-    n_in1_q     <= n_in;
+    n_out1_q    <= nout_q;
+    n_in1_q     <= nin_q;
     for (int k = 2; k <= 4; k++) begin
       test_q[k]   <= test_q[k-1];
       out_q[k]    <= out_q[k-1];
