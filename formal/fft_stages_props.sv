@@ -84,15 +84,16 @@ module fft_sdf_bf_props #(
   end
   always_comb if (!rst) assume (in_pos == f_pos);
 
-  f_vld_pipe #(.LAT(D + 1), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
+  f_vld_pipe #(.LAT(D + 2), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
     .clk, .rst, .en, .in_vld, .in_pos, .out_vld, .out_pos);
 
   // data (D = 1, no rotation): the pair (x0 at even pos, x1 at odd pos) leaves as x0 + x1
-  // (one enabled cycle after x1) then x0 - x1, saturated to W bits with the overflow flag
+  // (two enabled cycles after x1) then x0 - x1, saturated to W bits with the overflow flag
   if (D == 1 && !ROTATE) begin : g_data
     logic       past = 1'b0;
     logic [7:0] e_q, x0_q, x1_q;   // last even sample; the last complete pair
-    logic       ove_q, ov0_q, ov1_q;
+    logic [7:0] y0_q, y1_q;        // the pair before it
+    logic       ove_q, ov0_q, ov1_q, ovy0_q, ovy1_q;
     logic [2:0] ph_q;        // enabled cycles since the pair's x1 (saturating)
     function automatic logic [W-1:0] f_sat(input logic signed [5:0] v);
       f_sat = (v > 6'sd7) ? W'(7) : (v < -6'sd8) ? W'(-8) : W'(v);
@@ -103,8 +104,8 @@ module fft_sdf_bf_props #(
     logic signed [5:0] sr, si, dr, di;
     assign sr = 6'(signed'(x0_q[3:0])) + 6'(signed'(x1_q[3:0]));
     assign si = 6'(signed'(x0_q[7:4])) + 6'(signed'(x1_q[7:4]));
-    assign dr = 6'(signed'(x0_q[3:0])) - 6'(signed'(x1_q[3:0]));
-    assign di = 6'(signed'(x0_q[7:4])) - 6'(signed'(x1_q[7:4]));
+    assign dr = 6'(signed'(y0_q[3:0])) - 6'(signed'(y1_q[3:0]));
+    assign di = 6'(signed'(y0_q[7:4])) - 6'(signed'(y1_q[7:4]));
     always_ff @(posedge clk) begin
       past <= 1'b1;
       if (rst) ph_q <= 3'd7;
@@ -113,6 +114,10 @@ module fft_sdf_bf_props #(
           e_q   <= in_data;
           ove_q <= in_ov;
         end else begin
+          y0_q   <= x0_q;
+          y1_q   <= x1_q;
+          ovy0_q <= ov0_q;
+          ovy1_q <= ov1_q;
           x0_q  <= e_q;
           ov0_q <= ove_q;
           x1_q  <= in_data;
@@ -121,19 +126,20 @@ module fft_sdf_bf_props #(
         ph_q <= in_pos[0] ? 3'd0 : (ph_q == 3'd7 ? 3'd7 : ph_q + 3'd1);
       end
     end
-    // ph_q == 0: the sum leaves now; ph_q == 1: the difference leaves now
+    // ph_q == 1: the last pair's sum leaves now; ph_q == 0 (after a later pair's x1, the
+    // samples at consecutive positions): the pair before's difference leaves now
     always_comb if (past && !rst && out_vld) begin
-      if (ph_q == 3'd0) begin
+      if (ph_q == 3'd1) begin
         assert (out_data == {f_sat(si), f_sat(sr)});
         assert (out_ov == (ov0_q | ov1_q | f_ovf(sr) | f_ovf(si)));
       end
-      if (ph_q == 3'd1) begin
+      if (ph_q == 3'd0) begin
         assert (out_data == {f_sat(di), f_sat(dr)});
-        assert (out_ov == (ov0_q | ov1_q | f_ovf(dr) | f_ovf(di)));
+        assert (out_ov == (ovy0_q | ovy1_q | f_ovf(dr) | f_ovf(di)));
       end
     end
     always_comb if (past && !rst) begin
-      cover (out_vld && ph_q == 3'd1 && out_ov && !ov0_q && !ov1_q);
+      cover (out_vld && ph_q == 3'd0 && out_ov && !ovy0_q && !ovy1_q);
     end
   end
 endmodule
@@ -159,29 +165,28 @@ module fft_twiddle_props #(
     .out_ov);
 
   initial assume (rst);
-  f_vld_pipe #(.LAT(3), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
+  localparam int LAT = 6;   // fft_twiddle's stages
+  f_vld_pipe #(.LAT(LAT), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
     .clk, .rst, .en, .in_vld, .in_pos, .out_vld, .out_pos);
 
   // the overflow flag travels with its sample: an input flag always comes out set;
   // position 0 has twiddle 1 (cos 1, sin 0): the sample leaves unchanged, without overflow
   logic       past = 1'b0;
-  logic [2:0] ov_q, p0_q;
-  logic [2:0][9:0] d_q;
+  logic [LAT-1:0] ov_q, p0_q;
+  logic [LAT-1:0][9:0] d_q;
   always_ff @(posedge clk) begin
     past <= 1'b1;
     if (en) begin
-      ov_q <= {ov_q[1:0], in_ov};
-      p0_q <= {p0_q[1:0], in_pos == '0};
-      d_q[0] <= in_data;
-      d_q[1] <= d_q[0];
-      d_q[2] <= d_q[1];
+      ov_q <= {ov_q[LAT-2:0], in_ov};
+      p0_q <= {p0_q[LAT-2:0], in_pos == '0};
+      d_q  <= {d_q[LAT-2:0], in_data};
     end
   end
   always_comb if (past && !rst && out_vld) begin
-    if (ov_q[2]) assert (out_ov);
-    if (p0_q[2]) assert (out_data == d_q[2] && out_ov == ov_q[2]);
+    if (ov_q[LAT-1]) assert (out_ov);
+    if (p0_q[LAT-1]) assert (out_data == d_q[LAT-1] && out_ov == ov_q[LAT-1]);
   end
-  always_comb if (past && !rst) cover (out_vld && out_ov && !ov_q[2]);
+  always_comb if (past && !rst) cover (out_vld && out_ov && !ov_q[LAT-1]);
 endmodule
 
 `default_nettype wire

@@ -4,7 +4,8 @@
 // axis_checker instances (s_axis assumed, m_axis asserted) and the output FIFO's credit
 // invariants from buf_out_fifo's FORMAL block.
 //   - cells leave in (r, d) order: TUSER counts 0, 1, 2, ... and wraps; TLAST on d = last;
-//   - no cell created or lost: cells out <= last-TX words in <= cells out + 5 (FIFO + stage);
+//   - no cell created or lost: cells out <= last-TX words in <= cells out + 8 (the credit
+//     FIFO's depth: stored + in the pipeline);
 //   - status_framing_error is exactly "some input beat had TLAST != (d == N_DOPPLER-1)",
 //     frame_count exactly the completed input frames (counted here from the input beats);
 //   - the power of a cell is the sum of |x|^2 over its NUM_TX words (NUM_RX = 1 here).
@@ -45,7 +46,7 @@ module nci_props (
   logic [7:0] f_frames;
   logic       f_err;
   logic [POW_W-1:0] f_part [N_DOPPLER];  // TX-0 power per Doppler bin of the current row
-  logic [POW_W-1:0] f_exp  [4];          // expected powers in flight (cell index mod 4)
+  logic [POW_W-1:0] f_exp  [8];          // expected powers in flight (cell index mod 8)
 
   function automatic logic [POW_W-1:0] pow1(input logic [3:0] w);
     logic signed [1:0] i, q;
@@ -68,7 +69,7 @@ module nci_props (
         if (s_axis_tlast != d_q) f_err <= 1'b1;
         if (t_q == 1'b0) f_part[d_q] <= pow1(s_axis_tdata);
         else begin
-          f_exp[f_cells_in[1:0]] <= f_part[d_q] + pow1(s_axis_tdata);
+          f_exp[f_cells_in[2:0]] <= f_part[d_q] + pow1(s_axis_tdata);
           f_cells_in <= f_cells_in + 8'd1;
         end
         d_q <= !d_q;
@@ -88,12 +89,12 @@ module nci_props (
   end
 
   always_comb if (f_past && !rst) begin
-    assert (8'(f_cells_in - f_cells_out) <= 8'd5);
+    assert (8'(f_cells_in - f_cells_out) <= 8'd8);
     if (m_axis_tvalid) begin
       assert (f_cells_in != f_cells_out);
       assert (m_axis_tuser == cell_q);
       assert (m_axis_tlast == cell_q[0]);
-      assert (m_axis_tdata == OUT_W'(f_exp[f_cells_out[1:0]]));
+      assert (m_axis_tdata == OUT_W'(f_exp[f_cells_out[2:0]]));
     end
     assert (framing == f_err);
     assert (frame_count[7:0] == f_frames);

@@ -109,12 +109,17 @@ class AxisTB:
                 self.out_last = self.cycle
 
     def set_idle_generator(self, generator: Iterator[bool] | None) -> None:
-        """TVALID gaps on the source (None = back to back)."""
+        """TVALID gaps on the source (None = back to back: cocotbext keeps the last pause
+        value when its generator is removed, so it is cleared here)."""
         self.source.set_pause_generator(generator)
+        if generator is None:
+            self.source.pause = False
 
     def set_backpressure_generator(self, generator: Iterator[bool] | None) -> None:
-        """TREADY stalls on the sink (None = always ready)."""
+        """TREADY stalls on the sink (None = always ready, the last pause value cleared)."""
         self.sink.set_pause_generator(generator)
+        if generator is None:
+            self.sink.pause = False
 
     async def wait_quiet(self, quiet: int = 64) -> None:
         """Wait until the source has sent everything and neither interface has had TVALID

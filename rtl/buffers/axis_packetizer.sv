@@ -105,7 +105,7 @@ module axis_packetizer #(
   logic [BANK_W+POS_W-1:0] ram_wr_addr, ram_rd_addr;
   logic [WORD_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(NUM_BANKS << POS_W)) u_ram (
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(NUM_BANKS << POS_W), .OUT_REG(1'b1)) u_ram (
     .clk     (clk),
     .wr_en   (ram_wr_en),
     .wr_addr (ram_wr_addr),
@@ -166,14 +166,16 @@ module axis_packetizer #(
   // Output side: header (if any), the payload of bank rd_bank_q, then (with the header) the
   // CRC word. The bank is released after its last payload read; the CRC word is issued the
   // next clock from crc_q, which by the time it enters the FIFO has taken in every word of
-  // the packet (a word enters the FIFO the clock after its issue).
+  // the packet (a word enters the FIFO two clocks after its issue: the RAM's read and output
+  // registers; the header word and the sideband wait as long).
   logic [BANK_W-1:0] rd_bank_q;
   logic [POS_W-1:0] rd_idx_q;
   logic             hdr_sent_q;
   logic             crc_due_q;           // payload issued, the CRC word comes next
   logic             can_issue, issue, issue_hdr, issue_data, issue_crc, rd_last;
   logic             p_hdr_q, p_data_q, p_crc_q, p_last_q;  // sideband of last clock's issue
-  logic [WORD_W-1:0] hdr_word, p_hdr_word_q, push_word;
+  logic             p2_hdr_q, p2_data_q, p2_crc_q, p2_last_q;   // ... and the clock before
+  logic [WORD_W-1:0] hdr_word, p_hdr_word_q, p2_hdr_word_q, push_word;
   logic [31:0]      crc_q, crc_next;     // CRC-32 state (not inverted) of the packet so far
   logic [31:0]      crc_sent;            // the CRC word's lane 0: the final state inverted
   desc_t            rd_desc;
@@ -206,22 +208,22 @@ module axis_packetizer #(
   assign hdr_word = hdr_full[WORD_W-1:0];
 
   // CRC-32 at line rate: one word per clock, the header word starting from all ones
-  assign push_word = p_hdr_q ? p_hdr_word_q : ram_rd_data;
+  assign push_word = p2_hdr_q ? p2_hdr_word_q : ram_rd_data;
   assign crc_sent  = ~crc_q;
   packet_crc32 #(.LANES(NUM_RX)) u_crc (
-    .crc_in  (p_hdr_q ? 32'hFFFF_FFFF : crc_q),
+    .crc_in  (p2_hdr_q ? 32'hFFFF_FFFF : crc_q),
     .data    (push_word),
     .crc_out (crc_next)
   );
 
   logic [WORD_W:0] fifo_tdata;
 
-  buf_out_fifo #(.WIDTH(WORD_W + 1), .DEPTH(4)) u_out (
+  buf_out_fifo #(.WIDTH(WORD_W + 1), .DEPTH(4), .LATENCY(2)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (issue),
-    .in_data       ({p_last_q, p_crc_q ? WORD_W'(crc_sent) : push_word}),
+    .in_data       ({p2_last_q, p2_crc_q ? WORD_W'(crc_sent) : push_word}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
@@ -251,7 +253,12 @@ module axis_packetizer #(
     p_crc_q      <= issue_crc;
     p_last_q     <= HEADER ? issue_crc : (issue_data && rd_last);
     p_hdr_word_q <= hdr_word;
-    if (p_hdr_q || p_data_q) crc_q <= crc_next;
+    p2_hdr_q      <= p_hdr_q;
+    p2_data_q     <= p_data_q;
+    p2_crc_q      <= p_crc_q;
+    p2_last_q     <= p_last_q;
+    p2_hdr_word_q <= p_hdr_word_q;
+    if (p2_hdr_q || p2_data_q) crc_q <= crc_next;
     if (beat && pkt_end && cnt_next != '0) desc_q[wr_bank_q] <= new_desc;
   end
 

@@ -1,21 +1,24 @@
 // SPDX-License-Identifier: Apache-2.0
-// Small register FIFO that turns a one-clock-latency memory read pipeline into an AXI4-Stream
-// source: issue a read only when can_issue, the data arrives on in_data one clock later.
+// Small register FIFO that turns a fixed-latency read pipeline into an AXI4-Stream source:
+// issue a read only when can_issue, its data arrives on in_data LATENCY clocks later.
 `default_nettype none
 
 module buf_out_fifo #(
   // Width of one entry in bits (data plus sideband), 1..8192.
   parameter int WIDTH = 32,
-  // Entries, power of two, 4..64. Four sustain one word per clock with can_issue taken
-  // from registers only (no combinational path from m_axis_tready to the read enable).
-  parameter int DEPTH = 4
+  // Entries, power of two, 4..64. DEPTH >= LATENCY + 2 sustains one word per clock with
+  // can_issue taken from registers only (no combinational path from m_axis_tready to the
+  // read enable).
+  parameter int DEPTH = 4,
+  // Clocks from issue to in_data, 1..32 (2 for a block RAM with its output registered).
+  parameter int LATENCY = 1
 ) (
   input  wire logic             clk,
   input  wire logic             rst,
   // Read pipeline side
   output logic                  can_issue,  // room for one more read in flight
   input  wire logic             issue,      // a read was issued this clock (only if can_issue)
-  input  wire logic [WIDTH-1:0] in_data,    // data of the read issued the previous clock
+  input  wire logic [WIDTH-1:0] in_data,    // data of the read issued LATENCY clocks ago
   // AXI4-Stream source (tdata carries the whole entry, the parent splits it)
   output logic      [WIDTH-1:0] m_axis_tdata,
   output logic                  m_axis_tvalid,
@@ -31,15 +34,18 @@ module buf_out_fifo #(
   if (WIDTH < 1 || WIDTH > 8192) begin : g_bad_width
     $fatal(1, "%m: WIDTH=%0d out of range", WIDTH);
   end
+  if (LATENCY < 1 || LATENCY > 32) begin : g_bad_latency
+    $fatal(1, "%m: LATENCY=%0d out of range 1..32", LATENCY);
+  end
 
   logic [WIDTH-1:0] mem_q [DEPTH];
   logic [PTR_W-1:0] wr_ptr_q, rd_ptr_q;
   logic [PTR_W:0]   count_q;        // entries stored
   logic [PTR_W:0]   credit_q;       // entries stored + reads in flight
-  logic             inflight_q;     // a read was issued last clock
+  logic [LATENCY-1:0] inflight_q;   // bit k: a read was issued k+1 clocks ago
   logic             push, pop;
 
-  assign push          = inflight_q;
+  assign push          = inflight_q[LATENCY-1];
   assign pop           = m_axis_tvalid && m_axis_tready;
   assign m_axis_tvalid = (count_q != '0);
   assign m_axis_tdata  = mem_q[rd_ptr_q];
@@ -55,9 +61,9 @@ module buf_out_fifo #(
       rd_ptr_q   <= '0;
       count_q    <= '0;
       credit_q   <= '0;
-      inflight_q <= 1'b0;
+      inflight_q <= '0;
     end else begin
-      inflight_q <= issue;
+      inflight_q <= (inflight_q << 1) | LATENCY'(issue);
       if (push) wr_ptr_q <= wr_ptr_q + 1'b1;
       if (pop)  rd_ptr_q <= rd_ptr_q + 1'b1;
       count_q  <= count_q + (PTR_W+1)'(push) - (PTR_W+1)'(pop);
@@ -85,10 +91,15 @@ module buf_out_fifo #(
   initial assume (rst);
   always_comb if (!rst) assume (!issue || can_issue);
 `endif
+  logic [PTR_W:0] f_inflight;
+  always_comb begin
+    f_inflight = '0;
+    for (int k = 0; k < LATENCY; k++) f_inflight = f_inflight + (PTR_W+1)'(inflight_q[k]);
+  end
   always_comb if (f_past && !rst) begin
     assert (!issue || can_issue);
     assert (count_q <= (PTR_W+1)'(DEPTH));
-    assert (credit_q == count_q + (PTR_W+1)'(inflight_q));
+    assert (credit_q == count_q + f_inflight);
     assert (credit_q == (PTR_W+1)'(f_issued - f_popped));
     assert (PTR_W'(wr_ptr_q - rd_ptr_q) == count_q[PTR_W-1:0]);
   end

@@ -96,12 +96,13 @@ module corner_turn #(
   endfunction
 
   // ---------------------------------------------------------------------------------------
-  // Frame memory (one frame, simple dual port, registered read)
+  // Frame memory (one frame, simple dual port, registered read and output register: a read
+  // issued at clock t enters the output FIFO at t+2)
   logic              ram_wr_en, ram_rd_en;
   logic [B-1:0]      ram_wr_addr, ram_rd_addr;
   logic [WORD_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(1 << B)) u_ram (
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(1 << B), .OUT_REG(1'b1)) u_ram (
     .clk     (clk),
     .wr_en   (ram_wr_en),
     .wr_addr (ram_wr_addr),
@@ -125,7 +126,7 @@ module corner_turn #(
   logic [SH_W-1:0] rd_shift_q;   // (k+1)*ROT mod B for the frame being read
   logic            rd_active_q;
   logic            can_issue, rd_issue, rd_start;
-  logic            p_last_q, p_sof_q;
+  logic            p_last_q, p_sof_q, p2_last_q, p2_sof_q;
 
   // The writer may use slot W_{k+1}(i) = R_k(i) only once read i was issued (earlier clock).
   assign s_axis_tready = !rst && !pending_q && (!rd_active_q || (wr_cnt_q < rd_cnt_q));
@@ -177,8 +178,10 @@ module corner_turn #(
   end
 
   always_ff @(posedge clk) begin
-    p_last_q <= (rd_cnt_q[BD-1:0] == '1);
-    p_sof_q  <= (rd_cnt_q == '0);
+    p_last_q  <= (rd_cnt_q[BD-1:0] == '1);
+    p_sof_q   <= (rd_cnt_q == '0);
+    p2_last_q <= p_last_q;
+    p2_sof_q  <= p_sof_q;
   end
 
   always_ff @(posedge clk) begin
@@ -226,12 +229,12 @@ module corner_turn #(
   // Output
   logic [WORD_W+1:0] fifo_tdata;
 
-  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4)) u_out (
+  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4), .LATENCY(2)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (rd_issue),
-    .in_data       ({p_sof_q, p_last_q, ram_rd_data}),
+    .in_data       ({p2_sof_q, p2_last_q, ram_rd_data}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)

@@ -371,7 +371,7 @@ module frame_store_axi #(
   logic [BUF_AW-1:0] ram_rd_addr;
   logic [UNIT_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(UNIT_W), .DEPTH(BUF_DEPTH)) u_strip_buf (
+  buf_sdp_ram #(.WIDTH(UNIT_W), .DEPTH(BUF_DEPTH), .OUT_REG(1'b1)) u_strip_buf (
     .clk     (clk),
     .wr_en   (r_unit),
     .wr_addr (buf_wptr_q),
@@ -390,8 +390,8 @@ module frame_store_axi #(
   logic [1:0]     out_sc_q;      // groups completely read out (mod 4)
   logic           can_issue, o_issue, o_strip_end;
   logic [OIW-1:0] o_word;        // word index inside the group (memory order)
-  logic           p_last_q, p_sof_q;
-  logic [(BWPU > 0 ? BWPU : 1)-1:0] p_sel_q;
+  logic           p_last_q, p_sof_q, p2_last_q, p2_sof_q;   // read issued 1 / 2 clocks ago
+  logic [(BWPU > 0 ? BWPU : 1)-1:0] p_sel_q, p2_sel_q;
 
   always_comb begin
     logic [31:0] idx, d_, t_, r_;
@@ -411,26 +411,29 @@ module frame_store_axi #(
     p_last_q <= ((o_idx_q & OIW'(N_DOPPLER - 1)) == OIW'(N_DOPPLER - 1));
     p_sof_q  <= (o_idx_q == '0) && (o_strip_q == '0);
     p_sel_q  <= (BWPU > 0) ? o_word[(BWPU > 0 ? BWPU : 1)-1:0] : '0;
+    p2_last_q <= p_last_q;
+    p2_sof_q  <= p_sof_q;
+    p2_sel_q  <= p_sel_q;
   end
 
   logic [WORD_W-1:0] o_word_data;
   if (WPU > 1) begin : g_o_select
-    assign o_word_data = ram_rd_data[p_sel_q*WORD_W +: WORD_W];
+    assign o_word_data = ram_rd_data[p2_sel_q*WORD_W +: WORD_W];
   end else begin : g_o_whole
     assign o_word_data = ram_rd_data[WORD_W-1:0];
     /* verilator lint_off UNUSEDSIGNAL */
     logic unused_sel;
-    assign unused_sel = ^p_sel_q;
+    assign unused_sel = ^p2_sel_q;
     /* verilator lint_on UNUSEDSIGNAL */
   end
 
   logic [WORD_W+1:0] fifo_tdata;
-  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4)) u_out (
+  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4), .LATENCY(2)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (o_issue),
-    .in_data       ({p_sof_q, p_last_q, o_word_data}),
+    .in_data       ({p2_sof_q, p2_last_q, o_word_data}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)

@@ -159,121 +159,253 @@ module cfar_2d #(
   assign col      = (s_q < S_W'(N_DOPPLER)) ? BD'(s_q) : BD'(s_q - S_W'(N_DOPPLER));
 
   // ---------------------------------------------------------------------------------------
+  // Pipeline: one column step per clock, no stall inside (a step is taken only when the
+  // output FIFOs have room for every cell in flight). Stage k = k clocks after the step:
+  //    1  column store read data (the RAM's own read register); the step's row geometry
+  //    2  read data registered again (block RAM output before any logic); written back
+  //       with the input cell (read-modify-write); slot masks of the window rows
+  //    3  vertical sums, first two adder levels over the masked slots; the CUT-row and
+  //       range-neighbour cells picked from the word
+  //    4  vertical sums done (vo: window rows, vi: guard rows): the column arrives, shifts
+  //       into the column shift registers and updates the running window sums
+  //    5  window sums (CA total or the GO/SO halves); the cell, its neighbours, count,
+  //       {r, d} and TLAST -> early output FIFO
+  //    6  training sum S (GO/SO select), the row's threshold scale: multiplier inputs
+  //    7  partial products S_i * scale_j (17 x 17 bits: one DSP48E2 / MULT18 each)
+  //    8  partial products summed per scale chunk
+  //    9  product S * scale
+  //   10  decision CUT * 2^SCALE_FRAC > S * scale -> late output FIFO with S
+  localparam int LAT_E = 5;     // step -> early FIFO entry
+  localparam int LAT_L = 10;    // step -> late FIFO entry (the output's valid)
+
+  // ---------------------------------------------------------------------------------------
   // Column store: word d = cells of column d of the last ROWS rows, slot = row mod ROWS
-  logic [CW_W-1:0] cw_rd, cw_wr;
-  logic            st_wr_q;
-  logic [BD-1:0]   st_col_q;
-  logic [SLOT_W-1:0] st_slot_q;
-  logic [POW_W-1:0] st_x_q;
+  logic [CW_W-1:0]   cw_rd, cw2_q, cw_wr;
+  logic              st_wr1_q, st_wr2_q;
+  logic [BD-1:0]     st_col1_q, st_col2_q;
+  logic [SLOT_W-1:0] st_slot1_q;
+  logic [POW_W-1:0]  st_x1_q, st_x2_q;
+  logic [ROWS-1:0]   wsel2_q;   // slot written back (one-hot)
 
   buf_sdp_ram #(.WIDTH(CW_W), .DEPTH(N_DOPPLER)) u_store (
     .clk     (clk),
-    .wr_en   (st_wr_q),
-    .wr_addr (st_col_q),
+    .wr_en   (st_wr2_q),
+    .wr_addr (st_col2_q),
     .wr_data (cw_wr),
     .rd_en   (step),
     .rd_addr (col),
     .rd_data (cw_rd)
   );
 
-  // Slot selects are ROWS-way decodes with constant part-selects (a variable part-select
-  // of the CW_W-bit word would be a full-width shifter per use)
+  // A column is read again N_DOPPLER >= 4 steps after its write-back (2 clocks after its
+  // read): no read-after-write hazard.
+  always_ff @(posedge clk) cw2_q <= cw_rd;
+
   always_comb begin
-    cw_wr = cw_rd;
+    cw_wr = cw2_q;
     for (int s = 0; s < ROWS; s++)
-      if (st_slot_q == SLOT_W'(s)) cw_wr[s * POW_W +: POW_W] = st_x_q;
+      if (wsel2_q[s]) cw_wr[s * POW_W +: POW_W] = st_x2_q;
   end
 
   // ---------------------------------------------------------------------------------------
-  // Row geometry of the tested row q = p - PR - 1, computed at the step, used next clock
-  logic [NE-1:0]     rowv;       // window row k (row q-PR+k) exists
-  logic [$clog2(NE+1)-1:0] n_out, n_in;   // existing rows: whole window / guard band
-  logic [$clog2(NE)-1:0]   e_idx;
-  always_comb begin
+  // Row geometry of pass p (tested row q = p - PR - 1): which window rows exist, the edge
+  // index, whether the row may detect and has range neighbours. It changes only between passes, so the next pass's geometry is computed ahead in three
+  // register stages (a pass lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
+  localparam int E_W   = $clog2(NE);
+  localparam int NR_W  = $clog2(NE + 1);
+  localparam int GEO_W = 3 + BR + E_W + NE;   // {cut_ok, rm_ok, rp_ok, r, e, rowv}
+  // (results assigned to the function name, no `return`: Yosys reads the file as written)
+  function automatic logic [GEO_W-1:0] geo(input int p);
     int q, row, lo, hi;
-    q     = int'(p_q) - PR - 1;
-    n_out = '0;
-    n_in  = '0;
+    logic [NE-1:0] rv;
+    q = p - PR - 1;
     for (int k = 0; k < NE; k++) begin
-      row     = q - PR + k;
-      rowv[k] = (row >= 0) && (row < N_EFF);
-      if (rowv[k]) n_out = n_out + 1'b1;
-      if (rowv[k] && k >= PR - GUARD_R && k <= PR + GUARD_R) n_in = n_in + 1'b1;
+      row   = q - PR + k;
+      rv[k] = (row >= 0) && (row < N_EFF);     // window row k (row q-PR+k) exists
     end
-    lo = (q < PR) ? PR - q : 0;                         // rows cut below
+    lo = (q < PR) ? PR - q : 0;                          // rows cut below
     hi = (q + PR > N_EFF - 1) ? q + PR - (N_EFF - 1) : 0;  // rows cut above
-    if (hi > PR) hi = PR;                                 // blanked rows (not tested)
-    e_idx = $bits(e_idx)'((lo > 0) ? PR - lo : PR + hi);
+    if (hi > PR) hi = PR;                                  // blanked rows (not tested)
+    geo = {(q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI),   // may detect
+           q >= 1,                                               // row q-1 exists
+           q + 1 < N_RANGE,                                      // row q+1 exists
+           BR'(q), E_W'((lo > 0) ? PR - lo : PR + hi), rv};
+  endfunction
+  // existing rows: whole window (guard = 0) / guard band (guard = 1), an adder tree
+  function automatic logic [NR_W-1:0] n_rows(input logic [NE-1:0] rv, input bit guard);
+    logic [NR_W-1:0] t [64];
+    for (int k = 0; k < 64; k++)
+      t[k] = (k < NE && rv[k % NE] && (!guard || (k >= PR - GUARD_R && k <= PR + GUARD_R)))
+             ? NR_W'(1) : '0;
+    for (int w = 32; w >= 1; w = w / 2)
+      for (int k = 0; k < w; k++) t[k] = t[2 * k] + t[2 * k + 1];
+    n_rows = t[0];
+  endfunction
+
+  localparam logic [GEO_W-1:0] GEO0 = geo(0);
+  logic [P_W-1:0]   pn1_q;               // next pass
+  logic [GEO_W-1:0] geo_n2_q, geo_q;     // its geometry; the current pass's
+  logic [NR_W-1:0]  nout_n3_q, nin_n3_q, nout_q, nin_q;
+  always_ff @(posedge clk) begin
+    pn1_q     <= (p_q == P_W'(NPASS - 1)) ? '0 : p_q + 1'b1;
+    geo_n2_q  <= geo(int'(pn1_q));
+    nout_n3_q <= n_rows(geo_n2_q[NE-1:0], 1'b0);
+    nin_n3_q  <= n_rows(geo_n2_q[NE-1:0], 1'b1);
+    if (rst) begin
+      geo_q  <= GEO0;
+      nout_q <= n_rows(GEO0[NE-1:0], 1'b0);
+      nin_q  <= n_rows(GEO0[NE-1:0], 1'b1);
+    end else if (step && pass_end) begin
+      geo_q  <= geo_n2_q;
+      nout_q <= nout_n3_q;
+      nin_q  <= nin_n3_q;
+    end
   end
 
-  // Stage 1 registers (the step's read data arrives with them)
-  logic              v1_q, test1_q, out1_q, last1_q, cut_ok1_q, rm_ok1_q, rp_ok1_q;
+  // Per-cell control, carried down the pipeline (index = stage)
+  logic [4:1]        v_q;        // a step's data is in stage k (reset)
+  logic [4:1]        test_q, out_q, last_q, cut_ok_q, rm_ok_q, rp_ok_q;
+  logic [BR-1:0]     r_q [5:1];
+  logic [BD-1:0]     d_q [5:1];
+  logic [E_W-1:0]    e_q [5:1];
+  logic [S_W-1:0]    s_q1, s_q2, s_q3;
   logic [NE-1:0]     rowv1_q;
-  logic [$clog2(NE+1)-1:0] n_out1_q, n_in1_q;
-  logic [$clog2(NE)-1:0]   e1_q;
-  logic [BR-1:0]     r1_q;
-  logic [BD-1:0]     d1_q;
+  logic [NR_W-1:0]   n_out1_q, n_in1_q;
+  logic [CNT_W-1:0]  cnt_q [5:2];
 
   always_ff @(posedge clk) begin
-    int q;
-    q = int'(p_q) - PR - 1;
-    st_col_q  <= col;
-    st_slot_q <= slot_q;
-    st_x_q    <= s_axis_tdata[POW_W-1:0];
-    test1_q   <= testing;
-    out1_q    <= testing && (s_q >= S_W'(2 * PD));
-    last1_q   <= pass_end;
-    rowv1_q   <= rowv;
-    n_out1_q  <= n_out;
-    n_in1_q   <= n_in;
-    e1_q      <= e_idx;
-    cut_ok1_q <= (q < N_EFF) && (q >= REPORT_LO) && (q < REPORT_HI);
-    rm_ok1_q  <= (q >= 1);                 // row q-1 exists
-    rp_ok1_q  <= (q + 1 < N_RANGE);        // row q+1 exists
-    r1_q      <= BR'(q);
-    d1_q      <= BD'(s_q - S_W'(PD));   // centre column (mod N_DOPPLER)
+    st_col1_q   <= col;
+    st_slot1_q  <= slot_q;
+    st_x1_q     <= s_axis_tdata[POW_W-1:0];
+    st_col2_q   <= st_col1_q;
+    st_x2_q     <= st_x1_q;
+    test_q[1]   <= testing;
+    out_q[1]    <= testing && (s_q >= S_W'(2 * PD));
+    last_q[1]   <= pass_end;
+    {cut_ok_q[1], rm_ok_q[1], rp_ok_q[1], r_q[1], e_q[1], rowv1_q} <= geo_q;
+    d_q[1]      <= BD'(s_q - S_W'(PD));      // centre column (mod N_DOPPLER)
+    s_q1        <= s_q;
+    n_out1_q    <= nout_q;
+    n_in1_q     <= nin_q;
+    for (int k = 2; k <= 4; k++) begin
+      test_q[k]   <= test_q[k-1];
+      out_q[k]    <= out_q[k-1];
+      last_q[k]   <= last_q[k-1];
+      cut_ok_q[k] <= cut_ok_q[k-1];
+      rm_ok_q[k]  <= rm_ok_q[k-1];
+      rp_ok_q[k]  <= rp_ok_q[k-1];
+    end
+    for (int k = 2; k <= 5; k++) begin
+      r_q[k] <= r_q[k-1];
+      d_q[k] <= d_q[k-1];
+      e_q[k] <= e_q[k-1];
+    end
+    s_q2 <= s_q1;
+    s_q3 <= s_q2;
+    if (KIND == 0)
+      cnt_q[2] <= CNT_W'(n_out1_q * (2 * PD + 1) - n_in1_q * (2 * GUARD_D + 1));
+    else
+      cnt_q[2] <= CNT_W'(n_out1_q * PD - n_in1_q * GUARD_D);
+    for (int k = 3; k <= 5; k++) cnt_q[k] <= cnt_q[k-1];
   end
 
-  // ---------------------------------------------------------------------------------------
-  // Vertical sums of the arriving column over the tested row's window
-  logic [POW_W-1:0] win [NE];     // win[k]: cell of window row q-PR+k (slot (p+1+k) mod ROWS)
-  always_comb begin
-    for (int k = 0; k < NE; k++) win[k] = '0;
-    for (int s = 0; s < ROWS; s++)
-      if (st_slot_q == SLOT_W'(s))
-        for (int k = 0; k < NE; k++) win[k] = cw_rd[((s + 1 + k) % ROWS) * POW_W +: POW_W];
-  end
-
-  logic [SUM_W-1:0] vo, vi;
-  logic [POW_W-1:0] vcut;
-  always_comb begin
-    vo   = '0;
-    vi   = '0;
-    vcut = '0;
-    for (int k = 0; k < NE; k++) begin
-      if (rowv1_q[k]) begin
-        vo = vo + SUM_W'(win[k]);
-        if (k >= PR - GUARD_R && k <= PR + GUARD_R) vi = vi + SUM_W'(win[k]);
-      end
-      if (k == PR) vcut = win[k];
+  // Stage 2: slot masks. Window row k of the tested row sits in slot (slot+1+k) mod ROWS.
+  logic [ROWS-1:0] mo2_q, mi2_q, mc2_q, mrm2_q, mrp2_q;
+  always_ff @(posedge clk) begin
+    for (int s = 0; s < ROWS; s++) begin
+      wsel2_q[s] <= (st_slot1_q == SLOT_W'(s));
+      mo2_q[s]   <= 1'b0;
+      mi2_q[s]   <= 1'b0;
+      mc2_q[s]   <= 1'b0;
+      mrm2_q[s]  <= 1'b0;
+      mrp2_q[s]  <= 1'b0;
+      for (int k = 0; k < NE; k++)
+        if (st_slot1_q == SLOT_W'((s + ROWS - 1 - k) % ROWS)) begin
+          mo2_q[s]  <= rowv1_q[k];
+          mi2_q[s]  <= rowv1_q[k] && k >= PR - GUARD_R && k <= PR + GUARD_R;
+          mc2_q[s]  <= (k == PR);
+          mrm2_q[s] <= (k == PR - 1);
+          mrp2_q[s] <= (k == PR + 1);
+        end
     end
   end
 
+  // Stage 3: masked slots summed in two adder levels (64 -> 16 terms; slots beyond ROWS
+  // are constant zero), the CUT-row and range-neighbour cells selected (AND-OR over slots)
+  logic [SUM_W-1:0] po3_q [16], pi3_q [16];
+  logic [POW_W-1:0] c3_q, rm3_q, rp3_q;
+  always_ff @(posedge clk) begin
+    logic [SUM_W-1:0] xo [64], xi [64];
+    logic [POW_W-1:0] c, m, p, w;
+    c = '0;
+    m = '0;
+    p = '0;
+    for (int s = 0; s < 64; s++) begin
+      xo[s] = '0;
+      xi[s] = '0;
+      if (s < ROWS) begin
+        w = cw2_q[(s % ROWS) * POW_W +: POW_W];
+        if (mo2_q[s % ROWS]) xo[s] = SUM_W'(w);
+        if (mi2_q[s % ROWS]) xi[s] = SUM_W'(w);
+        if (mc2_q[s % ROWS]) c = c | w;
+        if (mrm2_q[s % ROWS]) m = m | w;
+        if (mrp2_q[s % ROWS]) p = p | w;
+      end
+    end
+    for (int i = 0; i < 32; i++) begin
+      xo[i] = xo[2 * i] + xo[2 * i + 1];
+      xi[i] = xi[2 * i] + xi[2 * i + 1];
+    end
+    for (int i = 0; i < 16; i++) begin
+      po3_q[i] <= xo[2 * i] + xo[2 * i + 1];
+      pi3_q[i] <= xi[2 * i] + xi[2 * i + 1];
+    end
+    c3_q  <= c;
+    rm3_q <= m;
+    rp3_q <= p;
+  end
+
+  // Stage 4: vertical sums complete (the remaining adder levels)
+  logic [SUM_W-1:0] vo4_q, vi4_q;
+  logic [POW_W-1:0] vcut4_q, rm4_q, rp4_q;
+  logic             first4_q;    // column step 0 of the pass (the running sums restart)
+  always_ff @(posedge clk) begin
+    logic [SUM_W-1:0] xo [16], xi [16];
+    for (int i = 0; i < 16; i++) begin
+      xo[i] = po3_q[i];
+      xi[i] = pi3_q[i];
+    end
+    for (int w = 8; w >= 1; w = w / 2)
+      for (int i = 0; i < w; i++) begin
+        xo[i] = xo[2 * i] + xo[2 * i + 1];
+        xi[i] = xi[2 * i] + xi[2 * i + 1];
+      end
+    vo4_q    <= xo[0];
+    vi4_q    <= xi[0];
+    vcut4_q  <= c3_q;
+    rm4_q    <= rm3_q;
+    rp4_q    <= rp3_q;
+    first4_q <= (s_q3 == '0);
+  end
+
+  // ---------------------------------------------------------------------------------------
   // Shift register of the previous 2*PD columns' sums (index 0 = newest), of the previous
   // PD+1 columns' CUT-row cells (the CUT at PD-1, its Doppler neighbours at PD and PD-2)
   // and of the previous PD columns' cells in rows q-1 and q+1 (the CUT's column at PD-1)
+  logic             ev4;         // a tested row's column arrives
   logic [SUM_W-1:0] sr_o [2*PD];
   logic [SUM_W-1:0] sr_i [2*PD];
   logic [POW_W-1:0] sr_c [PD+1];
   logic [POW_W-1:0] sr_rm [PD];
   logic [POW_W-1:0] sr_rp [PD];
+  assign ev4 = v_q[4] && test_q[4];
   always_ff @(posedge clk) begin
-    if (v1_q && test1_q) begin
-      sr_o[0]  <= vo;
-      sr_i[0]  <= vi;
-      sr_c[0]  <= vcut;
-      sr_rm[0] <= win[PR-1];
-      sr_rp[0] <= win[PR+1];
+    if (ev4) begin
+      sr_o[0]  <= vo4_q;
+      sr_i[0]  <= vi4_q;
+      sr_c[0]  <= vcut4_q;
+      sr_rm[0] <= rm4_q;
+      sr_rp[0] <= rp4_q;
       for (int k = 1; k < 2 * PD; k++) begin
         sr_o[k] <= sr_o[k-1];
         sr_i[k] <= sr_i[k-1];
@@ -286,55 +418,139 @@ module cfar_2d #(
     end
   end
 
-  // Neighbour powers of the centre cell (Doppler +1 is the arriving column when PD = 1)
-  logic [POW_W-1:0] nb_rm, nb_rp, nb_dm, nb_dp;
-  assign nb_rm = rm_ok1_q ? sr_rm[PD-1] : '0;
-  assign nb_rp = rp_ok1_q ? sr_rp[PD-1] : '0;
-  assign nb_dm = sr_c[PD];
-  if (PD > 1) begin : g_dp_sr
-    assign nb_dp = sr_c[PD-2];
-  end else begin : g_dp_arriving
-    assign nb_dp = vcut;
-  end
-
-  // Window around the centre column (offset j = -PD..PD; j = PD is the arriving column)
-  logic [SUM_W-1:0] sum_l, sum_r, sum_c, sum_sel;
-  logic [POW_W-1:0] cut;
-  logic [CNT_W-1:0] cnt;
-  always_comb begin
-    logic [SUM_W-1:0] wo, wi;
-    sum_l = '0;
-    sum_r = '0;
-    sum_c = '0;
-    // offsets -PD..PD-1 from the shift register (index PD-1-j), offset PD is the arriving
-    // column (always a training column: PD > GUARD_D)
-    for (int j = -PD; j < PD; j++) begin
-      wo = sr_o[PD - 1 - j];
-      wi = sr_i[PD - 1 - j];
-      if (j < 0) sum_l = sum_l + wo - ((j >= -GUARD_D) ? wi : '0);
-      if (j > 0) sum_r = sum_r + wo - ((j <= GUARD_D) ? wi : '0);
-      if (j == 0) sum_c = wo - wi;
+  // Running window sums: wsum[w] = sum of sr_x[A..B] before the shift (x = o or i), kept
+  // by adding the entry that enters position A and subtracting the one leaving B at each
+  // shift; an entry counts only once it belongs to this pass (at column step s, position k
+  // holds the pass's column s-1-k), so the sum restarts at step 0. CA: w0 = sr_o[0..2PD-1],
+  // w1 = sr_i[guard columns]; GO/SO: w0/w1 = left half o/i, w2/w3 = right half o/i.
+  // (results assigned to the function name, no `return`: Yosys reads the file as written)
+  function automatic int win_a(input int w);
+    if (KIND == 0) win_a = (w == 0) ? 0 : PD - 1 - GUARD_D;
+    else           win_a = (w < 2) ? PD : ((w == 2) ? 0 : PD - 1 - GUARD_D);
+  endfunction
+  function automatic int win_b(input int w);
+    if (KIND == 0) win_b = (w == 0) ? 2 * PD - 1 : PD - 1 + GUARD_D;
+    else           win_b = (w == 0) ? 2 * PD - 1 : ((w == 1) ? PD - 1 + GUARD_D : PD - 2);
+  endfunction
+  localparam int NW = (KIND == 0) ? 2 : 4;
+  logic [SUM_W-1:0] wsum [4];
+  for (genvar w = 0; w < 4; w++) begin : g_win
+    localparam int A = win_a(w);
+    localparam int B = win_b(w);
+    localparam bit IS_O = (w % 2 == 0);
+    if (w >= NW || B < A) begin : g_empty
+      assign wsum[w] = '0;
+    end else begin : g_run
+      logic [SUM_W-1:0] w_q, enter, leave;
+      logic             en_q, lv_q;
+      if (A == 0) begin : g_arriving
+        assign enter = IS_O ? vo4_q : vi4_q;
+        assign en_q  = 1'b1;
+      end else begin : g_shifted
+        assign enter = IS_O ? sr_o[A-1] : sr_i[A-1];
+        always_ff @(posedge clk) en_q <= (s_q3 >= S_W'(A));
+      end
+      assign leave   = IS_O ? sr_o[B] : sr_i[B];
+      assign wsum[w] = first4_q ? '0 : w_q;
+      always_ff @(posedge clk) begin
+        lv_q <= (s_q3 >= S_W'(B + 1));
+        if (ev4) w_q <= wsum[w] + (en_q ? enter : '0) - (lv_q ? leave : '0);
+      end
     end
-    sum_r = sum_r + vo;
-    cut = sr_c[PD - 1];
-    unique case (KIND)
-      1:       sum_sel = (sum_l > sum_r) ? sum_l : sum_r;
-      2:       sum_sel = (sum_l < sum_r) ? sum_l : sum_r;
-      default: sum_sel = sum_l + sum_r + sum_c;
-    endcase
-    if (KIND == 0)
-      cnt = CNT_W'(n_out1_q * (2 * PD + 1) - n_in1_q * (2 * GUARD_D + 1));
-    else
-      cnt = CNT_W'(n_out1_q * PD - n_in1_q * GUARD_D);
   end
 
-  logic [SCALE_W-1:0] scale;
-  logic [PROD_W-1:0]  prod, cut_sh;
-  logic               detect;
-  assign scale  = cfg_scale[e1_q * SCALE_W +: SCALE_W];
-  assign prod   = PROD_W'(sum_sel) * PROD_W'(scale);
-  assign cut_sh = PROD_W'(cut) << SCALE_FRAC;
-  assign detect = cut_ok1_q && (cut_sh > prod);
+  logic [POW_W-1:0] nb_dp4;
+  if (PD > 1) begin : g_dp_sr
+    assign nb_dp4 = sr_c[PD-2];
+  end else begin : g_dp_arriving
+    assign nb_dp4 = vcut4_q;
+  end
+
+  // Stage 5: window sums; the cell, its neighbours (Doppler +1 is the arriving column when
+  // PD = 1) and its sideband for the early FIFO
+  logic [SUM_W-1:0] sa5_q, sb5_q;
+  logic [POW_W-1:0] cut5_q, nb_rm5_q, nb_rp5_q, nb_dm5_q, nb_dp5_q;
+  logic             last5_q, ok5_q;
+  always_ff @(posedge clk) begin
+    if (KIND == 0) begin
+      sa5_q <= wsum[0] + vo4_q - wsum[1];
+      sb5_q <= '0;
+    end else begin
+      sa5_q <= wsum[0] - wsum[1];
+      sb5_q <= wsum[2] + vo4_q - wsum[3];
+    end
+    cut5_q   <= sr_c[PD-1];
+    nb_rm5_q <= rm_ok_q[4] ? sr_rm[PD-1] : '0;
+    nb_rp5_q <= rp_ok_q[4] ? sr_rp[PD-1] : '0;
+    nb_dm5_q <= sr_c[PD];
+    nb_dp5_q <= nb_dp4;
+    last5_q  <= last_q[4];
+    ok5_q    <= cut_ok_q[4];
+  end
+
+  // Stage 6: training sum S of the kind, the row's threshold scale (multiplier inputs)
+  logic [SUM_W-1:0]   sum_q [10:6];
+  logic [SCALE_W-1:0] scale6_q;
+  logic [POW_W-1:0]   cut_q [9:6];
+  logic               ok_q [9:6];
+  always_ff @(posedge clk) begin
+    unique case (KIND)
+      1:       sum_q[6] <= (sa5_q > sb5_q) ? sa5_q : sb5_q;
+      2:       sum_q[6] <= (sa5_q < sb5_q) ? sa5_q : sb5_q;
+      default: sum_q[6] <= sa5_q;
+    endcase
+    scale6_q <= cfg_scale[e_q[5] * SCALE_W +: SCALE_W];
+    cut_q[6] <= cut5_q;
+    ok_q[6]  <= ok5_q;
+    for (int k = 7; k <= 10; k++) sum_q[k] <= sum_q[k-1];
+    for (int k = 7; k <= 9; k++) begin
+      cut_q[k] <= cut_q[k-1];
+      ok_q[k]  <= ok_q[k-1];
+    end
+  end
+
+  // Stages 7-9: S * scale from CH-bit chunks, S = sum_i S_i 2^(CH i), scale likewise:
+  // products registered (7), then per scale chunk j the even-i and odd-i products, each a
+  // concatenation (a product is 2 CH bits wide), added (8), then the chunk sums (9)
+  localparam int CH = 17;
+  localparam int NA = (SUM_W + CH - 1) / CH;
+  localparam int NB = (SCALE_W + CH - 1) / CH;
+  logic [NA*CH-1:0]   a6;
+  logic [NB*CH-1:0]   b6;
+  logic [2*CH-1:0]    pp7_q [NA][NB];
+  logic [(NA+1)*CH:0] col8_q [NB];
+  logic [PROD_W-1:SCALE_FRAC] prod9_q;   // the product's bits that the decision uses
+  assign a6 = (NA * CH)'(sum_q[6]);
+  assign b6 = (NB * CH)'(scale6_q);
+  always_ff @(posedge clk) begin
+    logic [(NA+1)*CH-1:0] ev, od;
+    logic [PROD_W-1:0]    acc;
+    for (int i = 0; i < NA; i++)
+      for (int j = 0; j < NB; j++)
+        pp7_q[i][j] <= (2 * CH)'(a6[i * CH +: CH]) * (2 * CH)'(b6[j * CH +: CH]);
+    for (int j = 0; j < NB; j++) begin
+      ev = '0;
+      od = '0;
+      for (int i = 0; i < NA; i++)
+        if (i % 2 == 0) ev[i * CH +: 2 * CH] = pp7_q[i][j];
+        else            od[i * CH +: 2 * CH] = pp7_q[i][j];
+      col8_q[j] <= ((NA + 1) * CH + 1)'(ev) + ((NA + 1) * CH + 1)'(od);
+    end
+    acc = '0;
+    for (int j = 0; j < NB; j++) acc = acc + (PROD_W'(col8_q[j]) << (j * CH));
+    prod9_q <= acc[PROD_W-1:SCALE_FRAC];
+  end
+
+  // Stage 10: CUT * 2^SCALE_FRAC > P  <=>  CUT > floor(P / 2^SCALE_FRAC)
+  localparam int PH_W = PROD_W - SCALE_FRAC;
+  logic [PH_W-1:0] prod_hi;
+  logic            det10_q;
+  assign prod_hi = prod9_q;
+  always_ff @(posedge clk)
+    det10_q <= ok_q[9] && (prod_hi[PH_W-1:POW_W] == '0) && (cut_q[9] > prod_hi[POW_W-1:0]);
+
+  // output cells (rows' cells from step 2*PD on) down the pipeline, for the detection count
+  logic [10:5] o_q;
 
   // ---------------------------------------------------------------------------------------
   // Sequencing registers
@@ -343,16 +559,20 @@ module cfar_2d #(
       p_q         <= '0;
       s_q         <= '0;
       slot_q      <= '0;
-      v1_q        <= 1'b0;
-      st_wr_q     <= 1'b0;
+      v_q         <= '0;
+      o_q         <= '0;
+      st_wr1_q    <= 1'b0;
+      st_wr2_q    <= 1'b0;
       framing_q   <= 1'b0;
       frame_cnt_q <= '0;
       det_cnt_q   <= '0;
     end else begin
-      v1_q    <= step;
-      st_wr_q <= step && in_phase;
+      v_q      <= {v_q[3:1], step};
+      o_q      <= {o_q[9:5], v_q[4] && out_q[4]};
+      st_wr1_q <= step && in_phase;
+      st_wr2_q <= st_wr1_q;
       if (step && in_phase && (s_axis_tlast != (s_q == S_W'(N_DOPPLER - 1)))) framing_q <= 1'b1;
-      if (v1_q && out1_q && detect && det_cnt_q != '1) det_cnt_q <= det_cnt_q + 1'b1;
+      if (o_q[10] && det10_q && det_cnt_q != '1) det_cnt_q <= det_cnt_q + 1'b1;
       if (step) begin
         if (pass_end) begin
           s_q <= '0;
@@ -372,24 +592,45 @@ module cfar_2d #(
   end
 
   // ---------------------------------------------------------------------------------------
-  // Output FIFO: one entry per tested cell, the clock after its last column was read
-  localparam int FW = 1 + BR + BD + 5 * POW_W + SUM_W + CNT_W + 1;
-  logic [FW-1:0] fifo_tdata;
+  // Output FIFOs: one entry per tested cell, issued with the step that reads its last
+  // column. Two FIFOs in lockstep (same issues, same pops): the early one takes the cell's
+  // data at stage LAT_E, the late one its sum and decision at LAT_L and gives the port its
+  // valid, so the cell data need not travel down the multiplier's stages. DEPTH >= LAT_L + 2
+  // keeps one cell per clock.
+  localparam int FE = 1 + BR + BD + 4 * POW_W + CNT_W + POW_W;
+  localparam int FL = 1 + SUM_W;
+  logic          issue, e_can_issue, e_valid;
+  logic [FE-1:0] fe_data;
+  logic [FL-1:0] fl_data;
+  assign issue = step && testing && (s_q >= S_W'(2 * PD));
 
-  buf_out_fifo #(.WIDTH(FW), .DEPTH(4)) u_out (
+  buf_out_fifo #(.WIDTH(FE), .DEPTH(16), .LATENCY(LAT_E)) u_out_early (
+    .clk           (clk),
+    .rst           (rst),
+    .can_issue     (e_can_issue),
+    .issue         (issue),
+    .in_data       ({last5_q, r_q[5], d_q[5], nb_dp5_q, nb_dm5_q, nb_rp5_q, nb_rm5_q,
+                     cnt_q[5], cut5_q}),
+    .m_axis_tdata  (fe_data),
+    .m_axis_tvalid (e_valid),
+    .m_axis_tready (m_axis_tvalid && m_axis_tready)
+  );
+  buf_out_fifo #(.WIDTH(FL), .DEPTH(16), .LATENCY(LAT_L)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
-    .issue         (step && testing && (s_q >= S_W'(2 * PD))),
-    .in_data       ({last1_q, r1_q, d1_q, nb_dp, nb_dm, nb_rp, nb_rm, detect, cnt, sum_sel,
-                     cut}),
-    .m_axis_tdata  (fifo_tdata),
+    .issue         (issue),
+    .in_data       ({det10_q, sum_q[10]}),
+    .m_axis_tdata  (fl_data),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
   );
-  assign m_axis_tdata = OUT_W'(fifo_tdata[5 * POW_W + SUM_W + CNT_W:0]);
-  assign m_axis_tuser = fifo_tdata[FW-2 -: BR + BD];
-  assign m_axis_tlast = fifo_tdata[FW-1];
+  // {pow(r, d+1), pow(r, d-1), pow(r+1, d), pow(r-1, d), detect, count, sum, power}
+  assign m_axis_tdata = OUT_W'({fe_data[POW_W + CNT_W +: 4 * POW_W], fl_data[SUM_W],
+                                fe_data[POW_W +: CNT_W], fl_data[SUM_W-1:0],
+                                fe_data[POW_W-1:0]});
+  assign m_axis_tuser = fe_data[FE-2 -: BR + BD];
+  assign m_axis_tlast = fe_data[FE-1];
 
   assign status_framing_error = framing_q;
   assign frame_count          = frame_cnt_q;
@@ -397,7 +638,7 @@ module cfar_2d #(
 
   // input padding bits are not used
   logic unused_ok;
-  assign unused_ok = ^s_axis_tdata;
+  assign unused_ok = ^{s_axis_tdata, e_can_issue, e_valid};
 
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(IN_W + 1), .ASSUME(1'b1)) u_chk_s_axis (

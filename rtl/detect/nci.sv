@@ -86,63 +86,97 @@ module nci #(
   assign beat          = s_axis_tvalid && s_axis_tready;
   assign last_tx       = (NUM_TX == 1) || (t_q == BT'(NUM_TX - 1));
 
-  // Power of the input word: sum of I^2 + Q^2 over the lanes (exact)
-  logic [POW_W-1:0] word_pow;
-  always_comb begin
-    word_pow = '0;
-    for (int k = 0; k < NUM_RX; k++) begin
-      logic signed [LP_W-1:0] i_s, q_s, i2, q2;   // sign-extended, squares are >= 0
-      i_s = LP_W'(signed'(s_axis_tdata[k*2*DATA_W +: DATA_W]));
-      q_s = LP_W'(signed'(s_axis_tdata[k*2*DATA_W + DATA_W +: DATA_W]));
-      i2  = i_s * i_s;
-      q2  = q_s * q_s;
-      word_pow = word_pow + POW_W'(unsigned'(i2)) + POW_W'(unsigned'(q2));
+  // ---------------------------------------------------------------------------------------
+  // Pipeline, k clocks after the beat (stage k): 1 the word registered (multiplier inputs),
+  // 2 the squares I^2, Q^2 of every lane (products), 3 the lanes' I^2 + Q^2 summed in pairs,
+  // 4 the word's power (the rest of the adder tree) plus the partial sum of TX 0..t-1 (the
+  // accumulator RAM read is issued at stage 3): the cell's sum, to the output FIFO and the RAM
+  localparam int LAT = 4;
+  localparam int NP  = (NUM_RX + 1) / 2;                // lane pairs
+  logic [LAT:1]         v_q;                            // a beat is in stage k (reset)
+  logic [LAT:1]         first_q, last_q;
+  logic [BD-1:0]        dd_q [LAT:1];
+  logic [BR-1:0]        rr_q [LAT:1];
+  logic [NUM_RX*2*DATA_W-1:0] x1_q;
+  logic [LP_W-1:0]      sq2_q [2*NUM_RX];
+  logic [POW_W-1:0]     t3_q [64], s1_pow_q, acc_rd, s1_sum;
+
+  always_ff @(posedge clk) begin
+    x1_q <= s_axis_tdata;
+    // squares of the sign-extended lanes (>= 0)
+    for (int c = 0; c < 2 * NUM_RX; c++) begin
+      logic signed [LP_W-1:0] x_s, x2;
+      x_s = LP_W'(signed'(x1_q[c*DATA_W +: DATA_W]));
+      x2  = x_s * x_s;
+      sq2_q[c] <= unsigned'(x2);
+    end
+    for (int k = 0; k < 64; k++) begin
+      t3_q[k] <= '0;
+      if (k < NP) begin
+        t3_q[k] <= POW_W'(sq2_q[(4 * k) % (2 * NUM_RX)])
+                 + POW_W'(sq2_q[(4 * k + 1) % (2 * NUM_RX)]);
+        if (2 * k + 1 < NUM_RX)
+          t3_q[k] <= POW_W'(sq2_q[(4 * k) % (2 * NUM_RX)])
+                   + POW_W'(sq2_q[(4 * k + 1) % (2 * NUM_RX)])
+                   + POW_W'(sq2_q[(4 * k + 2) % (2 * NUM_RX)])
+                   + POW_W'(sq2_q[(4 * k + 3) % (2 * NUM_RX)]);
+      end
     end
   end
 
-  // ---------------------------------------------------------------------------------------
-  // Stage 1: add the partial sum of TX 0..t-1 (accumulator RAM, read issued with the beat)
-  logic             s1_valid_q, s1_first_q, s1_last_q;
-  logic [POW_W-1:0] s1_pow_q, acc_rd, s1_sum;
-  logic [BD-1:0]    s1_d_q;
-  logic [BR-1:0]    s1_r_q;
+  // stage 4: the pair sums added up as a tree (terms beyond NP are constant zero)
+  always_ff @(posedge clk) begin
+    logic [POW_W-1:0] t [64];
+    for (int k = 0; k < 64; k++) t[k] = t3_q[k];
+    for (int w = 32; w >= 1; w = w / 2)
+      for (int k = 0; k < w; k++) t[k] = t[2 * k] + t[2 * k + 1];
+    s1_pow_q <= t[0];
+  end
 
+  // ---------------------------------------------------------------------------------------
+  // Stage 4: add the partial sum of TX 0..t-1 (accumulator RAM, read issued at stage 3; the
+  // same cell's next TX word is read N_DOPPLER >= 2 beats later, after this write)
   if (NUM_TX > 1) begin : g_acc
     buf_sdp_ram #(.WIDTH(POW_W), .DEPTH(N_DOPPLER)) u_acc (
       .clk     (clk),
-      .wr_en   (s1_valid_q && !s1_last_q),
-      .wr_addr (s1_d_q),
+      .wr_en   (v_q[LAT] && !last_q[LAT]),
+      .wr_addr (dd_q[LAT]),
       .wr_data (s1_sum),
-      .rd_en   (beat),
-      .rd_addr (d_q),
+      .rd_en   (v_q[LAT-1]),
+      .rd_addr (dd_q[LAT-1]),
       .rd_data (acc_rd)
     );
   end else begin : g_no_acc
     assign acc_rd = '0;
     logic unused_ok;
-    assign unused_ok = ^{s1_valid_q, s1_last_q};
+    assign unused_ok = ^{v_q[LAT], last_q[LAT]};
   end
 
-  assign s1_sum = s1_pow_q + (s1_first_q ? '0 : acc_rd);
+  assign s1_sum = s1_pow_q + (first_q[LAT] ? '0 : acc_rd);
 
   always_ff @(posedge clk) begin
-    s1_pow_q   <= word_pow;
-    s1_first_q <= (t_q == '0);
-    s1_last_q  <= last_tx;
-    s1_d_q     <= d_q;
-    s1_r_q     <= r_q;
+    first_q[1] <= (t_q == '0);
+    last_q[1]  <= last_tx;
+    dd_q[1]    <= d_q;
+    rr_q[1]    <= r_q;
+    for (int k = 2; k <= LAT; k++) begin
+      first_q[k] <= first_q[k-1];
+      last_q[k]  <= last_q[k-1];
+      dd_q[k]    <= dd_q[k-1];
+      rr_q[k]    <= rr_q[k-1];
+    end
   end
 
   always_ff @(posedge clk) begin
     if (rst) begin
-      s1_valid_q  <= 1'b0;
+      v_q         <= '0;
       d_q         <= '0;
       t_q         <= '0;
       r_q         <= '0;
       framing_q   <= 1'b0;
       frame_cnt_q <= '0;
     end else begin
-      s1_valid_q <= beat;
+      v_q <= {v_q[LAT-1:1], beat};
       if (beat) begin
         if (s_axis_tlast != (d_q == '1)) framing_q <= 1'b1;
         d_q <= d_q + 1'b1;
@@ -162,12 +196,12 @@ module nci #(
   localparam int FW = POW_W + BR + BD + 1;
   logic [FW-1:0] fifo_tdata;
 
-  buf_out_fifo #(.WIDTH(FW), .DEPTH(4)) u_out (
+  buf_out_fifo #(.WIDTH(FW), .DEPTH(8), .LATENCY(LAT)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (beat && last_tx),
-    .in_data       ({(s1_d_q == '1), s1_r_q, s1_d_q, s1_sum}),
+    .in_data       ({(dd_q[LAT] == '1), rr_q[LAT], dd_q[LAT], s1_sum}),
     .m_axis_tdata  (fifo_tdata),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)

@@ -3,6 +3,8 @@
 // radix-2^2 trivial -j rotation (BF-II), optional 1/2 scaling, convergent rounding and
 // saturation. Every sample carries a tag (valid, index in frame, overflow) that travels with
 // it through the delay line, so the stage is controlled by the data it holds.
+// Two register stages: the exact sum / difference (W+1 bits; the difference also goes into
+// the delay line unrounded), then the rounding and saturation of whichever is sent on.
 `default_nettype none
 
 module fft_sdf_bf #(
@@ -30,7 +32,7 @@ module fft_sdf_bf #(
   input  logic                  in_vld,
   input  logic [LOG2N-1:0]      in_pos,
   input  logic                  in_ov,
-  // Sample out (registered), same order as the input, D+1 advances later.
+  // Sample out (registered), same order as the input, D+2 advances later.
   output logic [NUM_CH*2*W-1:0] out_data,
   output logic                  out_vld,
   output logic [LOG2N-1:0]      out_pos,
@@ -38,7 +40,8 @@ module fft_sdf_bf #(
 );
 
   localparam int DW = NUM_CH * 2 * W;
-  localparam int MW = DW + LOG2N + 1;         // delay line word: data, index, overflow
+  localparam int FW = NUM_CH * 2 * (W + 1);   // exact sums / differences
+  localparam int MW = FW + LOG2N + 1;         // delay line word: data, index, overflow
   localparam int DB = $clog2(D);              // index bit selecting the butterfly half
   localparam int PW = (D > 1) ? $clog2(D) : 1;
 
@@ -55,7 +58,7 @@ module fft_sdf_bf #(
   logic [PW-1:0] ptr_q;
   logic [MW-1:0] head;
   logic          head_vld;
-  logic [DW-1:0] head_data;
+  logic [FW-1:0] head_data;   // phase 1: an input (sign-extended); phase 0: a difference
   logic [LOG2N-1:0] head_pos;
   logic          head_ov;
 
@@ -77,8 +80,7 @@ module fft_sdf_bf #(
   // ---------------------------------------------------------------- butterfly
   logic          phase;     // 0: store the input, emit the stored difference; 1: butterfly
   logic          rot;
-  logic [DW-1:0] sum_data, dif_data;
-  logic          sum_ov, dif_ov;
+  logic [FW-1:0] in_ext, sum_full, dif_full;
 
   assign phase = in_pos[DB];
   if (ROTATE) begin : g_rot
@@ -87,54 +89,74 @@ module fft_sdf_bf #(
     assign rot = 1'b0;
   end
 
+  // Exact a + x and a - x with x rotated by -j (+j inverse): each component is the head's
+  // plus or minus one of the input's components (no separate negation).
   always_comb begin
-    logic signed [63:0] ar, ai, xr, xi, sr, si, dr, di;
-    sum_data = '0;
-    dif_data = '0;
-    sum_ov   = 1'b0;
-    dif_ov   = 1'b0;
+    logic signed [W:0] ar, ai, xr, xi, ur, ui;
+    logic              nr, ni;   // the rotated x's component is the negated ur / ui
     for (int ch = 0; ch < NUM_CH; ch++) begin
-      ar = 64'(signed'(head_data[ch*2*W +: W]));
-      ai = 64'(signed'(head_data[ch*2*W + W +: W]));
-      xr = 64'(signed'(in_data[ch*2*W +: W]));
-      xi = 64'(signed'(in_data[ch*2*W + W +: W]));
+      ar = (W+1)'(signed'(head_data[ch*2*(W+1) +: W+1]));
+      ai = (W+1)'(signed'(head_data[ch*2*(W+1) + W+1 +: W+1]));
+      xr = (W+1)'(signed'(in_data[ch*2*W +: W]));
+      xi = (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+      in_ext[ch*2*(W+1) +: W+1]       = xr;
+      in_ext[ch*2*(W+1) + W+1 +: W+1] = xi;
+      ur = xr;
+      ui = xi;
+      nr = 1'b0;
+      ni = 1'b0;
       if (rot) begin
-        if (INVERSE) begin  // x * (+j)
-          {xr, xi} = {-xi, xr};
-        end else begin      // x * (-j)
-          {xr, xi} = {xi, -xr};
+        if (INVERSE) begin  // x * (+j) = (-xi, xr)
+          ur = xi;
+          ui = xr;
+          nr = 1'b1;
+        end else begin      // x * (-j) = (xi, -xr)
+          ur = xi;
+          ui = xr;
+          ni = 1'b1;
         end
       end
-      sr = fft_pkg::round_conv(ar + xr, SCALE ? 1 : 0);
-      si = fft_pkg::round_conv(ai + xi, SCALE ? 1 : 0);
-      dr = fft_pkg::round_conv(ar - xr, SCALE ? 1 : 0);
-      di = fft_pkg::round_conv(ai - xi, SCALE ? 1 : 0);
-      sum_ov = sum_ov | fft_pkg::sat_ov(sr, W) | fft_pkg::sat_ov(si, W);
-      dif_ov = dif_ov | fft_pkg::sat_ov(dr, W) | fft_pkg::sat_ov(di, W);
-      sum_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(sr, W));
-      sum_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(si, W));
-      dif_data[ch*2*W +: W]     = W'(fft_pkg::sat_val(dr, W));
-      dif_data[ch*2*W + W +: W] = W'(fft_pkg::sat_val(di, W));
+      sum_full[ch*2*(W+1) +: W+1]       = nr ? ar - ur : ar + ur;
+      sum_full[ch*2*(W+1) + W+1 +: W+1] = ni ? ai - ui : ai + ui;
+      dif_full[ch*2*(W+1) +: W+1]       = nr ? ar + ur : ar - ur;
+      dif_full[ch*2*(W+1) + W+1 +: W+1] = ni ? ai + ui : ai - ui;
     end
   end
 
   // ---------------------------------------------------------------- registers
-  logic [DW-1:0]    out_data_q;
-  logic [LOG2N-1:0] out_pos_q;
+  logic [FW-1:0]    full_q;      // stage 1: exact value of the sample sent on
+  logic [LOG2N-1:0] pos1_q, out_pos_q;
+  logic             ov1_q, vld1_q;
+  logic [DW-1:0]    out_data_q;  // stage 2: rounded, saturated
   logic             out_ov_q, out_vld_q;
 
   always_ff @(posedge clk) begin
     if (en) begin
       if (phase) begin
-        out_data_q   <= sum_data;
-        out_ov_q     <= head_ov | in_ov | sum_ov;
-        mem_q[ptr_q] <= {dif_data, in_pos, head_ov | in_ov | dif_ov};
+        full_q       <= sum_full;
+        ov1_q        <= head_ov | in_ov;
+        mem_q[ptr_q] <= {dif_full, in_pos, head_ov | in_ov};
       end else begin
-        out_data_q   <= head_data;
-        out_ov_q     <= head_ov;
-        mem_q[ptr_q] <= {in_data, in_pos, in_ov};
+        full_q       <= head_data;
+        ov1_q        <= head_ov;
+        mem_q[ptr_q] <= {in_ext, in_pos, in_ov};
       end
-      out_pos_q <= head_pos;
+      pos1_q <= head_pos;
+    end
+  end
+
+  always_ff @(posedge clk) begin
+    logic signed [63:0] v;
+    logic               ov;
+    if (en) begin
+      ov = ov1_q;
+      for (int c = 0; c < 2 * NUM_CH; c++) begin
+        v  = fft_pkg::round_conv(64'(signed'(full_q[c*(W+1) +: W+1])), SCALE ? 1 : 0);
+        ov = ov | fft_pkg::sat_ov(v, W);
+        out_data_q[c*W +: W] <= W'(fft_pkg::sat_val(v, W));
+      end
+      out_ov_q  <= ov;
+      out_pos_q <= pos1_q;
     end
   end
 
@@ -142,11 +164,13 @@ module fft_sdf_bf #(
   always_ff @(posedge clk) begin
     if (rst) begin
       mvld_q    <= '0;
+      vld1_q    <= 1'b0;
       out_vld_q <= 1'b0;
       ptr_q     <= '0;
     end else if (en) begin
       mvld_q[ptr_q] <= in_vld;
-      out_vld_q     <= head_vld;
+      vld1_q        <= head_vld;
+      out_vld_q     <= vld1_q;
       ptr_q         <= (ptr_q == PW'(D - 1)) ? '0 : ptr_q + 1'b1;
     end
   end

@@ -3,6 +3,8 @@
 // W_M^(i0*(b1+2*b0)) in the quarter-wave ROM from the sample's index tag and multiplies every
 // lane with registered inputs and products (DSP48E2 friendly; three real products per lane,
 // Gauss, four for W = 27), exact sums, convergent rounding, saturation.
+// Six register stages: ROM index; quarter-wave ROM words; coefficients (quadrant, Gauss
+// pre-adds) and operands; products; exact sums; rounded and saturated result.
 `default_nettype none
 
 module fft_twiddle #(
@@ -26,7 +28,7 @@ module fft_twiddle #(
   input  logic                  in_vld,
   input  logic [LOG2N-1:0]      in_pos,
   input  logic                  in_ov,
-  // Sample out, 3 advances later.
+  // Sample out, 6 advances later.
   output logic [NUM_CH*2*W-1:0] out_data,
   output logic                  out_vld,
   output logic [LOG2N-1:0]      out_pos,
@@ -47,35 +49,46 @@ module fft_twiddle #(
     $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
   end
 
-  // ---------------------------------------------------------------- ROM index from the tag
-  logic [ROM_LOG2-1:0] rom_idx;
-  always_comb begin
-    logic [ROM_LOG2-1:0] i0, e;
-    logic [1:0] m;
-    i0 = ROM_LOG2'(in_pos[LOG2M-3:0]);
-    m  = {in_pos[LOG2M-2], in_pos[LOG2M-1]};   // b1 + 2*b0
-    e  = ROM_LOG2'(i0 * ROM_LOG2'(m));
-    rom_idx = e << (ROM_LOG2 - LOG2M);
+  // ---------------------------------------------------------------- stage 1: ROM index
+  // e = i0 * m, m = {in_pos[LOG2M-2], in_pos[LOG2M-1]} (b1 + 2*b0), as a shift-add (no
+  // multiplier); ROM index e * 2^(ROM_LOG2 - LOG2M)
+  logic [ROM_LOG2-1:0] idx_q;
+  always_ff @(posedge clk) begin
+    logic [ROM_LOG2-1:0] i0;
+    if (en) begin
+      i0 = ROM_LOG2'(in_pos[LOG2M-3:0]);
+      idx_q <= ROM_LOG2'(((in_pos[LOG2M-1] ? i0 : '0) + (in_pos[LOG2M-2] ? i0 << 1 : '0))
+                         << (ROM_LOG2 - LOG2M));
+    end
   end
 
-  // C = COS(k), S = SIN(k) = COS(k - 1024): quarter-wave ROM (generated, combinational)
-  logic [COEF_W-1:0] rom_cos, rom_sin;
-  fft_twiddle_rom u_rom (.k(rom_idx), .cos_o(rom_cos), .sin_o(rom_sin));
+  // ---------------------------------------------------------------- stage 2: ROM words
+  // C = COS(k), S = SIN(k) = COS(k - 1024): quarter-wave ROM (generated, combinational),
+  // registered
+  logic [COEF_W-1:0] rom_cos, rom_sin, cos2_q, sin2_q;
+  fft_twiddle_rom u_rom (.k(idx_q), .cos_o(rom_cos), .sin_o(rom_sin));
+  always_ff @(posedge clk) begin
+    if (en) begin
+      cos2_q <= rom_cos;
+      sin2_q <= rom_sin;
+    end
+  end
 
-  // ---------------------------------------------------------------- stage 1: operands
-  logic [DW-1:0]        d1_q;
-  logic [LOG2N-1:0]     pos1_q, pos2_q, pos3_q;
-  logic                 ov1_q, ov2_q, ov3_q;
-  logic                 vld1_q, vld2_q, vld3_q;
+  // ---------------------------------------------------------------- stage 3: operands
+  logic [DW-1:0]        da_q, db_q, d1_q;   // data in stages 1, 2, 3
+  logic [LOG2N-1:0]     pos_q [6];
+  logic                 ov_q  [5];
+  logic [5:0]           vld_q;
 
-  // ---------------------------------------------------------------- stage 3: sum, round
-  logic [DW-1:0] y_d, y3_q;
-  logic          y_ov;
+  // ---------------------------------------------------------------- stage 6: round, sat
+  logic [DW-1:0] y_d, y6_q;
+  logic          y_ov, ov6_q;
 
-  // Products (stage 2) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
-  // the inverse has S -> -S), full precision before the rounding: two forms, same bits.
-  logic signed [63:0] yr_full [NUM_CH];
-  logic signed [63:0] yi_full [NUM_CH];
+  // Products (stage 4) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
+  // the inverse has S -> -S), full precision before the rounding (stage 5): two forms,
+  // same bits.
+  logic signed [PRW+1:0] yr_full [NUM_CH], yi_full [NUM_CH];
+  logic signed [PRW+1:0] yr5_q [NUM_CH], yi5_q [NUM_CH];
 
   if (GAUSS) begin : g_gauss
     // Three real products per lane (Gauss): with d = -S (forward) or +S (inverse)
@@ -89,17 +102,17 @@ module fft_twiddle #(
     logic signed [PRW-1:0]    k3_q [NUM_CH];
     logic signed [COEF_W:0]   cc, ss;
 
-    assign cc = (COEF_W+1)'(signed'(rom_cos));
-    assign ss = (COEF_W+1)'(signed'(rom_sin));
+    assign cc = (COEF_W+1)'(signed'(cos2_q));
+    assign ss = (COEF_W+1)'(signed'(sin2_q));
 
     always_ff @(posedge clk) begin
       if (en) begin
-        c1_q <= signed'(rom_cos);
+        c1_q <= signed'(cos2_q);
         p1_q <= COEF_W'(INVERSE ? ss - cc : -ss - cc);
         m1_q <= COEF_W'(INVERSE ? cc + ss : cc - ss);
         for (int ch = 0; ch < NUM_CH; ch++) begin
-          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
-                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+          a1_q[ch] <= (W+1)'(signed'(db_q[ch*2*W +: W]))
+                    + (W+1)'(signed'(db_q[ch*2*W + W +: W]));
           k1_q[ch] <= (PRW+1)'(a1_q[ch]) * (PRW+1)'(c1_q);
           k2_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(p1_q);
           k3_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(m1_q);
@@ -109,8 +122,8 @@ module fft_twiddle #(
 
     always_comb begin
       for (int ch = 0; ch < NUM_CH; ch++) begin
-        yr_full[ch] = 64'(k1_q[ch]) - 64'(k3_q[ch]);
-        yi_full[ch] = 64'(k1_q[ch]) + 64'(k2_q[ch]);
+        yr_full[ch] = (PRW+2)'(k1_q[ch]) - (PRW+2)'(k3_q[ch]);
+        yi_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k2_q[ch]);
       end
     end
   end else begin : g_four
@@ -123,8 +136,8 @@ module fft_twiddle #(
 
     always_ff @(posedge clk) begin
       if (en) begin
-        c1_q <= signed'(rom_cos);
-        s1_q <= signed'(rom_sin);
+        c1_q <= signed'(cos2_q);
+        s1_q <= signed'(sin2_q);
         for (int ch = 0; ch < NUM_CH; ch++) begin
           prc_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(c1_q);
           prs_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(s1_q);
@@ -137,11 +150,11 @@ module fft_twiddle #(
     always_comb begin
       for (int ch = 0; ch < NUM_CH; ch++) begin
         if (INVERSE) begin   // x * (C + jS)
-          yr_full[ch] = 64'(prc_r_q[ch]) - 64'(prs_i_q[ch]);
-          yi_full[ch] = 64'(prc_i_q[ch]) + 64'(prs_r_q[ch]);
+          yr_full[ch] = (PRW+2)'(prc_r_q[ch]) - (PRW+2)'(prs_i_q[ch]);
+          yi_full[ch] = (PRW+2)'(prc_i_q[ch]) + (PRW+2)'(prs_r_q[ch]);
         end else begin       // x * (C - jS)
-          yr_full[ch] = 64'(prc_r_q[ch]) + 64'(prs_i_q[ch]);
-          yi_full[ch] = 64'(prc_i_q[ch]) - 64'(prs_r_q[ch]);
+          yr_full[ch] = (PRW+2)'(prc_r_q[ch]) + (PRW+2)'(prs_i_q[ch]);
+          yi_full[ch] = (PRW+2)'(prc_i_q[ch]) - (PRW+2)'(prs_r_q[ch]);
         end
       end
     end
@@ -149,14 +162,19 @@ module fft_twiddle #(
 
   always_ff @(posedge clk) begin
     if (en) begin
-      d1_q   <= in_data;
-      pos1_q <= in_pos;
-      ov1_q  <= in_ov;
-      pos2_q <= pos1_q;
-      ov2_q  <= ov1_q;
-      y3_q   <= y_d;
-      pos3_q <= pos2_q;
-      ov3_q  <= ov2_q | y_ov;
+      da_q     <= in_data;
+      db_q     <= da_q;
+      d1_q     <= db_q;
+      pos_q[0] <= in_pos;
+      ov_q[0]  <= in_ov;
+      for (int k = 1; k < 6; k++) pos_q[k] <= pos_q[k-1];
+      for (int k = 1; k < 5; k++) ov_q[k] <= ov_q[k-1];
+      for (int ch = 0; ch < NUM_CH; ch++) begin
+        yr5_q[ch] <= yr_full[ch];
+        yi5_q[ch] <= yi_full[ch];
+      end
+      y6_q     <= y_d;
+      ov6_q    <= ov_q[4] | y_ov;
     end
   end
 
@@ -165,8 +183,8 @@ module fft_twiddle #(
     y_d  = '0;
     y_ov = 1'b0;
     for (int ch = 0; ch < NUM_CH; ch++) begin
-      yr = fft_pkg::round_conv(yr_full[ch], COEF_FRAC);
-      yi = fft_pkg::round_conv(yi_full[ch], COEF_FRAC);
+      yr = fft_pkg::round_conv(64'(yr5_q[ch]), COEF_FRAC);
+      yi = fft_pkg::round_conv(64'(yi5_q[ch]), COEF_FRAC);
       y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
       y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
       y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));
@@ -175,20 +193,16 @@ module fft_twiddle #(
 
   always_ff @(posedge clk) begin
     if (rst) begin
-      vld1_q <= 1'b0;
-      vld2_q <= 1'b0;
-      vld3_q <= 1'b0;
+      vld_q <= '0;
     end else if (en) begin
-      vld1_q <= in_vld;
-      vld2_q <= vld1_q;
-      vld3_q <= vld2_q;
+      vld_q <= {vld_q[4:0], in_vld};
     end
   end
 
-  assign out_data = y3_q;
-  assign out_vld  = vld3_q;
-  assign out_pos  = pos3_q;
-  assign out_ov   = ov3_q;
+  assign out_data = y6_q;
+  assign out_vld  = vld_q[5];
+  assign out_pos  = pos_q[5];
+  assign out_ov   = ov6_q;
 endmodule
 
 `default_nettype wire
