@@ -224,3 +224,22 @@ def plot_point_cloud(x: np.ndarray, y: np.ndarray, snr_db: np.ndarray, path: Pat
     if note:
         fig.text(0.01, 0.005, note, fontsize=7, va="bottom", wrap=True)
     return _save(fig, path)
+
+
+def plot_side_view(x: np.ndarray, z: np.ndarray, snr_db: np.ndarray, path: Path, title: str
+                   ) -> Path:
+    """Side view (x-z) of a point cloud from an array with vertical extent: x forward to the
+    right, z up, coloured by SNR. x, z, snr_db: float (n,) in m, m, dB."""
+    fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
+    sc = ax.scatter(x, z, c=snr_db, cmap="plasma", s=28, zorder=3, label="radar points")
+    fig.colorbar(sc, ax=ax, label="point SNR (dB)")
+    radar, = ax.plot(0, 0, "k>", ms=10, label="radar")
+    top = max(float(np.max(np.abs(z), initial=0.0)), 1.0)
+    ax.set_xlim(0.0, max(float(np.max(x, initial=0.0)) * 1.1, 5.0))
+    ax.set_ylim(-1.2 * top, 1.2 * top)
+    ax.set_xlabel("x (m, forward)")
+    ax.set_ylabel("z (m, up)")
+    ax.grid(alpha=0.3)
+    ax.legend(handles=[sc, radar], loc="lower right", fontsize=8, framealpha=0.9)
+    ax.set_title(title)
+    return _save(fig, path)

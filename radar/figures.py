@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from host.pointcloud import PointCloud
+from model.array import has_vertical_extent
 from model.config import RadarConfig
 from model.reference import range_doppler_power
 from model.scene import Scene
@@ -55,9 +56,15 @@ def process_plots(folder: Path, cfg: RadarConfig, cube: np.ndarray, cloud: Point
                   frame: int) -> None:
     """``radar process --plots``: frame ``frame``'s range-Doppler map (cube complex
     (n_virtual, n_range, n_doppler)) with its detections circled, its range-azimuth map and
-    its x-y point cloud, written to ``folder``."""
+    its x-y point cloud (and its x-z side view when the array measures elevation), written
+    to ``folder``."""
     from host.angle import range_azimuth_power
-    from host.plots import plot_point_cloud, plot_range_azimuth_pair, plot_range_doppler
+    from host.plots import (
+        plot_point_cloud,
+        plot_range_azimuth_pair,
+        plot_range_doppler,
+        plot_side_view,
+    )
 
     title = f"{cfg.name} frame {frame}"
     ra, az = range_azimuth_power(cube, cfg)
@@ -69,4 +76,8 @@ def process_plots(folder: Path, cfg: RadarConfig, cube: np.ndarray, cloud: Point
                                      folder / "range_azimuth.png"),
              plot_point_cloud(cloud.x_m, cloud.y_m, cloud.snr_db, folder / "point_cloud.png",
                               f"{title}: point cloud ({len(cloud)} points)")]
+    if has_vertical_extent(cfg.virtual_positions_hw):
+        paths.append(plot_side_view(cloud.x_m, cloud.z_m, cloud.snr_db,
+                                    folder / "side_view.png",
+                                    f"{title}: side view x-z ({len(cloud)} points)"))
     print("figures: " + ", ".join(str(p) for p in paths))

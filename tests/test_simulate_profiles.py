@@ -250,3 +250,20 @@ def test_simulate_refuses_impairments_the_radar_cannot_have(tmp_path, capsys):
                  str(tmp_path / "x.bin")]) == 2
     assert "impairments.iq_gain_db" in capsys.readouterr().err
     assert not (tmp_path / "x.bin").exists()
+
+
+def test_process_plots_side_view_for_an_array_with_elevation(tmp_path, room, capsys):
+    """`radar process --plots` on a capture of the raised-TX profile: its points carry z_m and
+    elevation_deg and the figures include the x-z side view (planar arrays have none)."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(SMALL_TOML)
+    cap = tmp_path / "cap.npy"
+    assert main(["simulate", "--scene", str(room), "--radar", str(spec), "--frames", "1",
+                 "--out", str(cap)]) == 0
+    out, figs = tmp_path / "points.json", tmp_path / "figs"
+    assert main(["process", "--radar", str(spec), "--capture", str(cap), "--json", str(out),
+                 "--remove-static", "--plots", str(figs), "--train", "4", "3"]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["points"] and all("z_m" in p and "elevation_deg" in p for p in doc["points"])
+    assert (figs / "side_view.png").read_bytes()[:4] == b"\x89PNG"
+    assert "side_view.png" in capsys.readouterr().out
