@@ -6,8 +6,8 @@ scaled 1/n_range, corner turn, optional static-clutter removal, Doppler window, 
 scaled 1/n_doppler), each a pass over the cube. Both windows and both scales are linear
 per axis, so here they are one precomputed (n_samples, n_loops) weight, applied while the
 frame is cast to float64 and turned into cube order (a single pass); static-clutter removal
-(each slow-time vector less its mean) commutes with the range FFT, so it is done on the
-samples, between the range and the Doppler weights; then one 2-D FFT (a real ADC: a real
+(each slow-time vector less its mean) commutes with the range FFT and its window, so it is
+done on the samples, before the weight; then one 2-D FFT (a real ADC: a real
 FFT along range, which gives bins 0..n_range/2 directly). ``radar process`` builds its cubes
 here (``radar.commands.process.capture_frame_cloud``); the tests hold it to the reference.
 """
@@ -26,15 +26,14 @@ from model.reference import check_frame, hann_periodic
 
 @lru_cache(maxsize=16)
 def _weights(n_samples: int, n_loops: int, n_range: int, n_doppler: int, range_window: bool,
-             doppler_window: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(range weight float64 (n_samples, 1): the range window, Doppler weight float64
-    (n_loops,): the Doppler window over n_range * n_doppler, both FFT scales folded in)."""
+             doppler_window: bool) -> np.ndarray:
+    """Both windows and both FFT scales, w_r[s] w_d[l] / (n_range n_doppler), float64
+    (n_samples, n_loops)."""
     w_r = hann_periodic(n_samples) if range_window else np.ones(n_samples)
     w_d = hann_periodic(n_loops) if doppler_window else np.ones(n_loops)
-    w_r.flags.writeable = False
-    w_d = w_d / (n_range * n_doppler)
-    w_d.flags.writeable = False
-    return w_r[:, None], w_d
+    w = np.outer(w_r, w_d / (n_range * n_doppler))
+    w.flags.writeable = False
+    return w
 
 
 def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
@@ -45,20 +44,19 @@ def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     (n_virtual, n_range_bins, n_doppler), equal to the reference's to float64 rounding.
     """
     check_frame(adc, cfg)
-    w_r, w_d = _weights(cfg.n_samples, cfg.n_loops, cfg.n_range, cfg.n_doppler, range_window,
-                        doppler_window)
+    w = _weights(cfg.n_samples, cfg.n_loops, cfg.n_range, cfg.n_doppler, range_window,
+                 doppler_window)
     x = np.asarray(adc).reshape(cfg.n_loops, cfg.num_tx, cfg.num_rx, cfg.n_samples)
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         x = x[:, tx_slots(cfg)]                 # slot of each TX index
     x = x.transpose(1, 2, 3, 0)                 # (tx, rx, samples, loops)
     real = cfg.adc == "real"
     y = np.empty(x.shape, np.float64 if real else np.complex128)
-    if remove_static_clutter:
-        np.multiply(x, w_r, out=y)
-        y -= y.mean(axis=-1, keepdims=True)
-        y *= w_d
+    if remove_static_clutter:               # less the slow-time mean, in float64
+        np.subtract(x, x.mean(axis=-1, keepdims=True, dtype=y.dtype), out=y)
+        y *= w
     else:
-        np.multiply(x, w_r * w_d, out=y)
+        np.multiply(x, w, out=y)
     if real:
         y = scipy.fft.rfft(y, n=cfg.n_range, axis=2)[:, :, :cfg.n_range_bins]
         y = scipy.fft.fft(y, n=cfg.n_doppler, axis=3, overwrite_x=True)

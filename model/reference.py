@@ -201,8 +201,14 @@ def dma_order_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
 
 
 def range_doppler_power(cube: np.ndarray) -> np.ndarray:
-    """Non-coherently integrated power sum_v |cube|^2, float64 (n_range, n_doppler)."""
-    return np.sum(np.abs(cube) ** 2, axis=0)
+    """Non-coherently integrated power sum_v |cube|^2, float64 (n_range, n_doppler): summed
+    channel by channel in order (what ``np.sum(np.abs(cube) ** 2, axis=0)`` computes, without
+    its two cube-sized temporaries)."""
+    cube = np.asarray(cube)
+    power = np.abs(cube[0]) ** 2
+    for channel in cube[1:]:
+        power += np.abs(channel) ** 2
+    return power
 
 
 def tdm_phase_compensation(cfg: RadarConfig, doppler_bin: np.ndarray | int) -> np.ndarray:
