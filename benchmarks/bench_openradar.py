@@ -18,7 +18,8 @@ does the compensation it documents instead (the runner's docstring has the detai
 
 Ours runs in this process on the same frame, through ``radar process --remove-static``'s
 path: the profile and its options (``radar.commands.process``), ``host.adc_capture``, the
-float reference (``model.reference.radar_cube``) and ``radar.frame_cloud``.
+float reference's cube (``model.reference.radar_cube``, computed by ``host.cube.frame_cube``)
+and ``radar.frame_cloud``.
 
 Printed: detections of each; agreement with the peer's 15 dB detections (a match is within
 2 range and 2 Doppler bins; moving = Doppler bin not 0): the moving returns it finds that

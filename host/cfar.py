@@ -33,8 +33,6 @@ from functools import lru_cache
 
 import numpy as np
 from scipy import stats
-from scipy.ndimage import maximum_filter
-from scipy.signal import fftconvolve
 
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
@@ -126,21 +124,56 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
                          f"({OS_MAX_ELEMENTS:.0e} values); use fewer training cells or CA")
 
 
-def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False
-         ) -> tuple[np.ndarray, np.ndarray]:
-    """Map padded circularly on both axes (``mirrored``: the range axis reflected at both
-    ends, a real ADC's), and the matching validity mask (all ones: kept so a cut window
-    could be expressed again)."""
+def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False) -> np.ndarray:
+    """Map padded by the CFAR window's half extent, circularly on both axes (``mirrored``:
+    the range axis reflected at both ends, a real ADC's)."""
     (gr, gd), (tr, td) = params.guard, params.train
     pr, pd = gr + tr, gd + td
     check_window(params, power.shape)
     if mirrored:
-        padded = np.pad(np.pad(power, ((pr, pr), (0, 0)), mode="reflect"), ((0, 0), (pd, pd)),
-                        mode="wrap")
-    else:
-        padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
-    vpad = np.ones_like(padded)
-    return padded, vpad
+        return np.pad(np.pad(power, ((pr, pr), (0, 0)), mode="reflect"), ((0, 0), (pd, pd)),
+                      mode="wrap")
+    return np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
+
+
+def _shifted_sum(x: np.ndarray, offsets: range | list[int], axis: int, pad: int,
+                 n: int) -> np.ndarray:
+    """Sum over ``offsets`` (cells from the centre, |offset| <= ``pad``) of ``x`` shifted
+    along ``axis``, whose ``pad`` cells each side pad ``n`` centre cells: that axis comes
+    out n long. Sums of positive terms only, so no cancellation (float (.., n, ..))."""
+    def view(o: int) -> np.ndarray:
+        sl = [slice(None)] * x.ndim
+        sl[axis] = slice(pad + o, pad + o + n)
+        return x[tuple(sl)]
+
+    out = view(offsets[0]).copy()
+    for o in offsets[1:]:
+        out += view(o)
+    return out
+
+
+def training_sum(padded: np.ndarray, params: CfarParams) -> np.ndarray:
+    """Sum over each cell's CFAR training cells (:func:`_kernel`) of the padded map
+    (:func:`_pad`), float (n_range, n_doppler): separable sums of shifted views, training
+    rows of the full Doppler extent plus guard rows of the Doppler training cells only."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    pr, pd = gr + tr, gd + td
+    nr, nd = padded.shape[0] - 2 * pr, padded.shape[1] - 2 * pd
+    outer_d = [*range(-pd, -gd), *range(gd + 1, pd + 1)]
+    side = _shifted_sum(padded, outer_d, 1, pd, nd)                 # Doppler training cells
+    full = side + _shifted_sum(padded, range(-gd, gd + 1), 1, pd, nd)
+    outer_r = [*range(-pr, -gr), *range(gr + 1, pr + 1)]
+    return _shifted_sum(full, outer_r, 0, pr, nr) + _shifted_sum(side, range(-gr, gr + 1),
+                                                                  0, pr, nr)
+
+
+@lru_cache(maxsize=64)
+def _ca_alpha(pfa: float, n_channels: int, params: CfarParams, windowed: Windows) -> float:
+    """CA-CFAR factor of ``params``' window on a map of ``windowed`` axes (``ca_factor`` at
+    :func:`effective_cells`), once per configuration."""
+    n_train = float(_kernel(params).sum())
+    return float(ca_factor(pfa, n_channels, n_train * effective_cells(params, windowed)
+                           / n_train))
 
 
 def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
@@ -152,45 +185,44 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     kernel = _kernel(params)
+    n_train = int(kernel.sum())
     mirrored = map_axes(windowed, power.shape)[0].real
-    padded, vpad = _pad(power.astype(np.float64), params, mirrored)
-    count = np.rint(fftconvolve(vpad, kernel, mode="valid"))
-    # effective cells scale with the count of training cells that remain near range edges
-    n_eff = count * effective_cells(params, windowed) / kernel.sum()
+    padded = _pad(power.astype(np.float64), params, mirrored)
     if params.kind == "ca":
-        total = fftconvolve(padded, kernel, mode="valid")
-        noise = np.maximum(total, 0.0) / np.maximum(count, 1.0)
-        alpha = np.empty_like(noise)
-        for c in np.unique(count):
-            alpha[count == c] = ca_factor(params.pfa, n_channels, n_eff[count == c][0])
-        return alpha * noise, noise
-    # ordered statistic over the training cells (range edges: zero padding excluded)
+        noise = np.maximum(training_sum(padded, params), 0.0) / n_train
+        return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
+    # ordered statistic over the training cells
     win = np.lib.stride_tricks.sliding_window_view(padded, kernel.shape)
-    vwin = np.lib.stride_tricks.sliding_window_view(vpad, kernel.shape)
-    sel = kernel.ravel() > 0
-    cells = win.reshape(*win.shape[:2], -1)[..., sel]
-    ok = vwin.reshape(*vwin.shape[:2], -1)[..., sel] > 0
-    cells = np.where(ok, cells, np.inf)
-    threshold = np.empty(power.shape)
-    noise = np.empty(power.shape)
-    for c in np.unique(count).astype(int):
-        m = count == c
-        k = max(1, min(c, int(round(params.os_rank * c))))
-        kth = np.partition(cells[m], k - 1, axis=-1)[:, k - 1]
-        alpha = os_factor(params.pfa, n_channels, c, k)
-        threshold[m] = alpha * kth
-        # E[k-th of c] ~ theta * ppf(k / (c + 1)); mean noise power per cell = L * theta
-        noise[m] = kth * n_channels / stats.gamma(n_channels).ppf(k / (c + 1))
-    return threshold, noise
+    cells = win.reshape(*win.shape[:2], -1)[..., kernel.ravel() > 0]
+    k = max(1, min(n_train, int(round(params.os_rank * n_train))))
+    kth = np.partition(cells, k - 1, axis=-1)[..., k - 1]
+    alpha = os_factor(params.pfa, n_channels, n_train, k)
+    # E[k-th of c] ~ theta * ppf(k / (c + 1)); mean noise power per cell = L * theta
+    return alpha * kth, kth * n_channels / stats.gamma(n_channels).ppf(k / (n_train + 1))
 
 
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3),
                 mirrored: bool = False) -> np.ndarray:
     """Peak grouping: cells of ``mask`` that are the maximum of their (range, Doppler)
-    neighbourhood (both axes circular; ``mirrored``: the range axis reflected at its ends,
-    a real ADC's). Returns int (n, 2) of (range_bin, doppler_bin)."""
-    mx = maximum_filter(power, size=size, mode=("mirror" if mirrored else "wrap", "wrap"))
-    return np.argwhere(mask & (power >= mx))
+    neighbourhood of ``size`` cells (both axes circular; ``mirrored``: the range axis
+    reflected at its ends, a real ADC's; the neighbourhood of ``scipy.ndimage``'s filters:
+    offsets -(s // 2) .. s - s // 2 - 1). Only the cells of ``mask`` are compared with
+    their neighbours. Returns int (n, 2) of (range_bin, doppler_bin), row-major order."""
+    cells = np.argwhere(mask)
+    (nr, nd), (r0, d0) = power.shape, cells.T
+    p = power[r0, d0]
+    keep = np.ones(len(cells), bool)
+    for dr in range(-(size[0] // 2), size[0] - size[0] // 2):
+        r = r0 + dr
+        if mirrored:                      # reflect without repeating the edge cell
+            r = np.clip(np.where(np.abs(r) > nr - 1, 2 * (nr - 1) - np.abs(r), np.abs(r)),
+                        0, nr - 1)
+        else:
+            r %= nr
+        for dd in range(-(size[1] // 2), size[1] - size[1] // 2):
+            if dr or dd:
+                keep &= power[r, (d0 + dd) % nd] <= p
+    return cells[keep]
 
 
 def detection_mask(n_range: int, n_doppler: int, bins: tuple[int, int]) -> np.ndarray:

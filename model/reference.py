@@ -149,6 +149,14 @@ def signed_bins(n: int) -> np.ndarray:
     return signed_bin(np.arange(n), n)
 
 
+def check_frame(adc: np.ndarray, cfg: RadarConfig) -> None:
+    """ValueError unless ``adc`` is one ADC frame of ``cfg`` (``RadarConfig.check_adc``),
+    real for a real ADC."""
+    cfg.check_adc(adc)
+    if cfg.adc == "real" and np.iscomplexobj(adc):
+        raise ValueError(f"adc: complex samples for radar {cfg.name!r}, which has a real ADC")
+
+
 def range_fft(adc: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndarray:
     """Range FFT of every chirp, scaled 1/n_range: each chirp's n_samples (windowed by a
     periodic Hann of n_samples) zero-padded to n_range; a real ADC keeps bins
@@ -157,9 +165,7 @@ def range_fft(adc: np.ndarray, cfg: RadarConfig, window: bool = True) -> np.ndar
     adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
     (n_chirps, num_rx, n_range_bins).
     """
-    cfg.check_adc(adc)
-    if cfg.adc == "real" and np.iscomplexobj(adc):
-        raise ValueError(f"adc: complex samples for radar {cfg.name!r}, which has a real ADC")
+    check_frame(adc, cfg)
     x = adc.astype(np.complex128)
     if window:
         x = x * hann_periodic(cfg.n_samples)
@@ -227,8 +233,14 @@ def dma_order_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
 
 
 def range_doppler_power(cube: np.ndarray) -> np.ndarray:
-    """Non-coherently integrated power sum_v |cube|^2, float64 (n_range, n_doppler)."""
-    return np.sum(np.abs(cube) ** 2, axis=0)
+    """Non-coherently integrated power sum_v |cube|^2, float64 (n_range, n_doppler): summed
+    channel by channel in order (what ``np.sum(np.abs(cube) ** 2, axis=0)`` computes, without
+    its two cube-sized temporaries)."""
+    cube = np.asarray(cube)
+    power = np.abs(cube[0]) ** 2
+    for channel in cube[1:]:
+        power += np.abs(channel) ** 2
+    return power
 
 
 def tdm_phase_compensation(cfg: RadarConfig, doppler_bin: np.ndarray | int) -> np.ndarray:

@@ -3,7 +3,8 @@
 The profile (``--radar``: a preset, a TOML profile or a TI ``.cfg``, ``model.profile``) says
 how to read the capture (``--capture``: a DCA1000 ``.bin`` or a ``.npy``,
 ``host.adc_capture.open_capture``); its frames are read one at a time, turned into radar cubes
-by the float reference of the chain (``model.reference.radar_cube``) and into point clouds by
+as the float reference of the chain gives them (``model.reference.radar_cube``; computed by
+its fast equivalent ``host.cube.frame_cube``) and into point clouds by
 the host processing (``radar.frame_cloud``), as ``radar detect`` does with simulated frames.
 The JSON is ``radar detect``'s, each point carrying its frame's index in the capture.
 """
@@ -20,6 +21,7 @@ import numpy as np
 
 from host.adc_capture import NpyCapture, open_capture
 from host.calibration import check_calibration, load_calibration
+from host.cube import frame_cube
 from host.dca1000 import Dca1000Capture
 from host.params import DetectionParams
 from host.pointcloud import PointCloud
@@ -27,7 +29,6 @@ from host.ros.messages import FrameStatus
 from model.array import has_vertical_extent
 from model.config import RadarConfig
 from model.profile import Calibration, Profile, load_profile
-from model.reference import radar_cube
 from radar.common import (
     CliError,
     add_command,
@@ -130,9 +131,10 @@ def process_params(args: argparse.Namespace, profile: Profile) -> tuple[Detectio
 def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
                         frame_id: int, remove_static: bool) -> FrameCloud:
     """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
-    codes, -> its cube (the float reference, ``model.reference.radar_cube``, static clutter
-    removed if asked) and point cloud (``radar.frame_cloud``), as ``radar process`` does."""
-    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window,
+    codes, -> its cube (the float reference's, ``model.reference.radar_cube``, computed fast
+    by ``host.cube.frame_cube``, static clutter removed if asked) and point cloud
+    (``radar.frame_cloud``), as ``radar process`` does."""
+    cube = frame_cube(adc, cfg, params.range_window, params.doppler_window,
                       remove_static_clutter=remove_static)
     return frame_cloud(cube, cfg, params, frame_id, "process")
 
