@@ -96,6 +96,7 @@ bench: $(STAMP)
 	$(RUN) python -m benchmarks.bench_detect
 	$(RUN) python -m benchmarks.bench_unfold
 	$(RUN) python -m benchmarks.bench_mcap
+	$(RUN) python -m benchmarks.bench_impairments
 
 # OpenRadar (the peer library) in its own virtualenv: openradar 1.0.1 does not declare its
 # dependencies (scikit-learn among them); benchmarks/bench_openradar.py runs it in a subprocess
