@@ -11,6 +11,9 @@ Operators (one textual change on one line of ``rtl/**/*.sv``):
   noreset  a register left out of the reset branch
   sticky   a sticky flag made non-sticky (``if (c) f <= 1'b1;`` -> ``f <= c;``)
   swap     two fields of a concatenation swapped
+  dropfirst, merge, count, tie, last: the bug kinds outside checks kept finding (a counter
+           that miscounts in a corner, a flag dropped from a sticky merge, a comparison wrong
+           on a tie, a TLAST term lost), see tools/mutate_ops.py
 
 Lines inside ``ifdef FORMAL`` / ``ifndef SYNTHESIS`` blocks, parameter checks, comments and
 axis_checker instances are never mutated (they are checks, not design). Each mutant runs in
@@ -41,6 +44,9 @@ import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from mutate_ops import NEW_OPS, extra_mutants  # noqa: E402 - tools/ is on sys.path now
 
 REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
@@ -262,9 +268,11 @@ def candidates(module: str) -> list[Mutant]:
     files = sorted(RTL.glob(f"**/{module}.sv"))
     if not files:
         raise SystemExit(f"error: no rtl/**/{module}.sv")
-    path = files[0]
-    rel = str(path.relative_to(REPO))
-    text = path.read_text()
+    return candidates_text(module, str(files[0].relative_to(REPO)), files[0].read_text())
+
+
+def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
+    """Every mutant of the SystemVerilog source ``text`` (file ``rel`` of ``module``)."""
     lines = text.splitlines()
     found: dict[str, list[tuple[int, str]]] = {}
 
@@ -351,6 +359,14 @@ def candidates(module: str) -> list[Mutant]:
         m = re.match(r"^(\s*)(\w+)\s*<=.*;\s*$", lines[j])
         if m:
             add("noreset", j, f"{m.group(1)}// (mutant: {m.group(2)} not reset)")
+    # the operators of tools/mutate_ops.py: a text an earlier operator produced is left out
+    seen = {(i, new) for muts in found.values() for i, new in muts}
+    extra = list(extra_mutants(text, list(_design_lines(text)), _code_part, _expr_spans))
+    for op in NEW_OPS:
+        for o, i, new in extra:
+            if o == op and (i, new) not in seen:
+                seen.add((i, new))
+                add(op, i, new)
     out: list[Mutant] = []
     for op in sorted(found):
         for k, (i, new) in enumerate(found[op]):
