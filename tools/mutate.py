@@ -124,6 +124,9 @@ TESTS: dict[str, list[list[str]]] = {
     "radar_regs": [[_Q_RC], ["tb/radar_ctrl", "-k", "test_radar_ctrl"]],
 }
 
+GENERATED = ("fft_twiddle_rom", "fft_hann_rom", "packet_crc32", "radar_regs")
+"""Modules written by generators (``make gen``, ``make regs``)."""
+
 SLOW_STAGE = 4.0
 """Timeout factor of a stage running one of :data:`SLOW_TBS` (their Verilator builds alone
 take minutes on a loaded machine)."""
@@ -272,7 +275,8 @@ def candidates(module: str) -> list[Mutant]:
 
 
 def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
-    """Every mutant of the SystemVerilog source ``text`` (file ``rel`` of ``module``)."""
+    """Every mutant of the SystemVerilog source ``text`` (file ``rel`` of ``module``); the
+    operators of tools/mutate_ops.py only for a hand-written source."""
     lines = text.splitlines()
     found: dict[str, list[tuple[int, str]]] = {}
 
@@ -361,7 +365,8 @@ def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
             add("noreset", j, f"{m.group(1)}// (mutant: {m.group(2)} not reset)")
     # the operators of tools/mutate_ops.py: a text an earlier operator produced is left out
     seen = {(i, new) for muts in found.values() for i, new in muts}
-    extra = list(extra_mutants(text, list(_design_lines(text)), _code_part, _expr_spans))
+    extra = [] if module in GENERATED else \
+        list(extra_mutants(text, list(_design_lines(text)), _code_part, _expr_spans))
     for op in NEW_OPS:
         for o, i, new in extra:
             if o == op and (i, new) not in seen:

@@ -5,8 +5,9 @@
              operands after an operator): a counter guard losing its corner term
              (``!skip_q && ovf_drop`` -> ``ovf_drop``: drops counted while skipping), a sticky
              merge losing its hold term (``framing_q || err`` -> ``err``)
-  merge      one operand dropped from a bitwise ``|`` / ``&`` merge of flags, any position,
-             continuation lines of a multi-line assignment included
+  merge      one operand dropped from a bitwise ``|`` merge of flags, any position,
+             continuation lines of a multi-line assignment included (AND merges of flags are
+             written ``&&`` here, where ``drop`` / ``dropfirst`` reach them; ``&`` is a mask)
              (``pp | ct | pk | fft_q`` / ``| det_err;`` -> the flag no longer reaches the top)
   count      a status counter (a register that saturates, ``X != '1``, or drives an output
              directly) miscounts in a corner: its increment removed (``+ 32'd1`` -> ``+ 32'd0``;
@@ -19,9 +20,10 @@
              (the TLAST never seen), not in port connections and not where it is an operand
              of ``||`` (there ``drop``/``dropfirst`` already remove it)
 
-Each operator's mutants are numbered in source order (``module:op:index``, the original
-operators' numbering is untouched); a new mutant whose text some earlier operator already
-produced on the same line is left out.
+Generated sources (``GENERATED`` in ``tools/mutate.py``) get none of them: they model slips of
+a hand-written block. Each operator's mutants are numbered in source order
+(``module:op:index``; the original operators' numbering is untouched); a new mutant whose text
+some earlier operator already produced on the same line is left out.
 """
 
 from __future__ import annotations
@@ -70,7 +72,8 @@ def _operand_end(code: str, j: int, stops: tuple[str, ...]) -> int:
             if depth == 0:
                 break
             depth -= 1
-        elif depth == 0 and (any(code.startswith(s, j) for s in stops) or ch in ";?:,"):
+        elif depth == 0 and (any(code.startswith(s, j) for s in stops) or ch in ";?:,") \
+                and "::" not in code[j - 1:j + 2]:
             break
         j += 1
     return j
@@ -89,7 +92,7 @@ def _operand_start(code: str, j: int, lo: int, stops: tuple[str, ...]) -> tuple[
             if depth == 0:
                 break
             depth -= 1
-        elif depth == 0 and ch in "?:,=":
+        elif depth == 0 and ch in "?:,=" and "::" not in code[k - 1:k + 2]:
             break
         elif depth == 0 and any(code.startswith(s, k - len(s) + 1) for s in stops):
             return k + 1, False
@@ -133,8 +136,8 @@ def extra_mutants(text: str, design: list[tuple[int, str]],
         for new in _chain_drops(code, spans, re.compile(r"\s(&&|\|\|)\s"), ("&&", "||"),
                                 every=False):
             yield "dropfirst", i, new + comment
-        for new in _chain_drops(code, spans, re.compile(r"(?<![|&])\s?[|&]\s(?![|&=])"),
-                                ("|", "&"), every=True):
+        for new in _chain_drops(code, spans, re.compile(r"(?<![|&])\s?\|\s(?![|&=])"),
+                                ("|",), every=True):
             if new.strip():
                 yield "merge", i, new + comment
         m = _INC_RE.match(code)
