@@ -105,7 +105,9 @@ TESTS: dict[str, list[list[str]]] = {
     "cfar_2d": [[_Q_CFAR], [_Q_DC]],
     "detect_records": [[_Q_REC], [_Q_DC]],
     "detect_chain": [[_Q_DC], ["tb/detect_chain"]],
-    "radar_pipeline": [[_Q_RP], [_Q_RPFS], ["tb/radar_pipeline/test_harness.py"]],
+    # the detect-mode top (OUTPUT_MODE 1: g_detect, the detector's flag in the status merge)
+    "radar_pipeline": [[_Q_RP], [_Q_RPFS], ["tb/radar_pipeline/test_harness.py"],
+                       ["tb/radar_pipeline/test_radar_pipeline_detect.py", "-k", "small4"]],
     "fft_axis": _FFT,
     "fft_reorder": _FFT,
     "fft_sdf_bf": _FFT,
