@@ -233,3 +233,12 @@ def test_original_operator_ids_are_stable() -> None:
     old = [m for m in by_id.values() if m.op not in mutate.NEW_OPS]
     assert {m.op for m in old} == {"rel", "arith", "logic", "drop", "neg", "const", "noreset",
                                    "sticky", "swap"}
+
+
+def test_dropfirst_keeps_comparisons_whole() -> None:
+    """A comparison binds tighter than ``||``: the first operand dropped is all of it."""
+    text = _SNIPPET.replace("assign pos_end = (frames_q == 32'd7);",
+                            "assign pos_end = (frames_q == 32'd7 || beat);")
+    got = set(_snippet_mutants_of(text).values())
+    assert "assign pos_end = (beat);" in got
+    assert not [v for v in got if "frames_q == beat" in v]

@@ -92,7 +92,9 @@ def _operand_start(code: str, j: int, lo: int, stops: tuple[str, ...]) -> tuple[
             if depth == 0:
                 break
             depth -= 1
-        elif depth == 0 and ch in "?:,=" and "::" not in code[k - 1:k + 2]:
+        elif depth == 0 and ch in "?:,=" and "::" not in code[k - 1:k + 2] \
+                and not (ch == "=" and code[k - 1:k] in "=!<>" and k > lo) \
+                and code[k + 1:k + 2] != "=":
             break
         elif depth == 0 and any(code.startswith(s, k - len(s) + 1) for s in stops):
             return k + 1, False
