@@ -46,7 +46,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from mutate_ops import NEW_OPS, extra_mutants  # noqa: E402 - tools/ is on sys.path now
+from mutate_ops import NEW_OPS, extra_mutants, operand_end  # noqa: E402 - tools/ is on sys.path now
 
 REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
@@ -311,20 +311,7 @@ def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
         # dropped term: "a && b" -> "a" (the operand after the operator, up to the next
         # operator or closing paren at the same depth)
         for m in _ops_in(code, spans, re.compile(r"\s(&&|\|\|)\s")):
-            j, depth = m.end(), 0
-            while j < len(code):
-                ch = code[j]
-                if ch in "([{":
-                    depth += 1
-                elif ch in ")]}":
-                    if depth == 0:
-                        break
-                    depth -= 1
-                elif depth == 0 and (code.startswith("&&", j) or code.startswith("||", j)
-                                     or ch in ";?:,"):
-                    break
-                j += 1
-            tail = code[j:]
+            tail = code[operand_end(code, m.end(), ("&&", "||")):]
             if tail.startswith("&&") or tail.startswith("||"):
                 tail = " " + tail
             add("drop", i, code[:m.start()].rstrip() + tail.lstrip(" ") if tail.startswith((

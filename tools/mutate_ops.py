@@ -60,7 +60,7 @@ def wide_spans(code: str, spans: Spans) -> tuple[Spans, int]:
     return out, 2 if out else 0
 
 
-def _operand_end(code: str, j: int, stops: tuple[str, ...]) -> int:
+def operand_end(code: str, j: int, stops: tuple[str, ...]) -> int:
     """End of the operand starting at ``j``: the next ``stops`` operator, ``;?:,`` or closing
     bracket at depth 0."""
     depth = 0
@@ -113,7 +113,7 @@ def _chain_drops(code: str, spans: Spans, op_re: re.Pattern[str], stops: tuple[s
                 lead = len(code[start:m.start()]) - len(code[start:m.start()].lstrip())
                 yield code[:start + lead] + code[m.end():].lstrip()
             if every:
-                end = _operand_end(code, m.end(), stops)
+                end = operand_end(code, m.end(), stops)
                 if end > m.end():
                     yield code[:m.start()].rstrip() + code[end:] if code[end:end + 1] in \
                         (";", ")", ",", "") else code[:m.start()] + " " + code[end:].lstrip()
