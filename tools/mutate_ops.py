@@ -164,7 +164,7 @@ def extra_mutants(text: str, design: list[tuple[int, str]],
                 rhs = code[a + t.end():b].lstrip()
                 if lhs and re.search(r"_q$|cnt|count|idx|pos", lhs.group(1)) \
                         and "state" not in lhs.group(1) \
-                        and not re.match(r"'[01]\b|\d+'[bd]0\b|'0", rhs):
+                        and not re.match(r"'[01]\b|\d+'[bd]0\b|'0|0\b", rhs):
                     yield "tie", i, code[:a + t.start()] + ">=" + code[a + t.end():] + comment
             for t in LAST_RE.finditer(code, a, b) if beyond != 2 else ():
                 before = code[a:t.start()].rstrip()
