@@ -550,6 +550,11 @@ EQUIVALENT: dict[str, str] = {
     "mark_fifo:const:8": (
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
+    "frame_align:count:6": (
+        "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
+        "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
+        "stable), and the input contract (the proof's assumption) puts TLAST only on sample "
+        "N_RANGE-1 >= 1, so s_axis_tlast is 0 whenever the counter can count"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "
