@@ -29,7 +29,8 @@ coverage = _load("coverage")
 
 def test_every_operator_has_mutants() -> None:
     ops = {m.op for mod in mutate.TESTS for m in mutate.candidates(mod)}
-    assert ops == {"rel", "arith", "logic", "drop", "neg", "const", "noreset", "sticky", "swap"}
+    assert ops == {"rel", "arith", "logic", "drop", "neg", "const", "noreset", "sticky", "swap",
+                   *mutate.NEW_OPS}
 
 
 def test_checks_are_never_mutated() -> None:
@@ -145,3 +146,99 @@ def test_coverage_waivers(tmp_path: Path) -> None:
 def test_ci_mutant_is_killed(mutant) -> None:
     verdict, _ = mutate.run_mutant(mutant, timeout=300, quick=True)
     assert verdict in ("killed", "timeout"), f"{mutant.ident} {verdict}:\n{mutant.diff()}"
+
+
+# A small block holding each bug kind the new operators model (tools/mutate_ops.py).
+_SNIPPET = """\
+module snip (input logic clk, rst, beat, skip_q, ovf, s_axis_tlast, a_err, b_err,
+             output logic err, output logic [31:0] drops);
+  logic [31:0] drop_cnt_q, frames_q;
+  logic        framing_q, pos_end;
+  assign pos_end = (frames_q == 32'd7);
+  assign err = a_err | b_err
+             | framing_q;
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      drop_cnt_q <= '0;
+    end else begin
+      if (!skip_q && ovf && drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 32'd1;
+      framing_q <= framing_q || a_err;
+      if (beat && s_axis_tlast) frames_q <= frames_q + 1'b1;
+    end
+  end
+  assign drops = drop_cnt_q;
+endmodule
+"""
+
+
+def _snippet_mutants_of(text: str) -> dict[str, str]:
+    """ident -> mutated line (stripped) of every mutant of ``text``."""
+    return {m.ident: m.after.strip() for m in mutate.candidates_text("snip", "rtl/snip.sv", text)}
+
+
+def _snippet_mutants() -> dict[str, str]:
+    return _snippet_mutants_of(_SNIPPET)
+
+
+def test_new_operators_generate_the_intended_mutants() -> None:
+    """Each operator added for issue 33 produces the bug it models on a small block, with
+    fixed identifiers (the campaign's results and the equivalent list are keyed by them)."""
+    got = _snippet_mutants()
+    expected = {
+        # (a) a counter guard losing its corner term: drops counted while skipping
+        "snip:dropfirst:0": "if (ovf && drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 32'd1;",
+        # (b) a sticky merge losing its hold term (`||`) and a top-level merge losing a flag
+        "snip:dropfirst:1": "framing_q <= a_err;",
+        "snip:merge:0": "assign err = b_err",
+        "snip:merge:1": "assign err = a_err",
+        "snip:merge:2": ";",
+        # (a) a status counter's increment removed, and gaining a last-beat corner term (the
+    # last/end terms are those the block's conditions and right-hand sides read)
+        "snip:count:0": "if (!skip_q && ovf && drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 32'd0;",
+        "snip:count:1": ("if (!skip_q && ovf && drop_cnt_q != '1 && !s_axis_tlast) "
+                         "drop_cnt_q <= drop_cnt_q + 32'd1;"),
+        # (c) a counter compared with its bound: wrong past the tie
+        "snip:tie:0": "assign pos_end = (frames_q >= 32'd7);",
+        # (d) the TLAST term dropped from a condition, or never seen
+        "snip:dropfirst:2": "if (s_axis_tlast) frames_q <= frames_q + 1'b1;",
+        "snip:drop:3": "if (beat) frames_q <= frames_q + 1'b1;",
+        "snip:last:0": "if (beat && 1'b0) frames_q <= frames_q + 1'b1;",
+    }
+    for ident, after in expected.items():
+        assert got.get(ident) == after, (ident, got.get(ident))
+    # frames_q is not a status counter (neither saturating nor an output): no count mutant
+    assert not [k for k, v in got.items() if ":count:" in k and "frames_q <=" in v]
+    # the original `drop` drops only operands after an operator; `dropfirst` the first one
+    assert got["snip:drop:0"].startswith("if (!skip_q && drop_cnt_q")
+    # no two mutants of the new operators write the same line
+    lines = [v for k, v in got.items() if k.split(":")[1] in mutate.NEW_OPS]
+    assert len(lines) == len(set(lines))
+
+
+def test_tie_reaches_continuation_lines() -> None:
+    text = _SNIPPET.replace("assign pos_end = (frames_q == 32'd7);",
+                            "assign pos_end = beat\n                 && (frames_q < 32'd7);")
+    got = _snippet_mutants_of(text)
+    assert "&& (frames_q <= 32'd7);" in got.values()
+
+
+def test_original_operator_ids_are_stable() -> None:
+    """The new operators leave the original operators' numbering untouched: every mutant named
+    as equivalent or in the CI subset still names the same line."""
+    by_id = {m.ident: m for mod in mutate.TESTS for m in mutate.candidates(mod)}
+    assert set(mutate.EQUIVALENT) <= set(by_id)
+    assert "snap_room" in by_id["detect_chain:drop:0"].before
+    assert "b_err || r_err" in by_id["frame_store_axi:drop:24"].before
+    assert mutate.ci_mutants()
+    old = [m for m in by_id.values() if m.op not in mutate.NEW_OPS]
+    assert {m.op for m in old} == {"rel", "arith", "logic", "drop", "neg", "const", "noreset",
+                                   "sticky", "swap"}
+
+
+def test_dropfirst_keeps_comparisons_whole() -> None:
+    """A comparison binds tighter than ``||``: the first operand dropped is all of it."""
+    text = _SNIPPET.replace("assign pos_end = (frames_q == 32'd7);",
+                            "assign pos_end = (frames_q == 32'd7 || beat);")
+    got = set(_snippet_mutants_of(text).values())
+    assert "assign pos_end = (beat);" in got
+    assert not [v for v in got if "frames_q == beat" in v]

@@ -11,6 +11,9 @@ Operators (one textual change on one line of ``rtl/**/*.sv``):
   noreset  a register left out of the reset branch
   sticky   a sticky flag made non-sticky (``if (c) f <= 1'b1;`` -> ``f <= c;``)
   swap     two fields of a concatenation swapped
+  dropfirst, merge, count, tie, last: the bug kinds outside checks kept finding (a counter
+           that miscounts in a corner, a flag dropped from a sticky merge, a comparison wrong
+           on a tie, a TLAST term lost), see tools/mutate_ops.py
 
 Lines inside ``ifdef FORMAL`` / ``ifndef SYNTHESIS`` blocks, parameter checks, comments and
 axis_checker instances are never mutated (they are checks, not design). Each mutant runs in
@@ -41,6 +44,9 @@ import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from mutate_ops import NEW_OPS, extra_mutants, operand_end  # noqa: E402 - tools/ is on sys.path now
 
 REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
@@ -101,7 +107,9 @@ TESTS: dict[str, list[list[str]]] = {
     "cfar_2d": [[_Q_CFAR], [_Q_DC]],
     "detect_records": [[_Q_REC], [_Q_DC]],
     "detect_chain": [[_Q_DC], ["tb/detect_chain"]],
-    "radar_pipeline": [[_Q_RP], [_Q_RPFS], ["tb/radar_pipeline/test_harness.py"]],
+    # the detect-mode top (OUTPUT_MODE 1: g_detect, the detector's flag in the status merge)
+    "radar_pipeline": [[_Q_RP], [_Q_RPFS], ["tb/radar_pipeline/test_harness.py"],
+                       ["tb/radar_pipeline/test_radar_pipeline_detect.py", "-k", "small4"]],
     "fft_axis": _FFT,
     "fft_reorder": _FFT,
     "fft_sdf_bf": _FFT,
@@ -119,6 +127,9 @@ TESTS: dict[str, list[list[str]]] = {
     # testbench reads and writes every register through it
     "radar_regs": [[_Q_RC], ["tb/radar_ctrl", "-k", "test_radar_ctrl"]],
 }
+
+GENERATED = ("fft_twiddle_rom", "fft_hann_rom", "packet_crc32", "radar_regs")
+"""Modules written by generators (``make gen``, ``make regs``)."""
 
 SLOW_STAGE = 4.0
 """Timeout factor of a stage running one of :data:`SLOW_TBS` (their Verilator builds alone
@@ -264,9 +275,12 @@ def candidates(module: str) -> list[Mutant]:
     files = sorted(RTL.glob(f"**/{module}.sv"))
     if not files:
         raise SystemExit(f"error: no rtl/**/{module}.sv")
-    path = files[0]
-    rel = str(path.relative_to(REPO))
-    text = path.read_text()
+    return candidates_text(module, str(files[0].relative_to(REPO)), files[0].read_text())
+
+
+def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
+    """Every mutant of the SystemVerilog source ``text`` (file ``rel`` of ``module``); the
+    operators of tools/mutate_ops.py only for a hand-written source."""
     lines = text.splitlines()
     found: dict[str, list[tuple[int, str]]] = {}
 
@@ -299,20 +313,7 @@ def candidates(module: str) -> list[Mutant]:
         # dropped term: "a && b" -> "a" (the operand after the operator, up to the next
         # operator or closing paren at the same depth)
         for m in _ops_in(code, spans, re.compile(r"\s(&&|\|\|)\s")):
-            j, depth = m.end(), 0
-            while j < len(code):
-                ch = code[j]
-                if ch in "([{":
-                    depth += 1
-                elif ch in ")]}":
-                    if depth == 0:
-                        break
-                    depth -= 1
-                elif depth == 0 and (code.startswith("&&", j) or code.startswith("||", j)
-                                     or ch in ";?:,"):
-                    break
-                j += 1
-            tail = code[j:]
+            tail = code[operand_end(code, m.end(), ("&&", "||")):]
             if tail.startswith("&&") or tail.startswith("||"):
                 tail = " " + tail
             add("drop", i, code[:m.start()].rstrip() + tail.lstrip(" ") if tail.startswith((
@@ -353,6 +354,15 @@ def candidates(module: str) -> list[Mutant]:
         m = re.match(r"^(\s*)(\w+)\s*<=.*;\s*$", lines[j])
         if m:
             add("noreset", j, f"{m.group(1)}// (mutant: {m.group(2)} not reset)")
+    # the operators of tools/mutate_ops.py: a text an earlier operator produced is left out
+    seen = {(i, new) for muts in found.values() for i, new in muts}
+    extra = [] if module in GENERATED else \
+        list(extra_mutants(text, list(_design_lines(text)), _code_part, _expr_spans))
+    for op in NEW_OPS:
+        for o, i, new in extra:
+            if o == op and (i, new) not in seen:
+                seen.add((i, new))
+                add(op, i, new)
     out: list[Mutant] = []
     for op in sorted(found):
         for k, (i, new) in enumerate(found[op]):
@@ -542,6 +552,11 @@ EQUIVALENT: dict[str, str] = {
     "mark_fifo:const:8": (
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
+    "frame_align:count:6": (
+        "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
+        "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
+        "stable), and the input contract (the proof's assumption) puts TLAST only on sample "
+        "N_RANGE-1 >= 1, so s_axis_tlast is 0 whenever the counter can count"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "

@@ -176,12 +176,11 @@ def _params(num_tx: int, num_rx: int, n_range: int, n_doppler: int, max_det: int
 
 PARAMS = [
     _params(1, 1, 8, 8, 3),     # 8-word headers, 1-word snapshots
-]
-LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
+    # one-word headers (the full preset's 16 lanes): the only geometry where the last record
+    # of a truncated frame leaves out_q on the frame's last word while cells still come in
+    # (mutant detect_records:count:0 miscounts the detections past MAX_DETECTIONS there)
     _params(4, 16, 8, 16, 4),   # one-word headers, 4-word snapshots
 ]
-if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
-    PARAMS += LONG_PARAMS
 
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: "_".join(

@@ -88,13 +88,27 @@ class TB(AxisTB):
         cocotb.start_soon(self._axi_monitor())
 
     async def _axi_monitor(self) -> None:
-        """Record every AW/AR (address, beats); count input stalls when ``count_stalls``."""
+        """Record every AW/AR (address, beats); count input stalls when ``count_stalls``;
+        check that at most MAX_OUTSTANDING write bursts (AW in, B not yet) and read bursts
+        (AR in, last R beat not yet) are open (a limit off on the tie, ``<=`` for ``<``, lets
+        one more through: mutant ``frame_store_axi:tie:1``)."""
         d = self.dut
         beat_size = self.g.axi_bytes.bit_length() - 1
-        cyc = 0
+        limit = param("MAX_OUTSTANDING")
+        cyc = open_w = open_r = 0
         while True:
             await RisingEdge(d.clk)
             cyc += 1
+            if d.rst.value == 1:
+                open_w = open_r = 0
+                continue
+            open_w += int(d.m_axi_mem_awvalid.value == 1 and d.m_axi_mem_awready.value == 1)
+            open_w -= int(d.m_axi_mem_bvalid.value == 1 and d.m_axi_mem_bready.value == 1)
+            open_r += int(d.m_axi_mem_arvalid.value == 1 and d.m_axi_mem_arready.value == 1)
+            open_r -= int(d.m_axi_mem_rvalid.value == 1 and d.m_axi_mem_rready.value == 1
+                          and d.m_axi_mem_rlast.value == 1)
+            open_w, open_r = max(open_w, 0), max(open_r, 0)
+            assert open_w <= limit and open_r <= limit, (cyc, open_w, open_r, limit)
             if d.m_axi_mem_awvalid.value == 1 and d.m_axi_mem_awready.value == 1:
                 assert int(d.m_axi_mem_awsize.value) == beat_size
                 assert int(d.m_axi_mem_awburst.value) == 1
