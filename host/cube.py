@@ -6,9 +6,9 @@ scaled 1/n_range, corner turn, optional static-clutter removal, Doppler window, 
 scaled 1/n_doppler), each a pass over the cube. Both windows and both scales are linear
 per axis, so here they are one precomputed (n_samples, n_loops) weight, applied while the
 frame is cast to float64 and turned into cube order (a single pass); static-clutter removal
-(each slow-time vector less its mean) commutes with the range FFT and its window, so it is
-done on the samples, before the weight; then one 2-D FFT (a real ADC: a real
-FFT along range, which gives bins 0..n_range/2 directly). ``radar process`` builds its cubes
+(each slow-time vector less its Doppler-window weighted mean) commutes with the range FFT and
+its window, so it is done on the samples, before the weight; then one 2-D FFT (a real ADC: a
+real FFT along range, which gives bins 0..n_range/2 directly). ``radar process`` builds its cubes
 here (``radar.commands.process.capture_frame_cloud``); the tests hold it to the reference.
 """
 
@@ -52,8 +52,9 @@ def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     x = x.transpose(1, 2, 3, 0)                 # (tx, rx, samples, loops)
     real = cfg.adc == "real"
     y = np.empty(x.shape, np.float64 if real else np.complex128)
-    if remove_static_clutter:               # less the slow-time mean, in float64
-        np.subtract(x, x.mean(axis=-1, keepdims=True, dtype=y.dtype), out=y)
+    if remove_static_clutter:   # less the (Doppler-window weighted) slow-time mean, float64
+        w_d = hann_periodic(cfg.n_loops) if doppler_window else np.ones(cfg.n_loops)
+        np.subtract(x, (x @ w_d)[..., None] / w_d.sum(), out=y)
         y *= w
     else:
         np.multiply(x, w, out=y)

@@ -244,7 +244,7 @@ def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams
                              cfg.n_doppler, read_order=order)
     vectors = turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2)
     if params.static_removal:
-        vectors = remove_static_planar(vectors)[0].astype(vectors.dtype)
+        vectors = remove_static_planar(vectors, window=params.window)[0].astype(vectors.dtype)
     dop_p, dop_ov = fft_fixed_planar(vectors, window=params.window,
                                      scale_sch=params.doppler_scale_sch)
     return from_planar(dop_p).reshape(-1, cfg.num_rx), int(rng_ov.sum()), int(dop_ov.sum())

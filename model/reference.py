@@ -196,11 +196,18 @@ def doppler_fft(turned: np.ndarray, cfg: RadarConfig, window: bool = True) -> np
     return np.fft.fft(x, n=cfg.n_doppler, axis=-1) / cfg.n_doppler
 
 
-def remove_static(turned: np.ndarray) -> np.ndarray:
+def remove_static(turned: np.ndarray, window: bool = True) -> np.ndarray:
     """Static-clutter removal: each slow-time vector less its mean over the frame's chirps,
-    i.e. per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing a
-    capture"). turned: complex (..., n_loops) -> the same shape; returns a new array."""
-    return turned - turned.mean(axis=-1, keepdims=True)
+    per channel (TX slot and RX) and range bin (docs/profiles.md, "Processing a capture"),
+    the mean weighted by the Doppler window when it is on: ``c = sum(w x) / sum(w)`` with
+    ``w`` the periodic Hann of n_loops (:func:`doppler_fft`'s), so a constant is removed
+    exactly and the windowed zero-Doppler bin of any vector is left exactly zero (no residue
+    of a moving target's rectangular-window sidelobes); the plain mean with the window off.
+    turned: complex (..., n_loops) -> the same shape; returns a new array."""
+    if not window:
+        return turned - turned.mean(axis=-1, keepdims=True)
+    w = hann_periodic(turned.shape[-1])
+    return turned - (turned @ w)[..., None] / w.sum()
 
 
 def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
@@ -215,7 +222,7 @@ def radar_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     """
     turned = corner_turn(range_fft(adc, cfg, range_window), cfg)
     if remove_static_clutter:
-        turned = remove_static(turned)
+        turned = remove_static(turned, doppler_window)
     cube = doppler_fft(turned, cfg, doppler_window)
     return cube.reshape(cfg.cube_shape)
 

@@ -3,13 +3,19 @@ vector (one TX slot and range bin, ``n_doppler`` words of ``num_rx`` lanes) less
 the frame's first ``n_loops`` chirps, per lane and per I/Q, between the corner turn and the
 Doppler FFT. The float definition is ``model.reference.remove_static``.
 
-Arithmetic (the RTL's, exactly): ``s`` = the exact sum of a vector's first ``n_loops`` samples
-of one lane's I (or Q); the mean ``m = floor((s * RECIP + 2^(SH-1)) / 2^SH)`` with
-``SH = SUM_W + clog2(n_loops) + 1``, ``SUM_W = data_w + clog2(n_loops)`` and
-``RECIP = floor(2^SH / n_loops) + 1`` (:func:`mean`) -- which is ``s / n_loops`` rounded to
-nearest with ties away from zero for every reachable ``s`` (:func:`mean_exact`, checked in
-tests/test_static_removal.py). Words ``d < n_loops``: ``x - m`` saturated to ``data_w`` bits;
-words ``d >= n_loops`` (zero fill) pass unchanged; with the removal off everything passes.
+Arithmetic (the RTL's, exactly): ``s`` = the exact weighted sum ``sum w[n] x[n]`` of a
+vector's first ``n_loops`` samples of one lane's I (or Q), the weights :func:`weights` (the
+Doppler window's quantised periodic Hann, ``model.fft_rom.hann_window(n_loops)``, with the
+pipeline's WINDOW on; all ones, the plain mean, with it off); the divisor ``D = sum w``
+(:func:`divisor`: ``n_loops * 2^15`` windowed, ``n_loops`` plain); the mean
+``m = floor((s * RECIP + 2^(SH-1)) / 2^SH)`` with ``SH = data_w + 2 clog2(D) + 1`` and
+``RECIP = floor(2^SH / D) + 1`` (:func:`mean`) -- which is ``s / D`` rounded to nearest with
+ties away from zero for every reachable ``s`` (:func:`mean_exact`, checked in
+tests/test_static_removal.py). Subtracting the window-weighted mean leaves the windowed
+zero-Doppler bin of every vector zero up to that rounding (``sum w (x - s/D) = 0``), where the
+plain mean would leave a moving target's rectangular-window sidelobe there. Words
+``d < n_loops``: ``x - m`` saturated to ``data_w`` bits; words ``d >= n_loops`` (zero fill)
+pass unchanged; with the removal off everything passes.
 """
 
 from __future__ import annotations
@@ -17,43 +23,66 @@ from __future__ import annotations
 import numpy as np
 
 from model.axis_packetizer import pack_iq, unpack_iq
+from model.fft_rom import COEF_FRAC, ROM_SIZE, hann_window
 
 
 def _clog2(n: int) -> int:
     return (n - 1).bit_length()
 
 
-def shift_and_recip(n_loops: int, data_w: int = 16) -> tuple[int, int]:
-    """(SH, RECIP) of the reciprocal multiply for ``n_loops`` (RTL localparams)."""
-    lb = _clog2(n_loops)
+def weights(n_loops: int, window: bool = True) -> np.ndarray:
+    """int64 (n_loops,): the weight of each slow-time sample in the mean -- the Doppler
+    window's quantised periodic Hann (Q1.16, ``model.fft_rom.hann_window``, the
+    ``fft_hann_rom`` coefficients; ``n_loops`` a power of two >= 2) with ``window``, else
+    ones."""
+    if not window:
+        return np.ones(n_loops, dtype=np.int64)
+    if n_loops < 2 or n_loops & (n_loops - 1) or n_loops > ROM_SIZE:
+        raise ValueError(f"window-weighted mean needs n_loops a power of two in 2..{ROM_SIZE}")
+    return hann_window(n_loops)
+
+
+def divisor(n_loops: int, window: bool = True) -> int:
+    """sum of :func:`weights`: ``n_loops`` plain, ``n_loops * 2^15`` windowed (the RTL's
+    constant; equal to the table's sum, checked in tests/test_static_removal.py)."""
+    return n_loops << (COEF_FRAC - 1) if window else n_loops
+
+
+def shift_and_recip(div: int, data_w: int = 16) -> tuple[int, int]:
+    """(SH, RECIP) of the reciprocal multiply dividing by ``div`` (RTL localparams)."""
+    lb = _clog2(div)
     sh = data_w + 2 * lb + 1
-    return sh, (1 << sh) // n_loops + 1
+    return sh, (1 << sh) // div + 1
 
 
-def mean(sums: np.ndarray, n_loops: int, data_w: int = 16) -> np.ndarray:
-    """Rounded means of exact int64 sums of ``n_loops`` samples, as the RTL computes them:
-    ``(s * RECIP + 2^(SH-1)) >> SH`` (arithmetic shift). int64, same shape."""
-    sh, recip = shift_and_recip(n_loops, data_w)
+def mean(sums: np.ndarray, div: int, data_w: int = 16) -> np.ndarray:
+    """Rounded means of exact int64 weighted sums ``s`` (``|s| <= 2^(data_w-1) div``), as the
+    RTL computes them: ``(s * RECIP + 2^(SH-1)) >> SH`` (arithmetic shift). int64, same
+    shape."""
+    sh, recip = shift_and_recip(div, data_w)
+    s = np.asarray(sums, dtype=object if sh + data_w + _clog2(div) > 62 else np.int64)
+    return np.asarray((s * recip + (1 << (sh - 1))) >> sh).astype(np.int64)
+
+
+def mean_exact(sums: np.ndarray, div: int) -> np.ndarray:
+    """``s / div`` rounded to nearest, ties away from zero (what :func:`mean` equals)."""
     s = np.asarray(sums, dtype=np.int64)
-    return (s * np.int64(recip) + np.int64(1 << (sh - 1))) >> np.int64(sh)
-
-
-def mean_exact(sums: np.ndarray, n_loops: int) -> np.ndarray:
-    """``s / n_loops`` rounded to nearest, ties away from zero (what :func:`mean` equals)."""
-    s = np.asarray(sums, dtype=np.int64)
-    mag = (2 * np.abs(s) + n_loops) // (2 * n_loops)
+    mag = (2 * np.abs(s) + div) // (2 * div)
     return np.where(s < 0, -mag, mag)
 
 
-def remove_static_planar(x: np.ndarray, n_loops: int | None = None, data_w: int = 16
-                         ) -> tuple[np.ndarray, int]:
+def remove_static_planar(x: np.ndarray, n_loops: int | None = None, data_w: int = 16,
+                         window: bool = True) -> tuple[np.ndarray, int]:
     """Integer-valued planar vectors ``(..., n_doppler, num_rx, 2)`` (I, Q last; slow time on
-    axis -3) -> (the same shape, int64, less each lane's rounded mean over the first
-    ``n_loops`` (default n_doppler) slow-time samples and saturated; the number of output
-    words with a saturated value, the RTL's ``status_saturated`` events)."""
+    axis -3) -> (the same shape, int64, less each lane's rounded weighted mean over the first
+    ``n_loops`` (default n_doppler) slow-time samples (:func:`weights`: the Doppler window's
+    when ``window``, else the plain mean) and saturated; the number of output words with a
+    saturated value, the RTL's ``status_saturated`` events)."""
     v = np.asarray(x).astype(np.int64)
     n_loops = v.shape[-3] if n_loops is None else n_loops
-    m = mean(v[..., :n_loops, :, :].sum(axis=-3, keepdims=True), n_loops, data_w)
+    w = weights(n_loops, window)[:, None, None]
+    m = mean((v[..., :n_loops, :, :] * w).sum(axis=-3, keepdims=True),
+             divisor(n_loops, window), data_w)
     lo, hi = -(1 << (data_w - 1)), (1 << (data_w - 1)) - 1
     out = v.copy()
     d = v[..., :n_loops, :, :] - m
@@ -63,7 +92,7 @@ def remove_static_planar(x: np.ndarray, n_loops: int | None = None, data_w: int 
 
 
 def static_removal(words: np.ndarray, n_doppler: int, n_loops: int | None = None,
-                   enable: bool = True) -> tuple[np.ndarray, int]:
+                   enable: bool = True, window: bool = True) -> tuple[np.ndarray, int]:
     """One frame through the block. ``words``: uint32 ``(frame_words, num_rx)`` packed
     ``{Q, I}`` lanes, whole Doppler vectors of ``n_doppler`` words in stream order ->
     (the output words, same shape and order; saturated output words)."""
@@ -72,5 +101,5 @@ def static_removal(words: np.ndarray, n_doppler: int, n_loops: int | None = None
     w = np.asarray(words)
     c = unpack_iq(w).reshape(-1, n_doppler, w.shape[1])
     planar = np.stack([c.real, c.imag], axis=-1)
-    out, sat = remove_static_planar(planar, n_loops)
+    out, sat = remove_static_planar(planar, n_loops, window=window)
     return pack_iq((out[..., 0] + 1j * out[..., 1]).reshape(w.shape)), sat

@@ -3,7 +3,7 @@ profile (the OpenRadar 2 TX x 4 RX) and one seed, with every effect but the clut
 simulation is the slow part) and large per-channel errors (3 dB / 30 deg rms per TX and RX):
 the calibration ``radar calibrate`` estimates takes the azimuth errors back to the clean
 case's, keeps every target to one point and adds no angle component in the targets' cells.
-A property, not a timing; the benchmark's table and what it leaves (remove-static residue,
+A property, not a timing; the benchmark's table and what it leaves (leakage skirts,
 I/Q images) are in docs/profiles.md, "Measured: impairments and calibration"."""
 
 from __future__ import annotations

@@ -92,7 +92,8 @@ def test_real_frame_cloud(remove):
     ref = frame_cloud(radar_cube(adc, cfg, remove_static_clutter=remove), cfg, params, 0,
                       "process")
     assert_same_cloud(fast.cloud, ref.cloud)
-    np.testing.assert_allclose(fast.nci, ref.nci, rtol=1e-9)
+    # atol: with the removal the zero-Doppler bin is exactly zero up to float64 rounding
+    np.testing.assert_allclose(fast.nci, ref.nci, rtol=1e-9, atol=1e-12 * ref.nci.max())
 
 
 @pytest.mark.parametrize("preset,seed", [(name, seed) for name in PRESETS for seed in (0, 3)])

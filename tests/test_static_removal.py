@@ -13,11 +13,19 @@ from model.radar_pipeline import PipelineParams, scaled_cube
 from model.reference import remove_static
 from model.scene import PointTarget, Scene
 from model.simulate import simulate_scene
-from model.static_removal import mean, mean_exact, remove_static_planar, static_removal
+from model.static_removal import (
+    divisor,
+    mean,
+    mean_exact,
+    remove_static_planar,
+    static_removal,
+    weights,
+)
 
 
-@pytest.mark.parametrize("n_loops", [1, 2, 3, 13, 200, 255, 256, 4095])
+@pytest.mark.parametrize("n_loops", [1, 2, 3, 13, 200, 255, 256, 4095, 2 << 15, 256 << 15])
 def test_mean_is_rounded_half_away_for_every_sum(n_loops: int) -> None:
+    """Divisors: plain means of n_loops samples and windowed ones (n_loops * 2^15)."""
     lo, hi = -(1 << 15) * n_loops, ((1 << 15) - 1) * n_loops
     if hi - lo < 1 << 22:
         s = np.arange(lo, hi + 1)
@@ -29,20 +37,43 @@ def test_mean_is_rounded_half_away_for_every_sum(n_loops: int) -> None:
     assert mean(s, n_loops).min() >= -(1 << 15) and mean(s, n_loops).max() < 1 << 15
 
 
-def test_follows_the_float_definition() -> None:
+@pytest.mark.parametrize("n", [2, 4, 16, 256, 4096])
+def test_window_sum_is_the_rtl_divisor(n: int) -> None:
+    """The quantised Hann's sum is n * 2^15 (HANN[k] + HANN[k + 2048] = 65536 exactly), the
+    constant the RTL divides by."""
+    assert int(weights(n).sum()) == divisor(n) == n << 15
+
+
+@pytest.mark.parametrize("window", [True, False])
+def test_follows_the_float_definition(window: bool) -> None:
     rng = np.random.default_rng(0)
     x = rng.integers(-12000, 12000, (5, 32, 4, 2)) + rng.integers(-9000, 9000, (5, 1, 4, 2))
-    out, sat = remove_static_planar(x)
-    ref = remove_static((x[..., 0] + 1j * x[..., 1]).transpose(0, 2, 1)).transpose(0, 2, 1)
+    out, sat = remove_static_planar(x, window=window)
+    ref = remove_static((x[..., 0] + 1j * x[..., 1]).transpose(0, 2, 1),
+                        window).transpose(0, 2, 1)
     assert sat == 0
-    assert np.abs(out[..., 0] - ref.real).max() <= 0.5
-    assert np.abs(out[..., 1] - ref.imag).max() <= 0.5
+    assert np.abs(out[..., 0] - ref.real).max() <= 0.5 + 1e-6 * window
+    assert np.abs(out[..., 1] - ref.imag).max() <= 0.5 + 1e-6 * window
+
+
+def test_windowed_zero_doppler_bin_is_left_empty() -> None:
+    """A moving tone less its window-weighted mean: the Hann-windowed DC bin is zero up to the
+    mean's rounding, |0.5 + 0.5j| (with the plain mean it keeps the tone's rectangular
+    sidelobe)."""
+    n = np.arange(64)
+    tone = 8000 * np.exp(2j * np.pi * 5.3 * n / 64)
+    x = np.stack([np.rint(tone.real), np.rint(tone.imag)], -1)[:, None, :]
+    w = weights(64) / divisor(64)
+    for window, bound in ((True, 0.5**0.5), (False, None)):
+        out = remove_static_planar(x, window=window)[0][:, 0]
+        dc = abs(((out[:, 0] + 1j * out[:, 1]) * w).sum())
+        assert dc <= bound if bound else dc > 50
 
 
 def test_zero_fill_saturation_and_bypass() -> None:
     x = np.zeros((1, 8, 1, 2), dtype=np.int64)
     x[0, :5, 0, 0] = [32767, 32767, 32767, 32767, -32767]   # mean 19660.2 -> 19660
-    out, sat = remove_static_planar(x, n_loops=5)
+    out, sat = remove_static_planar(x, n_loops=5, window=False)
     assert out[0, :, 0, 0].tolist() == [13107] * 4 + [-32768, 0, 0, 0]
     assert sat == 1                                          # -32767 - 19660 saturates
     words = np.arange(16, dtype=np.uint32).reshape(8, 2) * 0x10001

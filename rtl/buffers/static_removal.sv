@@ -1,16 +1,27 @@
 // SPDX-License-Identifier: Apache-2.0
 // Static-clutter removal between the corner turn and the Doppler FFT: each slow-time vector
 // (one TX slot, one range bin, N_DOPPLER words of NUM_RX lanes) less its mean over the frame's
-// chirps, per lane and per I/Q (model/static_removal.py; the float definition is
-// model.reference.remove_static). Works behind either corner turn (corner_turn or
-// frame_store_axi, both read whole Doppler vectors in either READ_ORDER).
+// chirps, per lane and per I/Q, the mean weighted by the Doppler window when WINDOW
+// (model/static_removal.py; the float definition is model.reference.remove_static). Works
+// behind either corner turn (corner_turn or frame_store_axi, both read whole Doppler vectors
+// in either READ_ORDER).
 //
-// Structure: a ping-pong of two vectors. The writer stores vector v in one bank while summing
-// its first N_LOOPS words (per lane, I and Q, SUM_W-bit exact sums); the reader streams the
-// previous vector out of the other bank, less its mean. One word per clock per lane
-// sustained: a bank is refilled from the clock after its last word was read, and a vector's
-// mean is registered one clock after its last word is written, before the reader's first
-// word reaches the subtractor. Latency: one vector (N_DOPPLER words) plus 3 clocks.
+// Why weighted: the Doppler FFT windows each vector with w (periodic Hann); subtracting
+// c = sum(w x) / sum(w) removes a constant exactly and leaves the windowed zero-Doppler bin
+// of every vector zero (sum w (x - c) = 0), whereas the plain mean of a moving target is its
+// rectangular-window DFT at zero Doppler (-13 dB sidelobes), and subtracting it puts a residue
+// 20-30 dB under the target into the zero-Doppler bin, which the CFAR detects.
+//
+// Structure: a ping-pong of two vectors. The writer stores vector v in one bank while
+// accumulating sum(w[n] x[n]) over its first N_LOOPS words (per lane, I and Q, SUM_W-bit
+// exact sums; w[n] = HANN[n * 4096 / N_LOOPS] from fft_hann_rom, the fft_window block's
+// coefficients, or 1 without WINDOW) in a DSP-style multiply-accumulate: operand, product
+// and sum registers; the reader streams the previous vector out of the other bank, less its
+// mean, through two extra registers that match the two MACC stages. One word per clock per
+// lane sustained: a bank is refilled from the clock after its last word was read, and a
+// vector's mean is registered three clocks after its last word is written, before the
+// reader's first word of it reaches the subtractor. Latency: one vector (N_DOPPLER words)
+// plus 5 clocks.
 //
 // Why not the accumulate-while-writing-the-corner-turn scheme: that needs one accumulator per
 // (TX, RX, range bin), two sets (the frame being read and the frame being written), inside
@@ -18,15 +29,18 @@
 // and Q sums): 2 x 4 x 16 x 256 x 48 bits = 1.5 Mbit, against 2 x 256 x 16 x 32 bits =
 // 256 Kbit here (six times less), and neither corner turn changes.
 //
-// Arithmetic (exact, model.static_removal.mean): sum s = the vector's first N_LOOPS samples of
-// one lane's I (or Q), mean m = floor((s * RECIP + 2^(SH-1)) / 2^SH) with
-// SH = SUM_W + clog2(N_LOOPS) + 1 and RECIP = floor(2^SH / N_LOOPS) + 1. This is s / N_LOOPS
-// rounded to nearest, ties away from zero, for every s in range (the error of RECIP,
-// |s| * (RECIP - 2^SH/N_LOOPS) / 2^SH < 1/(4 N_LOOPS), is below the 1/(2 N_LOOPS) that
-// separates s / N_LOOPS from a rounding boundary, and it has the sign of s at a tie). With
-// N_LOOPS a power of two the product is a shift and an add (no multiplier). Output word d <
-// N_LOOPS: x - m saturated to DATA_W bits (sticky status_saturated); words d >= N_LOOPS (the
-// zero fill of a frame with fewer loops than N_DOPPLER) pass unchanged.
+// Arithmetic (exact, model.static_removal.mean): sum s = sum(w x) over the vector's first
+// N_LOOPS samples of one lane's I (or Q); divisor D = sum(w) = N_LOOPS * 2^15 with WINDOW
+// (HANN[k] + HANN[k + 2048] = 65536 exactly; model.static_removal.divisor, checked against
+// the table in tests/test_static_removal.py), N_LOOPS without; mean
+// m = floor((s * RECIP + 2^(SH-1)) / 2^SH) with SH = SUM_W + clog2(D) + 1,
+// SUM_W = DATA_W + clog2(D) and RECIP = floor(2^SH / D) + 1. This is s / D rounded to
+// nearest, ties away from zero, for every s in range (|s| <= 2^(DATA_W-1) D; the error of
+// RECIP, |s| * (RECIP - 2^SH/D) / 2^SH < 1/(4 D), is below the 1/(2 D) that separates s / D
+// from a rounding boundary, and it has the sign of s at a tie). With D a power of two (always
+// with WINDOW) the product is a shift and an add (no multiplier). Output word d < N_LOOPS:
+// x - m saturated to DATA_W bits (sticky status_saturated); words d >= N_LOOPS (the zero fill
+// of a frame with fewer loops than N_DOPPLER) pass unchanged.
 //
 // Run-time switch: `enable` is sampled with the first word of every frame (TUSER[0]) and
 // holds for the whole frame; off, m = 0 and the words pass bit-identical with the same
@@ -42,7 +56,10 @@ module static_removal #(
   // 1..N_DOPPLER; any integer (the division is a reciprocal multiply, see above).
   parameter int N_LOOPS = N_DOPPLER,
   // Bits of I and of Q per lane, 8..32.
-  parameter int DATA_W = 16
+  parameter int DATA_W = 16,
+  // 1: the mean weighted by the Doppler window (the pipeline's WINDOW: the fft_window
+  // block's periodic Hann over N_LOOPS, N_LOOPS a power of two); 0: the plain mean.
+  parameter bit WINDOW = 1'b1
 ) (
   input  wire logic                       clk,
   input  wire logic                       rst,
@@ -69,12 +86,19 @@ module static_removal #(
   localparam int WORD_W = NUM_RX * 2 * DATA_W;
   localparam int NV     = 2 * NUM_RX;                 // values per word (I and Q of each lane)
   localparam int POS_W  = $clog2(N_DOPPLER);
-  localparam int LB     = $clog2(N_LOOPS);
-  localparam int SUM_W  = DATA_W + LB;                // exact sum of N_LOOPS samples
+  localparam int ROM_LOG2 = fft_rom_pkg::ROM_LOG2;
+  localparam int COEF_W = fft_rom_pkg::COEF_W;        // signed weight (0..65536 windowed)
+  localparam int LBN    = $clog2(N_LOOPS);
+  // divisor = sum of the weights: N_LOOPS * 2^15 windowed (HANN[k] + HANN[k+2048] = 65536,
+  // model.static_removal.divisor, checked in tests/test_static_removal.py), N_LOOPS plain
+  localparam int DIV    = WINDOW ? (N_LOOPS << (fft_rom_pkg::COEF_FRAC - 1)) : N_LOOPS;
+  localparam int LB     = $clog2(DIV);
+  localparam int SUM_W  = DATA_W + LB;                // exact sum, |s| <= 2^(DATA_W-1) DIV
   localparam int SH     = SUM_W + LB + 1;
-  localparam bit POW2   = (N_LOOPS == (1 << LB));
+  localparam bit POW2   = (DIV == (1 << LB));
   localparam int RCP_W  = SH - LB + 2;                // bits of RECIP (unsigned)
-  localparam longint unsigned RECIP = ((64'd1 << SH) / 64'(N_LOOPS)) + 64'd1;
+  // (POW2: unused, and SH may exceed 63 there)
+  localparam longint unsigned RECIP = POW2 ? 64'd1 : ((64'd1 << SH) / 64'(DIV)) + 64'd1;
   localparam int PROD_W = SUM_W + RCP_W + 1;
 
   // ---- parameter checks -----------------------------------------------------------------
@@ -86,6 +110,9 @@ module static_removal #(
   end
   if (N_LOOPS < 1 || N_LOOPS > N_DOPPLER) begin : g_bad_n_loops
     $fatal(1, "%m: N_LOOPS=%0d not in 1..N_DOPPLER (%0d)", N_LOOPS, N_DOPPLER);
+  end
+  if (WINDOW && (N_LOOPS < 2 || (1 << LBN) != N_LOOPS)) begin : g_bad_window
+    $fatal(1, "%m: WINDOW needs N_LOOPS=%0d a power of two >= 2", N_LOOPS);
   end
   if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
     $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
@@ -105,13 +132,17 @@ module static_removal #(
   logic [1:0] sof_q;         // bank's vector starts a frame (TUSER[0] of its first word)
   logic [1:0] en_q;          // bank's vector has its mean removed (enable of its frame)
 
-  // ---- write side: store and sum ---------------------------------------------------------
+  // ---- write side: store and accumulate sum(w x) ----------------------------------------
   logic             wr_bank_q;
   logic [POS_W-1:0] wr_idx_q;
   logic             en_frame_q;                       // enable sampled at the frame start
-  logic signed [SUM_W-1:0] acc_q [NV];                // running sums of the current vector
-  logic signed [SUM_W-1:0] sum_q [NV];                // sums of the last complete vector
-  logic             sum_new_q, sum_bank_q;            // sum_q was latched last clock, its bank
+  logic signed [DATA_W-1:0]         x_q [NV];         // multiplier operands (input registers)
+  logic signed [COEF_W-1:0]         c_q;              //   (coefficient shared by the lanes)
+  logic signed [DATA_W+COEF_W-1:0]  m_q [NV];         // products (product registers)
+  logic signed [SUM_W-1:0]          acc_q [NV];       // running sums (output registers)
+  logic             a_first_q, a_last_q, a_bank_q;    // word framing with x_q / c_q
+  logic             m_first_q, m_last_q, m_bank_q;    //   with m_q
+  logic             s_last_q, s_bank_q;               // acc_q holds a complete vector's sums
   logic signed [DATA_W-1:0] mean_q [2][NV];           // per bank
 
   logic beat, wr_first, wr_last, in_loops;
@@ -123,17 +154,18 @@ module static_removal #(
   assign ram_wr_en   = beat;
   assign ram_wr_addr = {wr_bank_q, wr_idx_q};
 
-  // acc_next = (first word ? 0 : acc) + x for the first N_LOOPS words; acc otherwise
-  logic signed [SUM_W-1:0] acc_next [NV];
-  always_comb begin
-    for (int k = 0; k < NV; k++) begin
-      acc_next[k] = wr_first ? '0 : acc_q[k];
-      if (in_loops)
-        acc_next[k] = acc_next[k] + SUM_W'(signed'(s_axis_tdata[k*DATA_W +: DATA_W]));
-    end
+  // the weight of word wr_idx_q: HANN[wr_idx_q * 4096 / N_LOOPS] (the fft_window block's
+  // coefficients, rtl/fft/fft_hann_rom.sv) windowed, 1 plain; 0 past the loops or without a beat
+  logic [COEF_W-1:0] coef;
+  if (WINDOW) begin : g_win
+    logic [ROM_LOG2-1:0] rom_idx;
+    assign rom_idx = ROM_LOG2'(wr_idx_q) << (ROM_LOG2 - LBN);
+    fft_hann_rom u_rom (.k(rom_idx), .hann_o(coef));
+  end else begin : g_plain
+    assign coef = COEF_W'(1);
   end
 
-  // mean of sum_q: floor((s * RECIP + 2^(SH-1)) / 2^SH)
+  // mean of a sum: floor((s * RECIP + 2^(SH-1)) / 2^SH)
   function automatic logic signed [DATA_W-1:0] mean_of(input logic signed [SUM_W-1:0] s);
     logic signed [PROD_W-1:0] p;
     if (POW2) begin   // RECIP = 2^(SH-LB) + 1: a shift and an add
@@ -145,24 +177,38 @@ module static_removal #(
     mean_of = DATA_W'(p >>> SH);
   endfunction
 
+  // multiply-accumulate, DSP-friendly: operands, product and sum registered (acc_q is the
+  // DSP's P register, cleared by the first product of a vector)
   always_ff @(posedge clk) begin
-    if (beat) begin
-      for (int k = 0; k < NV; k++) acc_q[k] <= acc_next[k];
-      if (wr_last) for (int k = 0; k < NV; k++) sum_q[k] <= acc_next[k];
-      if (wr_first) begin
-        sof_q[wr_bank_q] <= s_axis_tuser[0];
-        en_q[wr_bank_q]  <= s_axis_tuser[0] ? enable : en_frame_q;
-      end
+    for (int k = 0; k < NV; k++) begin
+      x_q[k]   <= signed'(s_axis_tdata[k*DATA_W +: DATA_W]);
+      m_q[k]   <= x_q[k] * c_q;
+      acc_q[k] <= (m_first_q ? '0 : acc_q[k]) + SUM_W'(m_q[k]);
     end
-    sum_bank_q <= wr_bank_q;
-    if (sum_new_q) for (int k = 0; k < NV; k++) mean_q[sum_bank_q][k] <= mean_of(sum_q[k]);
+    c_q       <= (beat && in_loops) ? signed'(coef) : '0;
+    a_first_q <= beat && wr_first;
+    a_last_q  <= beat && wr_last;
+    a_bank_q  <= wr_bank_q;
+    m_first_q <= a_first_q;
+    m_last_q  <= a_last_q;
+    m_bank_q  <= a_bank_q;
+    s_last_q  <= m_last_q;
+    s_bank_q  <= m_bank_q;
+    if (s_last_q) for (int k = 0; k < NV; k++) mean_q[s_bank_q][k] <= mean_of(acc_q[k]);
+    if (beat && wr_first) begin
+      sof_q[wr_bank_q] <= s_axis_tuser[0];
+      en_q[wr_bank_q]  <= s_axis_tuser[0] ? enable : en_frame_q;
+    end
   end
 
   // ---- read side: stream the full bank out less its mean ----------------------------------
   logic             rd_bank_q;
   logic [POS_W-1:0] rd_idx_q;
   logic             can_issue, issue, rd_last;
-  logic             p_last_q, p_user_q, p_sub_q, p_bank_q;
+  // word framing along the read pipeline: issue -> RAM data (stage 0) -> two registers
+  // (stages 1, 2, matching the two MACC stages before a mean) -> subtractor
+  logic [2:0]        p_last_q, p_user_q, p_sub_q, p_bank_q;
+  logic [WORD_W-1:0] rd1_q, rd2_q;
 
   assign issue       = full_q[rd_bank_q] && can_issue;
   assign rd_last     = (rd_idx_q == POS_W'(N_DOPPLER - 1));
@@ -170,10 +216,12 @@ module static_removal #(
   assign ram_rd_addr = {rd_bank_q, rd_idx_q};
 
   always_ff @(posedge clk) begin
-    p_last_q <= rd_last;
-    p_user_q <= (rd_idx_q == '0) && sof_q[rd_bank_q];
-    p_sub_q  <= en_q[rd_bank_q] && ({1'b0, rd_idx_q} < (POS_W + 1)'(N_LOOPS));
-    p_bank_q <= rd_bank_q;
+    p_last_q <= {p_last_q[1:0], rd_last};
+    p_user_q <= {p_user_q[1:0], (rd_idx_q == '0) && sof_q[rd_bank_q]};
+    p_sub_q  <= {p_sub_q[1:0], en_q[rd_bank_q] && ({1'b0, rd_idx_q} < (POS_W + 1)'(N_LOOPS))};
+    p_bank_q <= {p_bank_q[1:0], rd_bank_q};
+    rd1_q    <= ram_rd_data;
+    rd2_q    <= rd1_q;
   end
 
   // x - m per value, saturated to DATA_W bits
@@ -183,8 +231,8 @@ module static_removal #(
     sat = 1'b0;
     for (int k = 0; k < NV; k++) begin
       logic signed [DATA_W:0] d;
-      d = (DATA_W + 1)'(signed'(ram_rd_data[k*DATA_W +: DATA_W]))
-        - (p_sub_q ? (DATA_W + 1)'(mean_q[p_bank_q][k]) : '0);
+      d = (DATA_W + 1)'(signed'(rd2_q[k*DATA_W +: DATA_W]))
+        - (p_sub_q[2] ? (DATA_W + 1)'(mean_q[p_bank_q[2]][k]) : '0);
       if (d[DATA_W] != d[DATA_W-1]) begin
         sat = 1'b1;
         diff[k*DATA_W +: DATA_W] = d[DATA_W] ? {1'b1, {(DATA_W-1){1'b0}}}
@@ -195,7 +243,7 @@ module static_removal #(
     end
   end
 
-  logic push_q;    // a read issued last clock: its word enters the output FIFO now
+  logic [2:0] push_q;    // bit 2: a read issued 3 clocks ago, its word enters the FIFO now
   logic framing_q, sat_q;
   always_ff @(posedge clk) begin
     if (rst) begin
@@ -203,15 +251,13 @@ module static_removal #(
       wr_bank_q  <= 1'b0;
       wr_idx_q   <= '0;
       en_frame_q <= 1'b0;
-      sum_new_q  <= 1'b0;
       rd_bank_q  <= 1'b0;
       rd_idx_q   <= '0;
-      push_q     <= 1'b0;
+      push_q     <= '0;
       framing_q  <= 1'b0;
       sat_q      <= 1'b0;
     end else begin
-      push_q    <= issue;
-      sum_new_q <= beat && wr_last;
+      push_q    <= {push_q[1:0], issue};
       if (beat) begin
         wr_idx_q <= wr_idx_q + 1'b1;
         if (wr_first && s_axis_tuser[0]) en_frame_q <= enable;
@@ -228,14 +274,14 @@ module static_removal #(
         if (beat && wr_last && wr_bank_q == 1'(b)) full_q[b] <= 1'b1;
         if (issue && rd_last && rd_bank_q == 1'(b)) full_q[b] <= 1'b0;
       end
-      if (push_q && sat) sat_q <= 1'b1;
+      if (push_q[2] && sat) sat_q <= 1'b1;
     end
   end
 
   // ---- output ---------------------------------------------------------------------------
   logic [WORD_W+1:0] fifo_tdata;
-  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(4)) u_out (
-    .clk, .rst, .can_issue, .issue, .in_data({p_user_q, p_last_q, diff}),
+  buf_out_fifo #(.WIDTH(WORD_W + 2), .DEPTH(8), .LATENCY(3)) u_out (
+    .clk, .rst, .can_issue, .issue, .in_data({p_user_q[2], p_last_q[2], diff}),
     .m_axis_tdata(fifo_tdata), .m_axis_tvalid, .m_axis_tready
   );
   assign m_axis_tdata    = fifo_tdata[WORD_W-1:0];
@@ -254,7 +300,7 @@ module static_removal #(
     .payload({m_axis_tuser, m_axis_tlast, m_axis_tdata}));
   // block invariant: the mean of a bank is registered before its first word is subtracted
   always_ff @(posedge clk) begin
-    if (!rst) assert (!(push_q && sum_new_q && p_sub_q && sum_bank_q == p_bank_q))
+    if (!rst) assert (!(push_q[2] && s_last_q && p_sub_q[2] && s_bank_q == p_bank_q[2]))
       else $error("%m: a vector's first word reached the subtractor before its mean");
   end
 `endif

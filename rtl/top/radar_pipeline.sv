@@ -21,7 +21,8 @@
 //
 // STATIC_REMOVAL = 1: static-clutter removal (static_removal, one slow-time vector of
 // latency) between the corner turn (either variant) and the Doppler FFT, switched at run time
-// by cfg_static_removal, which takes effect at the next frame out of the corner turn.
+// by cfg_static_removal, which takes effect at the next frame out of the corner turn; the
+// mean it removes is weighted by the Doppler window when WINDOW (docs/buffers.md).
 `default_nettype none
 
 module radar_pipeline #(
@@ -356,7 +357,8 @@ module radar_pipeline #(
 
   if (STATIC_REMOVAL) begin : g_static_removal
     static_removal #(
-      .NUM_RX(NUM_RX), .N_DOPPLER(N_DOPPLER), .N_LOOPS(N_DOPPLER), .DATA_W(DATA_W)
+      .NUM_RX(NUM_RX), .N_DOPPLER(N_DOPPLER), .N_LOOPS(N_DOPPLER), .DATA_W(DATA_W),
+      .WINDOW(WINDOW)
     ) u_static_removal (
       .clk, .rst, .enable(cfg_static_removal),
       .s_axis_tdata(ct_tdata), .s_axis_tvalid(ct_tvalid), .s_axis_tready(ct_tready),

@@ -26,6 +26,7 @@ class TB(AxisTB):
         self.num_rx = param("NUM_RX")
         self.n_doppler = param("N_DOPPLER")
         self.n_loops = param("N_LOOPS")
+        self.window = bool(param("WINDOW"))
         assert param("DATA_W") == 16
         self.frame_words = VECTORS * self.n_doppler
         self.schedule: list[bool] = []      # enable of frame k (set by drive_enable)
@@ -76,7 +77,8 @@ class TB(AxisTB):
         """Compare every frame with the model; returns the model's saturated words."""
         saturated = 0
         for k, (g, f, en) in enumerate(zip(got, sent, enables, strict=True)):
-            exp, sat = static_removal(f, self.n_doppler, self.n_loops, enable=en)
+            exp, sat = static_removal(f, self.n_doppler, self.n_loops, enable=en,
+                                      window=self.window)
             saturated += sat
             if not np.array_equal(g, exp):
                 bad = np.argwhere(g != exp)
@@ -165,10 +167,12 @@ async def test_framing_error(dut):
 # ------------------------------------------------------------------------------------------
 # pytest: one Verilator build per HDL parameter set
 PARAMS = [
-    # power-of-two loops (shift-and-add mean), 2 lanes
-    dict(NUM_RX=2, N_DOPPLER=8, N_LOOPS=8),
-    # 13 loops of 16 (reciprocal multiply, zero fill passes unchanged), 1 lane
-    dict(NUM_RX=1, N_DOPPLER=16, N_LOOPS=13),
+    # Hann-weighted mean (shift-and-add division by N_LOOPS 2^15), 2 lanes
+    dict(NUM_RX=2, N_DOPPLER=8, N_LOOPS=8, WINDOW=1),
+    # Hann-weighted over 8 loops of 16 (zero fill passes unchanged), 1 lane
+    dict(NUM_RX=1, N_DOPPLER=16, N_LOOPS=8, WINDOW=1),
+    # plain mean of 13 loops of 16 (reciprocal multiply, zero fill passes unchanged), 1 lane
+    dict(NUM_RX=1, N_DOPPLER=16, N_LOOPS=13, WINDOW=0),
 ]
 
 
@@ -176,7 +180,8 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_static_removal(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"),
+    sources = [*rtl_sources("fft/fft_rom_pkg.sv", "fft/fft_hann_rom.sv", "common/*.sv",
+                            "buffers/buf_*.sv"),
                *rtl_sources("buffers/static_removal.sv")]
     run_cocotb("static_removal", sources, "test_static_removal", here,
                parameters={"DATA_W": 16, **parameters})
