@@ -5,10 +5,15 @@ the screen for a second one, and RELAX on the rows that hold several.
   its first component at a given sin(az), and the Cauchy-Schwarz screen: the residual r
   after the first component can hold a second one only if |s^H r / n|^2 <= ||r||^2 / n
   (|s_v| = 1) passes the three gates of ``host.angle.AngleParams`` (SNR, dynamic range,
-  model order: ``host.angle`` module docstring).
+  model order: ``host.angle`` module docstring); and the split screen: a residual whose
+  energy lies mostly in the first component's derivative directions (:data:`SPLIT_STRUCTURE`)
+  may be two unresolved targets the first component sits between (:func:`split_rows`).
 - :func:`steering_rows`: exp(-j pi v s) per row, from two sines and cosines per row.
 - :func:`relax_rows`: RELAX-style sequential estimation (``host.angle`` module docstring),
   every pass's batch of rows through the peak search of ``host._angle_peaks``.
+- :func:`split_rows`: two components refined from the first and the residual's peak, kept
+  where the refined pair passes the gates and explains the residual (``host.angle``
+  module docstring, "Two targets within a beamwidth").
 
 The numpy implementations these replaced are the oracles in ``tests/oracles/angle.py``.
 """
@@ -21,6 +26,18 @@ import numpy as np
 
 from host._angle_peaks import COARSE_FFT, SECOND_LOBE, _c128, _class_peaks, _tables
 from host.kernels import njit, warm_up
+
+SPLIT_ITERATIONS = 8
+"""RELAX passes of :func:`split_rows` (a first component midway between two targets moves
+to one of them in a few passes; 2, the default ``refine_iterations``, often stop short)."""
+SPLIT_STRUCTURE = 0.5
+"""A row may be split only when at least this fraction of its residual's energy lies in
+the first component's first two derivative directions (the residual of two targets the
+first component sits between; a model error's residue spreads over n - 1 dimensions:
+``host.angle`` module docstring), and that part reaches the SNR gate."""
+SPLIT_EXPLAINED = 0.75
+"""A split is kept only when the pair removes at least this fraction of the first
+component's residual energy beyond the noise (``host.angle`` module docstring)."""
 
 
 @njit(fastmath=True)
@@ -54,14 +71,18 @@ def _steer_row(s: float, str_: np.ndarray, sti: np.ndarray, lor: np.ndarray,
 
 
 @njit(fastmath=True)
+def _scratch(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Scratch of :func:`_steer_row` for n channels: str_, sti float (n,), lor, loi float
+    (ceil(sqrt(n)),)."""
+    b0 = int(math.ceil(math.sqrt(n)))
+    return np.empty(n), np.empty(n), np.empty(b0), np.empty(b0)
+
+
+@njit(fastmath=True)
 def _steering(s: np.ndarray, out: np.ndarray) -> None:
     """:func:`steering_rows` into out (complex128 (m, n))."""
     m, n = out.shape
-    b0 = int(math.ceil(math.sqrt(n)))
-    lor = np.empty(b0)
-    loi = np.empty(b0)
-    str_ = np.empty(n)
-    sti = np.empty(n)
+    str_, sti, lor, loi = _scratch(n)
     for i in range(m):
         _steer_row(s[i], str_, sti, lor, loi)
         for v in range(n):
@@ -81,20 +102,20 @@ def steering_rows(s: np.ndarray, n: int) -> np.ndarray:
 @njit(fastmath=True)
 def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.ndarray,
                       snr_lin: float, dyn_lin: float, err_lin: float, screen: bool,
-                      out: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray
-                      ) -> None:
+                      out: np.ndarray, a1: np.ndarray, p1: np.ndarray, maybe: np.ndarray,
+                      split: np.ndarray) -> None:
     """:func:`first_components` (x, ph, out complex128; snr_lin, dyn_lin, err_lin: the
     gates as power ratios)."""
     n_rows, nv = x.shape
     ntx = ph.shape[1]
     nrx = nv // ntx
-    b0 = int(math.ceil(math.sqrt(nv)))
-    lor = np.empty(b0)
-    loi = np.empty(b0)
-    str_ = np.empty(nv)
-    sti = np.empty(nv)
+    str_, sti, lor, loi = _scratch(nv)
     outr = np.empty(nv)
     outi = np.empty(nv)
+    c1 = (nv - 1) / 2.0
+    c2 = (nv * nv - 1) / 12.0
+    n1 = max(nv * (nv * nv - 1) / 12.0, 1e-300)
+    n2 = max(nv * (nv * nv - 1) * (nv * nv - 4) / 180.0, 1e-300)
     for i in range(n_rows):
         for t in range(ntx):
             pr = ph[i, t].real
@@ -118,25 +139,42 @@ def _first_components(x: np.ndarray, ph: np.ndarray, s1: np.ndarray, noise: np.n
         p1[i] = ar * ar + ai * ai
         if screen:
             e = 0.0
+            d1r = 0.0               # conj(st) q_k(v) . r, q_k the discrete Legendre
+            d1i = 0.0               # polynomials of degree 1, 2 on v = 0..nv-1
+            d2r = 0.0
+            d2i = 0.0
             for v in range(nv):
                 rr = outr[v] - (ar * str_[v] - ai * sti[v])
                 ri = outi[v] - (ar * sti[v] + ai * str_[v])
                 e += rr * rr + ri * ri
+                q1 = v - c1
+                q2 = q1 * q1 - c2
+                pr = str_[v] * rr + sti[v] * ri
+                pi = str_[v] * ri - sti[v] * rr
+                d1r += q1 * pr
+                d1i += q1 * pi
+                d2r += q2 * pr
+                d2i += q2 * pi
             bound = e * (1.0 + 1e-9) / nv
-            maybe[i] = (bound * nv >= snr_lin * noise[i]) and (
-                p1[i] <= dyn_lin * max(bound, 1e-300)) and (
-                bound >= noise[i] + err_lin * p1[i])
+            gates = (bound * nv >= snr_lin * noise[i]) and (
+                p1[i] <= dyn_lin * max(bound, 1e-300))
+            maybe[i] = gates and (bound >= noise[i] + err_lin * p1[i])
+            if gates and nv >= 3:
+                es = (d1r * d1r + d1i * d1i) / n1 + (d2r * d2r + d2i * d2i) / n2
+                split[i] = (es >= SPLIT_STRUCTURE * e) and (es >= snr_lin * noise[i])
+                maybe[i] = maybe[i] or split[i]
 
 
 
 def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
                      noise_per_channel: np.ndarray, min_snr_db: float,
                      dynamic_range_db: float, array_error_db: float, screen: bool = True
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The first angle component of each TDM-compensated snapshot and the screen for a
     second (module docstring):
     (compensated rows complex128 (n, n_v), amplitude a1 complex (n,), power |a1|^2 float
-    (n,), ``maybe`` bool (n,): the row may hold a second component).
+    (n,), ``maybe`` bool (n,): the row may hold a second component, ``split`` bool (n,):
+    it may be two targets the first component sits between (the split screen)).
 
     x: complex (n, num_tx * num_rx); phasors: complex (n, num_tx) per TX
     (``host.tdm.tx_phasors``); first_sin: float (n,) sin(az) of the row's peak;
@@ -148,13 +186,14 @@ def first_components(x: np.ndarray, phasors: np.ndarray, first_sin: np.ndarray,
         raise ValueError(f"first_components: snapshots {x.shape}, phasors {phasors.shape}")
     out = np.empty(x.shape, np.complex128)
     a1, p1, maybe = np.zeros(n, complex), np.zeros(n), np.zeros(n, bool)
+    split = np.zeros(n, bool)
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
     if n:
         _first_components(_c128(x), _c128(phasors),
                           np.ascontiguousarray(first_sin, dtype=float),
                           noise, 10 ** (min_snr_db / 10), 10 ** (dynamic_range_db / 10),
-                          10 ** (array_error_db / 10), screen, out, a1, p1, maybe)
-    return out, a1, p1, maybe
+                          10 ** (array_error_db / 10), screen, out, a1, p1, maybe, split)
+    return out, a1, p1, maybe, split
 
 
 
@@ -186,11 +225,7 @@ def _relax(xs: np.ndarray, noise: np.ndarray, refine: int, min_snr_db: float,
     err_lin: the array-error floor as a power ratio."""
     m, n = xs.shape
     kmax = s_c.shape[1]
-    b0 = int(math.ceil(math.sqrt(n)))
-    lor = np.empty(b0)
-    loi = np.empty(b0)
-    str_ = np.empty(n)
-    sti = np.empty(n)
+    str_, sti, lor, loi = _scratch(n)
     st_c = np.zeros((m, kmax, n), np.complex128)    # steering of s_c, once per estimate
     first = np.zeros(m)
     residual = xs.copy()
@@ -290,9 +325,89 @@ def relax_rows(x: np.ndarray, noise: np.ndarray, n_fft: int, max_targets: int,
     return s_c, a_c, count
 
 
+@njit(fastmath=True, error_model="numpy")
+def _split(xs: np.ndarray, noise: np.ndarray, e1: np.ndarray, iters: int, snr_lin: float,
+           dyn_lin: float, err_lin: float, n_fft: int, second_lobe: float, wr: np.ndarray,
+           wi: np.ndarray, rank: np.ndarray, dmr: np.ndarray, dmi: np.ndarray, oc: np.ndarray,
+           os_: np.ndarray, s_c: np.ndarray, a_c: np.ndarray, keep: np.ndarray) -> None:
+    """:func:`split_rows` into s_c, a_c (float, complex (m, 2): the starting pair in) and
+    keep (bool (m,)); snr_lin, dyn_lin, err_lin: the gates as power ratios."""
+    m, n = xs.shape
+    str_, sti, lor, loi = _scratch(n)
+    st_c = np.zeros((m, 2, n), np.complex128)
+    for i in range(m):
+        for j in range(2):
+            _steer_row(s_c[i, j], str_, sti, lor, loi)
+            for v in range(n):
+                st_c[i, j, v] = complex(str_[v], sti[v])
+    batch = np.empty((m, n), np.complex128)
+    rows = np.arange(m)
+    ones = np.ones((m, 1), np.complex128)
+    out_pow = np.empty(m)
+    out_sin = np.empty(m)
+    for _ in range(iters):
+        for j in range(2):
+            for i in range(m):              # the row without the other component
+                for v in range(n):
+                    batch[i, v] = xs[i, v] - a_c[i, 1 - j] * st_c[i, 1 - j, v]
+            _class_peaks(batch, rows, ones, n_fft, second_lobe, wr, wi, rank, dmr, dmi, oc,
+                         os_, out_pow, out_sin)
+            for i in range(m):
+                s_c[i, j] = out_sin[i]
+                a_c[i, j] = _project(out_sin[i], batch[i], str_, sti, lor, loi)
+                for v in range(n):
+                    st_c[i, j, v] = complex(str_[v], sti[v])
+    for i in range(m):
+        e2 = 0.0
+        for v in range(n):
+            r = xs[i, v] - a_c[i, 0] * st_c[i, 0, v] - a_c[i, 1] * st_c[i, 1, v]
+            e2 += r.real * r.real + r.imag * r.imag
+        pa = a_c[i, 0].real ** 2 + a_c[i, 0].imag ** 2
+        pb = a_c[i, 1].real ** 2 + a_c[i, 1].imag ** 2
+        big = max(pa, pb)
+        small = min(pa, pb)
+        floor = n * noise[i]
+        keep[i] = (small * n >= snr_lin * noise[i]) and (big <= dyn_lin * small) and (
+            small >= noise[i] + err_lin * big) and (
+            abs(s_c[i, 0] - s_c[i, 1]) > 0.5 / n) and (
+            e2 - floor <= (1.0 - SPLIT_EXPLAINED) * (e1[i] - floor))
+
+
+def split_rows(x: np.ndarray, noise: np.ndarray, s_start: np.ndarray, a_start: np.ndarray,
+               n_fft: int, min_snr_db: float, dynamic_range_db: float, array_error_db: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Two components of each row of x (complex (m, n), TDM-compensated; noise float (m,)
+    per channel, >= 1e-30), refined by :data:`SPLIT_ITERATIONS` RELAX passes from the
+    starting pair (sin s_start float (m, 2), amplitude a_start complex (m, 2): the first
+    component and the peak of its residual). Kept (``host.angle`` module docstring) where
+    the weaker reaches the coherent SNR ``min_snr_db``, is within ``dynamic_range_db`` of
+    the stronger, passes the model-order test against it (|a|^2 >= noise +
+    10^(array_error_db / 10) |a_strong|^2), the two are more than 0.5 / n apart in sin(az),
+    and the pair leaves at most 1 - :data:`SPLIT_EXPLAINED` of the first component's
+    residual energy beyond the noise n N. Returns (sin(az) float (m, 2), amplitude
+    complex (m, 2), kept bool (m,))."""
+    xs = _c128(x)
+    m, n = xs.shape
+    s_c = np.array(s_start, dtype=float, order="C")
+    a_c = np.array(a_start, dtype=np.complex128, order="C")
+    if noise.shape != (m,) or s_c.shape != (m, 2) or a_c.shape != (m, 2):
+        raise ValueError(f"split_rows: {m} rows, noise {noise.shape}, start {s_c.shape}")
+    keep = np.zeros(m, bool)
+    if m:
+        ns = np.ascontiguousarray(noise, dtype=float)
+        e1 = np.sum(np.abs(xs - a_c[:, :1] * steering_rows(s_c[:, 0], n)) ** 2, axis=1)
+        wr, wi, rank, dmr, dmi, oc, os_ = _tables(n, n_fft)
+        _split(xs, ns, e1, SPLIT_ITERATIONS, 10 ** (min_snr_db / 10),
+               10 ** (dynamic_range_db / 10), 10 ** (array_error_db / 10), n_fft, SECOND_LOBE,
+               wr, wi, rank, dmr, dmi, oc, os_, s_c, a_c, keep)
+    return s_c, a_c, keep
+
+
 @warm_up
 def _warm_up() -> None:
     """RELAX and the steering rows (reached only by cells with several targets) on one row:
     the argument types of ``host.angle`` and its default ``AngleParams``."""
     steering_rows(np.zeros(1), 8)
     relax_rows(np.zeros((1, 8), np.complex128), np.ones(1), 1024, 3, 2, 12.0, 20.0, -10.0)
+    split_rows(np.zeros((1, 8), np.complex128), np.ones(1), np.zeros((1, 2)),
+               np.zeros((1, 2), np.complex128), 1024, 12.0, 20.0, -10.0)

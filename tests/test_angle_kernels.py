@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from host._angle_peaks import class_peaks, peak_sins
-from host._angle_relax import first_components, relax_rows, steering_rows
+from host._angle_relax import first_components, relax_rows, split_rows, steering_rows
 from host.angle import AngleParams, _relax, estimate_angles, peak_powers
 from host.tdm import tx_phasors
 from model.config import get_preset
@@ -28,6 +28,7 @@ from tests.oracles.angle import (
     first_component_screen,
     peak_power_fast,
     peak_sin_fast,
+    split_pairs,
 )
 from tests.oracles.points import tdm_compensate
 
@@ -152,13 +153,14 @@ def test_first_components_are_the_screened_ones() -> None:
     s1, _ = peak_sin_fast(xc, 1024)
     noise = rng.uniform(0.5, 2, n)
     p = AngleParams()
-    xs, a1, p1, maybe = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db,
-                                         p.array_error_db)
+    xs, a1, p1, maybe, split = first_components(x, ph, s1, noise, p.min_snr_db,
+                                                p.dynamic_range_db, p.array_error_db)
     np.testing.assert_allclose(xs, xc, rtol=1e-12, atol=1e-9)
-    want_a, want_p, want_maybe = first_component_screen(xc, noise, p, s1)
+    want_a, want_p, want_maybe, want_split = first_component_screen(xc, noise, p, s1)
     np.testing.assert_allclose(a1, want_a, rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(p1, want_p, rtol=1e-9)
     np.testing.assert_array_equal(maybe, want_maybe)
+    np.testing.assert_array_equal(split, want_split)
     assert 0 < maybe.sum() < n
     none = first_components(x, ph, s1, noise, p.min_snr_db, p.dynamic_range_db,
                             p.array_error_db, screen=False)
@@ -248,3 +250,40 @@ def uncompiled_case() -> np.ndarray:
     cloud = process_frame(simulate_scene(scene).samples, scene.config)
     return np.concatenate([p, s, ang.cell, ang.sin_az, np.abs(ang.amplitude),
                            cloud.range_m, cloud.azimuth_deg, cloud.radial_velocity_mps])
+
+
+@pytest.mark.parametrize("n", [16, 64])
+def test_split_rows_is_split_pairs(n: int) -> None:
+    """The compiled split of a first component between two targets: the numpy
+    ``split_pairs`` with the same peak search and steering (pairs 0.4-0.9 beamwidths apart,
+    a single target with array errors, noise only)."""
+    rng = np.random.default_rng(31)
+    m = 120
+    u = rng.uniform(-0.5, 0.5, m)
+    sep = rng.uniform(0.4, 0.9, m) * 2 / n
+    v = np.arange(n)
+    x = np.exp(-1j * np.pi * np.outer(u, v)) + np.exp(2j * np.pi * rng.random((m, 1))) * \
+        np.exp(-1j * np.pi * np.outer(u + sep, v))
+    x[:20] = np.exp(-1j * np.pi * np.outer(u[:20], v)) * np.exp(
+        0.2j * rng.normal(size=(20, n)))
+    x[20:25] = 0.0
+    noise = np.full(m, 1e-3)
+    x = x + np.sqrt(noise[:, None] / 2) * (rng.normal(size=(m, n)) + 1j * rng.normal(
+        size=(m, n)))
+    p = AngleParams()
+    s1, _ = peak_sins(x, p.n_fft)
+    st = steering_rows(s1, n)
+    a1 = np.sum(np.conj(st) * x, axis=1) / n
+    r = x - a1[:, None] * st
+    s2, _ = peak_sins(r, p.n_fft)
+    a2 = np.sum(np.conj(steering_rows(s2, n)) * r, axis=1) / n
+    start_s, start_a = np.stack([s1, s2], axis=1), np.stack([a1, a2], axis=1)
+    got = split_rows(x, noise, start_s, start_a, p.n_fft, p.min_snr_db, p.dynamic_range_db,
+                     p.array_error_db)
+    want = split_pairs(x, noise, p, start_s, start_a, peaks=peak_sins, steer=steering_rows)
+    np.testing.assert_array_equal(got[2], want[2])
+    assert 0 < got[2].sum() < m - 25
+    np.testing.assert_allclose(got[0], want[0], atol=1e-9)
+    np.testing.assert_allclose(got[1], want[1], rtol=1e-9, atol=1e-9)
+    assert len(split_rows(np.zeros((0, n)), np.zeros(0), np.zeros((0, 2)),
+                          np.zeros((0, 2), complex), 1024, 12.0, 20.0, -10.0)[2]) == 0
