@@ -24,7 +24,10 @@ module radar_pipeline_props (
   radar_pipeline #(.NUM_RX(1), .NUM_TX(1), .N_RANGE(16), .N_DOPPLER(16), .DATA_W(16),
                    .PACKET_WORDS(16), .WINDOW(1'b0), .OUT_BANKS(2)) dut (
     .clk, .rst, .s_axis_adc_tdata, .s_axis_adc_tvalid, .s_axis_adc_tready,
-    .s_axis_adc_tlast, .s_axis_adc_tuser, .cfg_cfar_scale('0), .cfg_static_removal(1'b0),
+    .s_axis_adc_tlast, .s_axis_adc_tuser, .cfg_cfar_scale('0),
+    .s_axil_awvalid(1'b0), .s_axil_awaddr('0), .s_axil_awprot('0), .s_axil_wvalid(1'b0),
+    .s_axil_wdata('0), .s_axil_wstrb('0), .s_axil_bready(1'b1), .s_axil_arvalid(1'b0),
+    .s_axil_araddr('0), .s_axil_arprot('0), .s_axil_rready(1'b1),
     .m_axis_dma_tdata, .m_axis_dma_tvalid, .m_axis_dma_tready, .m_axis_dma_tlast,
     .m_axi_mem_awready(1'b0), .m_axi_mem_wready(1'b0), .m_axi_mem_bid(1'b0),
     .m_axi_mem_bresp(2'b00), .m_axi_mem_bvalid(1'b0), .m_axi_mem_arready(1'b0),
@@ -33,6 +36,8 @@ module radar_pipeline_props (
     .m_axi_mem_awvalid(awvalid), .m_axi_mem_wvalid(wvalid), .m_axi_mem_arvalid(arvalid),
     .m_axi_mem_bready(bready), .m_axi_mem_rready(rready),
     /* verilator lint_off PINCONNECTEMPTY */
+    .s_axil_awready(), .s_axil_wready(), .s_axil_bvalid(), .s_axil_bresp(),
+    .s_axil_arready(), .s_axil_rvalid(), .s_axil_rdata(), .s_axil_rresp(), .irq(),
     .status_adc_overflow(), .status_dma_overflow(), .status_fft_overflow(),
     .status_framing_error(), .adc_chirps_dropped(), .dma_words_dropped(),
     .fft_overflow_count(), .framing_error_count(), .chirps_in(), .frames_damaged(),

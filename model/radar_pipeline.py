@@ -23,7 +23,8 @@ and weak targets round away to zero; with 0x555 noise sits near 1.6 LSB and the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -65,8 +66,10 @@ class PipelineParams:
     :meth:`store_tile_r` picks it); ``output_mode``:
     OUTPUT_MODE (0: radar cube, 1: detection records); ``detect``: the detector settings in
     mode 1 (None: :meth:`detect_config` derives them from the RadarConfig);
-    ``static_removal``: STATIC_REMOVAL (static-clutter removal before the Doppler FFT, on
-    for every frame: the top's ``cfg_static_removal`` driven high).
+    ``static_removal``: STATIC_REMOVAL (static-clutter removal before the Doppler FFT; the
+    register SETTINGS.clutter_removal switches it per frame and is on after reset, so
+    without register writes every frame has it; :func:`dma_frames`' ``removal`` follows
+    the switch).
     """
 
     packet_words: int = 1024
@@ -286,12 +289,14 @@ def record_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
 
 
 def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,
-                params: PipelineParams | None = None, first_frame_id: int = 0
-                ) -> list[np.ndarray]:
+                params: PipelineParams | None = None, first_frame_id: int = 0,
+                removal: Sequence[bool] | None = None) -> list[np.ndarray]:
     """DMA packets of consecutive frames exactly as ``radar_pipeline`` sends them: uint32
     arrays (words, num_rx), one per TLAST-closed packet, header word first. Mode 0: the
-    cube; mode 1: the record streams (:func:`record_frames`), same framing."""
-    return [p for f in dma_frames(adc_frames, cfg, params, first_frame_id) for p in f.packets]
+    cube; mode 1: the record streams (:func:`record_frames`), same framing. ``removal``: as
+    :func:`dma_frames`."""
+    return [p for f in dma_frames(adc_frames, cfg, params, first_frame_id, removal)
+            for p in f.packets]
 
 
 @dataclass(frozen=True)
@@ -310,25 +315,34 @@ class FrameDma:
 
 
 def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
-               params: PipelineParams | None = None, first_frame_id: int = 0
-               ) -> list[FrameDma]:
+               params: PipelineParams | None = None, first_frame_id: int = 0,
+               removal: Sequence[bool] | None = None) -> list[FrameDma]:
     """:func:`dma_packets` per frame, with each frame's FFT overflow beats (one model run
-    gives both: what a soak compares the RTL's packets and status counters with)."""
+    gives both: what a soak compares the RTL's packets and status counters with).
+    ``removal``: per frame, the register's static-clutter removal switch as that frame ran
+    (ACTIVE_SETTINGS.clutter_removal; True needs ``params.static_removal``); None: every
+    frame as ``params.static_removal`` (the reset setting)."""
     params = params or PipelineParams()
     params.check(cfg)
+    if removal is None:
+        removal = [params.static_removal] * len(adc_frames)
+    if len(removal) != len(adc_frames) or (any(removal) and not params.static_removal):
+        raise ValueError("removal: one switch per frame, on only with static_removal "
+                         "(STATIC_REMOVAL = 1)")
+    per_frame = [replace(params, static_removal=bool(on)) for on in removal]
     overflow: list[tuple[int, int]] = []
     if params.output_mode == 1:
         def words():                    # one frame's Doppler output at a time
-            for adc in adc_frames:
-                dop, rng_ov, dop_ov = _doppler_out(adc, cfg, params)
+            for adc, fp in zip(adc_frames, per_frame, strict=True):
+                dop, rng_ov, dop_ov = _doppler_out(adc, cfg, fp)
                 overflow.append((rng_ov, dop_ov))
                 yield pack_iq(dop)
         payloads = detect_stream(words(), params.detect_config(cfg),
                                  first_frame_id=first_frame_id)
     else:
         payloads = []
-        for adc in adc_frames:
-            out = run_chain(adc, cfg, params)
+        for adc, fp in zip(adc_frames, per_frame, strict=True):
+            out = run_chain(adc, cfg, fp)
             overflow.append((out.range_overflow, out.doppler_overflow))
             payloads.append(cube_to_payload(out.payload))
     return [FrameDma(packetize(payload, params.packet_words, first_frame_id + k,

@@ -1,11 +1,14 @@
 """cocotb-side driver of ``radar_pipeline``: ADC frames in, DMA packets out.
 
 Used by the end-to-end testbench (``tb/radar_pipeline``) and by the stream test behind
-``radar detect --backend rtl`` (:mod:`rtlsim.pipeline_test`). Imported only inside a cocotb
-simulation.
+``radar detect --backend rtl`` (:mod:`rtlsim.pipeline_test`), and the register block's
+AXI4-Lite slave (:meth:`PipelineTB.attach_regs`; ``host.regs`` names the registers). Imported
+only inside a cocotb simulation.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -40,13 +43,39 @@ class PipelineTB(AxisTB):
                             if self.output_mode == 1
                             else self.num_tx * self.n_range * self.n_doppler)
         self.dut.cfg_cfar_scale.value = 0
-        # static-clutter removal, when built in (STATIC_REMOVAL = 1), is on for every frame
-        self.dut.cfg_static_removal.value = param("STATIC_REMOVAL", 0)
+        # the register block idle until attach_regs (its reset settings hold: static-clutter
+        # removal, when built in with STATIC_REMOVAL = 1, on for every frame)
+        for name in ("awvalid", "wvalid", "arvalid"):
+            getattr(self.dut, f"s_axil_{name}").value = 0
+        self.axil = None
         self.packets_per_frame = packets_per_frame(self.frame_words, self.packet_words)
 
     async def reset(self, cycles: int = 8) -> None:
         """Synchronous active-high reset."""
         await super().reset(cycles)
+
+    def attach_regs(self, pauses: Callable[[], Iterator[bool]] | None = None) -> None:
+        """Drive the register block's AXI4-Lite slave ``s_axil_*`` with cocotbext-axi's
+        ``AxiLiteMaster``; ``pauses`` (if given) makes a pause generator for each of its five
+        channels (random AXI4-Lite stalls)."""
+        from cocotbext.axi import AxiLiteBus, AxiLiteMaster
+
+        self.axil = AxiLiteMaster(AxiLiteBus.from_prefix(self.dut, "s_axil"), self.dut.clk,
+                                  self.dut.rst)
+        if pauses is not None:
+            for ch in (self.axil.write_if.aw_channel, self.axil.write_if.w_channel,
+                       self.axil.write_if.b_channel, self.axil.read_if.ar_channel,
+                       self.axil.read_if.r_channel):
+                ch.set_pause_generator(pauses())
+
+    async def read32(self, address: int) -> int:
+        """One 32-bit register read at byte ``address`` (after :meth:`attach_regs`); with
+        ``host.regs.decode`` / ``address`` it reads a register by name."""
+        return int(await self.axil.read_dword(address))
+
+    async def write32(self, address: int, value: int) -> None:
+        """One 32-bit register write at byte ``address`` (after :meth:`attach_regs`)."""
+        await self.axil.write_dword(address, int(value))
 
     def set_cfar_scale(self, value: int) -> None:
         """Drive the quasi-static ``cfg_cfar_scale`` input (OUTPUT_MODE = 1), e.g.

@@ -24,7 +24,8 @@ from model.config import RadarConfig
 from model.radar_pipeline import PipelineParams
 from rtlsim.toolchain import build_and_test, rtl_sources
 
-PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "detect/*.sv", "top/*.sv")
+PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "detect/*.sv", "regs/*.sv",
+                    "top/*.sv")
 """Globs (under ``rtl/``) of the files the ``radar_pipeline`` top elaborates."""
 
 

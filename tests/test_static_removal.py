@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from host.pipeline import process_cube
+from model.config import RadarConfig
 from model.impairments import Ground, Impairments, Wall
-from model.radar_pipeline import PipelineParams, scaled_cube
+from model.radar_pipeline import PipelineParams, dma_packets, scaled_cube
 from model.reference import remove_static
 from model.scene import PointTarget, Scene
-from model.simulate import simulate_scene
+from model.simulate import simulate_frame, simulate_scene
 from model.static_removal import (
     divisor,
     mean,
@@ -151,3 +152,26 @@ def test_radar_detect_remove_static(tmp_path, backend: str) -> None:
     assert any(r == 30 and not moving for r, moving in found[False])
     assert not any(r in (29, 30, 31) for r, _ in found[True])
     assert any(r in (59, 60, 61) and moving for r, moving in found[True])
+
+
+def test_dma_frames_removal_per_frame() -> None:
+    """``dma_frames(removal=...)``: each frame as a run with its own switch (the register
+    SETTINGS.clutter_removal, tb/radar_pipeline/test_radar_pipeline_regs.py); on needs
+    STATIC_REMOVAL."""
+    cfg = RadarConfig(name="small4", num_tx=4, num_rx=4, n_range=32, n_doppler=32,
+                      sample_rate_hz=10e6, chirp_period_s=4e-6, design_max_range_m=50.0)
+    sc = Scene(preset="full", targets=(PointTarget(12.0, -20.0, 0.0, 5.0),)).scatterers()
+    frames = [simulate_frame(cfg, sc, rng=np.random.default_rng(k), frame_index=k).samples
+              for k in range(2)]
+    chain = PipelineParams(packet_words=256, static_removal=True)
+    mixed = dma_packets(frames, cfg, chain, removal=[False, True])
+    half = len(mixed) // 2
+    off = dma_packets(frames[:1], cfg, chain, removal=[False])
+    on = dma_packets(frames[1:], cfg, chain, first_frame_id=1)
+    assert all(np.array_equal(a, b) for a, b in zip(mixed, off + on, strict=True))
+    assert not all(np.array_equal(a, b) for a, b in zip(
+        mixed[half:], dma_packets(frames[1:], cfg, chain, 1, [False]), strict=True))
+    with pytest.raises(ValueError, match="removal"):
+        dma_packets(frames, cfg, PipelineParams(packet_words=256), removal=[True, False])
+    with pytest.raises(ValueError, match="removal"):
+        dma_packets(frames, cfg, chain, removal=[True])

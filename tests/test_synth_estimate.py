@@ -144,10 +144,10 @@ def test_vivado_job_tcl_names_top_parameters_and_files(set_name: str, tmp_path: 
     pkgs = [Path(p) for p in re.findall(r"\{([^}]*)\}", lines["pkgs"])]
     mods = [Path(p) for p in re.findall(r"\{([^}]*)\}", lines["mods"])]
     assert all(p.is_absolute() and p.exists() for p in pkgs + mods)
-    assert {p.stem for p in pkgs} == {"fft_pkg", "fft_rom_pkg"}
+    assert {p.stem for p in pkgs} == {"fft_pkg", "fft_rom_pkg", "radar_regs_pkg"}
     stems = {p.stem for p in mods}
     assert {"radar_pipeline", "fft_axis", "fft_twiddle_rom", "fft_hann_rom", "corner_turn",
-            "frame_store_axi", "axis_packetizer"} <= stems
+            "frame_store_axi", "axis_packetizer", "radar_ctrl", "radar_regs"} <= stems
     assert tcl.rstrip().endswith(f"source {{{TCL}}}")
     # run.tcl takes what job.tcl sets (and falls back to -tclargs only without it)
     run = TCL.read_text()

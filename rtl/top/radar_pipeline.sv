@@ -21,8 +21,19 @@
 //
 // STATIC_REMOVAL = 1: static-clutter removal (static_removal, one slow-time vector of
 // latency) between the corner turn (either variant) and the Doppler FFT, switched at run time
-// by cfg_static_removal, which takes effect at the next frame out of the corner turn; the
-// mean it removes is weighted by the Doppler window when WINDOW (docs/buffers.md).
+// by the register SETTINGS.clutter_removal (on after reset), which takes effect at the next
+// frame out of the corner turn; the mean it removes is weighted by the Doppler window when
+// WINDOW (docs/buffers.md).
+//
+// Control plane (docs/regs.md): radar_ctrl on the AXI4-Lite slave s_axil_* with the level
+// interrupt irq. Its frame_start is the frame boundary at static_removal's input (the corner
+// turn's output): the active settings follow the pending ones in every cycle that ends with
+// that input between two frames, and are frozen from the cycle of a frame's first word to
+// the cycle of its last word, so static_removal, which samples the switch with a frame's
+// first word, always runs a frame with the ACTIVE_SETTINGS of that frame. The event counters
+// and sticky flags count what the status ports below count (frames and packets out of the
+// packetizer, dropped ADC chirps and DMA words, framing errors, FFT saturation, memory
+// errors); the status ports stay until rtlsim reads the registers instead.
 `default_nettype none
 
 module radar_pipeline #(
@@ -67,7 +78,7 @@ module radar_pipeline #(
   // 0: the radar cube to the DMA (docs/design.md 3.2); 1: detection records (docs/design.md 3.4).
   parameter int OUTPUT_MODE = 0,
   // 1: static-clutter removal before the Doppler FFT (static_removal, switched by
-  // cfg_static_removal); 0: none, cfg_static_removal unused.
+  // SETTINGS.clutter_removal, on after reset); 0: none, the setting has no effect.
   parameter bit STATIC_REMOVAL = 1'b0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
   // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,
@@ -84,7 +95,9 @@ module radar_pipeline #(
   parameter int REPORT_HI = N_RANGE,
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
-  parameter int MAX_DETECTIONS = 256
+  parameter int MAX_DETECTIONS = 256,
+  // Byte address bits of the register block (s_axil_awaddr / araddr), fixed by the map.
+  localparam int REGS_ADDR_W = radar_regs_pkg::RADAR_REGS_MIN_ADDR_WIDTH
 ) (
   input  wire logic                       clk,
   input  wire logic                       rst,
@@ -99,9 +112,29 @@ module radar_pipeline #(
   // entry e at bits e*SCALE_W (model.cfar_2d.scale_table / pack_scale). A quasi-static
   // configuration register: change it only between frames. Unused in OUTPUT_MODE = 0.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_cfar_scale,
-  // Static-clutter removal on (STATIC_REMOVAL = 1; the register block's clutter_removal
-  // setting): sampled with the first word of every frame out of the corner turn.
-  input  wire logic                       cfg_static_removal,
+  // Control and status registers (radar_ctrl, docs/regs.md): AXI4-Lite slave, 32-bit data,
+  // byte addresses; tie the VALIDs low when unused.
+  input  wire logic                       s_axil_awvalid,
+  output logic                            s_axil_awready,
+  input  wire logic [REGS_ADDR_W-1:0]     s_axil_awaddr,
+  input  wire logic [2:0]                 s_axil_awprot,
+  input  wire logic                       s_axil_wvalid,
+  output logic                            s_axil_wready,
+  input  wire logic [31:0]                s_axil_wdata,
+  input  wire logic [3:0]                 s_axil_wstrb,
+  output logic                            s_axil_bvalid,
+  input  wire logic                       s_axil_bready,
+  output logic      [1:0]                 s_axil_bresp,
+  input  wire logic                       s_axil_arvalid,
+  output logic                            s_axil_arready,
+  input  wire logic [REGS_ADDR_W-1:0]     s_axil_araddr,
+  input  wire logic [2:0]                 s_axil_arprot,
+  output logic                            s_axil_rvalid,
+  input  wire logic                       s_axil_rready,
+  output logic      [31:0]                s_axil_rdata,
+  output logic      [1:0]                 s_axil_rresp,
+  // Level interrupt: a STATUS flag whose IRQ_ENABLE bit is set
+  output logic                            irq,
   // DMA stream: per packet [header] + payload (for tx, range bin, Doppler bin: one word of
   // NUM_RX lanes), TLAST on the last word of every packet.
   output logic      [NUM_RX*32-1:0]       m_axis_dma_tdata,
@@ -350,6 +383,7 @@ module radar_pipeline #(
   end
 
   // ---- static-clutter removal (STATIC_REMOVAL = 1) -----------------------------------------
+  logic              cfg_clutter_removal;   // radar_ctrl's active setting (below)
   logic [WORD_W-1:0] sr_tdata;
   logic              sr_tvalid, sr_tready, sr_tlast;
   logic [0:0]        sr_tuser;
@@ -360,7 +394,7 @@ module radar_pipeline #(
       .NUM_RX(NUM_RX), .N_DOPPLER(N_DOPPLER), .N_LOOPS(N_DOPPLER), .DATA_W(DATA_W),
       .WINDOW(WINDOW)
     ) u_static_removal (
-      .clk, .rst, .enable(cfg_static_removal),
+      .clk, .rst, .enable(cfg_clutter_removal),
       .s_axis_tdata(ct_tdata), .s_axis_tvalid(ct_tvalid), .s_axis_tready(ct_tready),
       .s_axis_tlast(ct_tlast), .s_axis_tuser(ct_tuser),
       .m_axis_tdata(sr_tdata), .m_axis_tvalid(sr_tvalid), .m_axis_tready(sr_tready),
@@ -377,7 +411,7 @@ module radar_pipeline #(
     assign sr_saturated = 1'b0;
     /* verilator lint_off UNUSEDSIGNAL */
     logic unused_sr;
-    assign unused_sr = cfg_static_removal;
+    assign unused_sr = cfg_clutter_removal;
     /* verilator lint_on UNUSEDSIGNAL */
   end
 
@@ -533,16 +567,75 @@ module radar_pipeline #(
                      + {2'b00, pk_framing_count} + {2'b00, fft_framing_count_q};
   assign framing_error_count = (framing_sum[33:32] != 2'b00) ? '1 : framing_sum[31:0];
 
+  // ---- control and status registers --------------------------------------------------------
+  // Frame boundary at static_removal's input (the corner turn's output, CUBE_WORDS words a
+  // frame in either read order): ct_word_q counts the words of the current frame. The
+  // active settings follow the pending ones while no word of a frame has been taken yet
+  // (ct_word_q == 0 and no beat) and in the cycle of a frame's last word; so they are frozen
+  // from a frame's first word, where static_removal samples the switch, to its last.
+  localparam int CWORD_W = $clog2(CUBE_WORDS);
+  logic [CWORD_W-1:0] ct_word_q;
+  logic               ct_beat, ct_frame_last, ctrl_frame_start;
+  assign ct_beat          = ct_tvalid && ct_tready;
+  assign ct_frame_last    = ct_beat && (ct_word_q == CWORD_W'(CUBE_WORDS - 1));
+  assign ctrl_frame_start = ct_beat ? ct_frame_last : (ct_word_q == '0);
+  always_ff @(posedge clk) begin
+    if (rst) ct_word_q <= '0;
+    else if (ct_beat) ct_word_q <= ct_frame_last ? '0 : ct_word_q + 1'b1;
+  end
+
+  // Event pulses from the status counters and sticky flags above (the same conditions): a
+  // counter's bit 0 toggles once per counted event (each counts at most one a clock), a
+  // sticky flag rises once. One clock late, which no counter minds.
+  localparam int NEV = 10;
+  logic [NEV-1:0] ev_now, ev_q, ev;
+  assign ev_now = {frames_out[0], packets_out[0], adc_chirps_dropped[0], dma_words_dropped[0],
+                   pp_framing_count[0], ct_framing_count[0], pk_framing_count[0],
+                   mem_error_count[0], det_framing_error, sr_framing};
+  always_ff @(posedge clk) begin
+    if (rst) ev_q <= '0;
+    else     ev_q <= ev_now;
+  end
+  assign ev = ev_now ^ ev_q;
+
+  logic ctrl_frame_done, ctrl_packet_done, ctrl_drop, ctrl_error;
+  assign ctrl_frame_done  = ev[9];
+  assign ctrl_packet_done = ev[8];
+  assign ctrl_drop        = ev[7] | ev[6];
+  assign ctrl_error       = (|ev[5:0]) | rf_ev_ovf | df_ev_ovf | fft_tlast_event;
+
+  logic [1:0]  cfg_cfar_kind;
+  logic [15:0] cfg_max_detections, cfg_packet_words;
+  logic [31:0] cfg_scale;
+  radar_ctrl #(
+    .MAX_DETECTIONS((OUTPUT_MODE == 1) ? MAX_DETECTIONS : 256), .PACKET_WORDS(PACKET_WORDS),
+    .CFAR_KIND(0), .CFAR_SCALE(0), .CLUTTER_REMOVAL(STATIC_REMOVAL)
+  ) u_ctrl (
+    .clk, .rst,
+    .s_axil_awvalid, .s_axil_awready, .s_axil_awaddr, .s_axil_awprot,
+    .s_axil_wvalid, .s_axil_wready, .s_axil_wdata, .s_axil_wstrb,
+    .s_axil_bvalid, .s_axil_bready, .s_axil_bresp,
+    .s_axil_arvalid, .s_axil_arready, .s_axil_araddr, .s_axil_arprot,
+    .s_axil_rvalid, .s_axil_rready, .s_axil_rdata, .s_axil_rresp,
+    .frame_start(ctrl_frame_start), .frame_done(ctrl_frame_done),
+    .packet_done(ctrl_packet_done), .drop(ctrl_drop), .error(ctrl_error),
+    .cfg_cfar_kind, .cfg_clutter_removal, .cfg_max_detections, .cfg_cfar_scale(cfg_scale),
+    .cfg_packet_words, .irq
+  );
+
   // Signals the chain does not need: bin indices (the order is implied), the ping-pong's
   // frame-start / discontinuity marks (its counters report drops), the corner turn's
   // frame-start mark (after static removal) and output frame count, the ping-pong's
   // dropped-sample count (chirps dropped are reported instead), and the static removal's
   // saturation flag (the model reports it; no status port yet). Waiver: reduced into a
-  // deliberately unused bit.
+  // deliberately unused bit. The settings the datapath cannot take at run time yet (CFAR kind
+  // and scale, detections per frame, packet length: HDL parameters of the detector and the
+  // packetizer, docs/regs.md) stay in the register map, unused here.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
   assign unused_ok = ^{rf_tuser, df_tuser, sr_tuser, ct_frames_out, pp_drop_samples,
-                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated};
+                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated,
+                       cfg_cfar_kind, cfg_max_detections, cfg_packet_words, cfg_scale};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

@@ -141,7 +141,13 @@ class Harness {
       else if (a.cfar_scale[i]) fail(2, "--cfar-scale wider than cfg_cfar_scale");
     }
     harness::put_words(top_->cfg_cfar_scale, scale.data(), static_cast<int>(scale_words));
-    top_->cfg_static_removal = 1;  // on for every frame when built in (STATIC_REMOVAL = 1)
+    // the register block stays idle: its reset settings (static-clutter removal on when
+    // built in, STATIC_REMOVAL = 1) hold for every frame
+    top_->s_axil_awvalid = 0;
+    top_->s_axil_wvalid = 0;
+    top_->s_axil_arvalid = 0;
+    top_->s_axil_bready = 1;
+    top_->s_axil_rready = 1;
   }
 
   int run() {
