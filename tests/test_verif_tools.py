@@ -15,9 +15,13 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def _load(name: str):
-    spec = importlib.util.spec_from_file_location(name, REPO / "tools" / f"{name}.py")
+    """tools/<name>.py as the module ``tools_<name>`` (not ``<name>``: tools/coverage.py must
+    not stand in for the coverage package that numba imports, in this process or in the
+    processes it forks)."""
+    key = f"tools_{name}"
+    spec = importlib.util.spec_from_file_location(key, REPO / "tools" / f"{name}.py")
     mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
+    sys.modules[key] = mod
     spec.loader.exec_module(mod)
     return mod
 
@@ -25,6 +29,15 @@ def _load(name: str):
 mutate = _load("mutate")
 formal = _load("formal")
 coverage = _load("coverage")
+
+
+def test_loading_the_tools_leaves_imports_alone() -> None:
+    """Neither tools/ on sys.path nor a tools module under a package's name: the cocotb runner
+    hands this process's sys.path to every later simulation as PYTHONPATH, where numba's
+    `import coverage` would find tools/coverage.py and fail."""
+    assert not any(Path(p).resolve() == REPO / "tools" for p in sys.path if p)
+    assert "coverage" not in sys.modules or "tools" not in str(
+        getattr(sys.modules["coverage"], "__file__", ""))
 
 
 def test_every_operator_has_mutants() -> None:

@@ -45,8 +45,14 @@ from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+# tools/ on sys.path only while mutate_ops is imported: a test that imports this module must
+# not leave tools/ (whose coverage.py shadows the coverage package) on the sys.path that the
+# cocotb runner hands to later simulations as PYTHONPATH
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from mutate_ops import NEW_OPS, extra_mutants, operand_end  # noqa: E402 - tools/ is on sys.path now
+try:
+    from mutate_ops import NEW_OPS, extra_mutants, operand_end
+finally:
+    sys.path.pop(0)
 
 REPO = Path(__file__).resolve().parents[1]
 RTL = REPO / "rtl"
