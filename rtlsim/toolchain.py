@@ -9,6 +9,7 @@ dump ``dump.vcd``.
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import sys
@@ -147,10 +148,16 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
     cov = coverage_enabled()
     build_dir = SIM_BUILD / toplevel / (param_tag(parameters) + ("_cov" if cov else ""))
     runner = get_runner("verilator")
-    runner.build(sources=[str(s) for s in sources], hdl_toplevel=toplevel,
-                 parameters=parameters, build_dir=build_dir,
-                 build_args=list(BUILD_ARGS) + (list(COVERAGE_ARGS) if cov else []),
-                 timescale=("1ns", "1ps"), waves=waves, always=False)
+    # two pytest workers may build the same parameter set at once (test modules of one top
+    # share sets): one builds, the other waits and finds it built (a concurrent make in one
+    # directory breaks the precompiled header)
+    build_dir.mkdir(parents=True, exist_ok=True)
+    with open(build_dir.parent / f"{build_dir.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        runner.build(sources=[str(s) for s in sources], hdl_toplevel=toplevel,
+                     parameters=parameters, build_dir=build_dir,
+                     build_args=list(BUILD_ARGS) + (list(COVERAGE_ARGS) if cov else []),
+                     timescale=("1ns", "1ps"), waves=waves, always=False)
     env = {f"PARAM_{k}": str(v) for k, v in parameters.items()}
     env.update(extra_env or {})
     if cov:  # cocotb reads COVERAGE too (Python coverage of the testbench): not wanted here
