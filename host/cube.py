@@ -21,17 +21,15 @@ import scipy.fft
 
 from model.array import tx_slots
 from model.config import RadarConfig
-from model.reference import check_frame, hann_periodic
+from model.reference import check_frame, fft_axes, remove_static
 
 
 @lru_cache(maxsize=16)
-def _weights(n_samples: int, n_loops: int, n_range: int, n_doppler: int, range_window: bool,
-             doppler_window: bool) -> np.ndarray:
-    """Both windows and both FFT scales, w_r[s] w_d[l] / (n_range n_doppler), float64
-    (n_samples, n_loops)."""
-    w_r = hann_periodic(n_samples) if range_window else np.ones(n_samples)
-    w_d = hann_periodic(n_loops) if doppler_window else np.ones(n_loops)
-    w = np.outer(w_r, w_d / (n_range * n_doppler))
+def _weights(cfg: RadarConfig, range_window: bool, doppler_window: bool) -> np.ndarray:
+    """Both windows (``model.reference.fft_axes``) and both FFT scales,
+    w_r[s] w_d[l] / (n_range n_doppler), float64 (n_samples, n_loops)."""
+    ax_r, ax_d = fft_axes(cfg, range_window, doppler_window)
+    w = np.outer(ax_r.window(), ax_d.window() / (cfg.n_range * cfg.n_doppler))
     w.flags.writeable = False
     return w
 
@@ -44,20 +42,15 @@ def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     (n_virtual, n_range_bins, n_doppler), equal to the reference's to float64 rounding.
     """
     check_frame(adc, cfg)
-    w = _weights(cfg.n_samples, cfg.n_loops, cfg.n_range, cfg.n_doppler, range_window,
-                 doppler_window)
+    w = _weights(cfg, range_window, doppler_window)
     x = np.asarray(adc).reshape(cfg.n_loops, cfg.num_tx, cfg.num_rx, cfg.n_samples)
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         x = x[:, tx_slots(cfg)]                 # slot of each TX index
     x = x.transpose(1, 2, 3, 0)                 # (tx, rx, samples, loops)
     real = cfg.adc == "real"
     y = np.empty(x.shape, np.float64 if real else np.complex128)
-    if remove_static_clutter:   # less the (Doppler-window weighted) slow-time mean, float64
-        w_d = hann_periodic(cfg.n_loops) if doppler_window else np.ones(cfg.n_loops)
-        np.subtract(x, (x @ w_d)[..., None] / w_d.sum(), out=y)
-        y *= w
-    else:
-        np.multiply(x, w, out=y)
+    # less the (Doppler-window weighted) slow-time mean when asked, then both weights
+    np.multiply(remove_static(x, doppler_window) if remove_static_clutter else x, w, out=y)
     if real:
         y = scipy.fft.rfft(y, n=cfg.n_range, axis=2)[:, :, :cfg.n_range_bins]
         y = scipy.fft.fft(y, n=cfg.n_doppler, axis=3, overwrite_x=True)
