@@ -21,6 +21,7 @@ and a one-line reason on stderr. ``radar <cmd> --help`` explains every option.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from model.config import PRESETS
@@ -67,6 +68,11 @@ def main(argv: list[str] | None = None) -> int:
     except CliError as exc:
         print(f"radar {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # the reader went away (`radar ... | head`): not an error of ours; stdout goes to
+        # /dev/null so the interpreter's final flush cannot raise again
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except OSError as exc:
         print(f"radar {args.command}: error: {exc.strerror or exc}: "
               f"{getattr(exc, 'filename', '') or ''}", file=sys.stderr)

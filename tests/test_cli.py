@@ -130,3 +130,14 @@ def test_detect_with_gnn_objects(tmp_path):
         assert {"class", "score", "x_m", "y_m", "length_m", "width_m", "heading_deg",
                 "points", "frame"} <= set(o)
         assert all(0 <= i < len(doc["points"]) for i in o["points"])
+
+
+def test_closed_pipe_is_quiet():
+    """`radar profile show NAME | head -1`: the reader leaving early is not an error (no
+    'Broken pipe' message, no traceback; exit 141 as a shell reports SIGPIPE)."""
+    p = subprocess.Popen([sys.executable, "-m", "radar.cli", "profile", "show", "paper-fpga"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    assert p.wait() == 141
+    assert err == ""
