@@ -200,3 +200,26 @@ def test_a_profile_the_rtl_cannot_run_is_refused(tmp_path, capsys):
         assert err.count("\n") == 0 and f"--backend {backend}" in err and "18-bit" in err
         assert "(--backend float runs it)" in err, err
     assert not out.exists()
+
+
+def test_a_frame_the_chain_does_not_send_is_an_error(tmp_path, monkeypatch, capsys):
+    """A frame missing from the chain's DMA stream (here the model's last frame dropped):
+    the frames that came are written, then one line, exit status 2."""
+    from radar.sources import ModelSource
+
+    send = ModelSource.cube_packets
+
+    def drop_last(self, adc_frames, cfg):  # noqa: ANN001, ANN202 - as cube_packets
+        packets = list(send(self, adc_frames, cfg))
+        return iter(packets[:len(packets) // 2])
+
+    monkeypatch.setattr(ModelSource, "cube_packets", drop_last)
+    frame = open_capture(BIN_FILE, OPENRADAR).frame(0)
+    path = tmp_path / "frames.npy"
+    write_npy(path, iter([frame, frame]), 2, OPENRADAR.config)
+    out = tmp_path / "x.json"
+    assert main(["process", "--radar", str(CFG_FILE), "--capture", str(path), "--json",
+                 str(out), "--backend", "model"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "1 of 2 frame(s) did not come out of the chain" in err
+    assert json.loads(out.read_text())["frames"] == 1

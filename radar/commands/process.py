@@ -217,10 +217,15 @@ def frame_clouds(adc_frames: Iterator[np.ndarray], frames: range, cfg: RadarConf
             yield k, capture_frame_cloud(adc, cfg, params, k, remove_static), {}
         return
     # the model and the RTL send every frame, in order, numbered from 0 after reset
+    done = 0
     for k, f in zip(frames, source.dma_frames(adc_frames, cfg, dcfg), strict=False):
         fc = frame_cloud(f, cfg, params, k, "process")
         info = dma_frame_info(f, k, "process", dcfg.max_detections if dcfg else 0)
+        done += 1
         yield k, fc, {**info, "damaged": not f.complete, "problems": f.problems}
+    if done < len(frames):
+        raise SourceError(f"{len(frames) - done} of {len(frames)} frame(s) did not come out "
+                          f"of the chain")
 
 
 def cmd_process(args: argparse.Namespace) -> int:
