@@ -12,7 +12,7 @@ OUT    ?= out
 
 .PHONY: all setup demo test test-python sim lint gen regs bench bench-rtl soak gnn-dataset gnn-train \
         gnn-eval clean help view view-records bench-view test-detect-long test-full test-full-detect \
-        formal coverage mutate mutate-ci curves bench-ray bench-openradar
+        test-process-rtl formal coverage mutate mutate-ci curves bench-ray bench-openradar
 all: test
 
 help:
@@ -32,6 +32,7 @@ help:
 	@echo "make test-full       one full-size frame, FRAME_STORE=1 top + AXI4 memory, bit-exact"
 	@echo "make test-full-detect  Table I full frame, OUTPUT_MODE=1 + FRAME_STORE=1, records bit-exact"
 	@echo "make test-detect-long  detector blocks and the mode-1 top at every parameter set"
+	@echo "make test-process-rtl  the OpenRadar capture, --backend rtl = model, every chain"
 	@echo "make synth-estimate  Yosys resource estimate (paper-fpga blocks + top) -> $(OUT)/synth/"
 	@echo "make synth-vivado    Vivado synthesis for the ZCU106 (needs vivado on PATH)"
 	@echo "make timing          ECP5-85 place and route + xcup LUT depth per block -> $(OUT)/timing/"
@@ -204,6 +205,13 @@ bench-view: $(STAMP)
 test-detect-long: $(STAMP)
 	DETECT_LONG=1 $(RUN) pytest -n $(JOBS) tb/nci tb/cfar_2d tb/detect_records tb/detect_chain \
 	  tb/radar_pipeline/test_radar_pipeline_detect.py tests/test_detect_fpga.py
+
+# The OpenRadar capture through `radar process --backend rtl` against --backend model with
+# static-clutter removal and the on-chip detector too (a build each; make test runs the plain
+# chain only)
+.PHONY: test-process-rtl
+test-process-rtl: $(STAMP)
+	PROCESS_RTL=1 $(RUN) pytest -q -n 0 tests/test_process_rtl.py
 
 # One full-size frame (4 TX x 16 RX, 256 x 256) through the FRAME_STORE = 1 top and the C++
 # harness's AXI4 memory, every DMA byte against the model (not in `make test`: the 16-lane

@@ -41,6 +41,7 @@ from host.params import DetectionParams
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from host.records import RecordArrays, outside_map
+from model.array import slot_channels
 from model.config import RadarConfig
 from model.reference import fft_axes
 
@@ -137,8 +138,10 @@ def record_cells(arr: RecordArrays, cfg: RadarConfig, params: DetectionParams) -
     idx = select_records(arr, cfg, params)
     r = arr.range_bin[idx]
     offsets = record_offsets(arr.power[idx], _neighbours(arr)[idx], r, cfg, params)
+    snapshot = arr.snapshot[idx]
+    order = slot_channels(cfg)          # the chain's channels are chirp slots
     return Cells(r, arr.doppler_bin[idx], arr.power[idx], arr.noise[idx], offsets,
-                 arr.snapshot[idx])
+                 snapshot if order is None else snapshot[:, order])
 
 
 @njit()

@@ -29,6 +29,7 @@ from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
+from model.array import tx_slots
 from model.axis_packetizer import (
     MAGIC,
     PacketHeader,
@@ -101,9 +102,12 @@ def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig, gain: float = 1.0
     result as ``model.reference.dma_order_to_cube(model.axis_packetizer.payload_to_cube(
     ...)) / gain``, several times faster on a ``full`` frame: the 32-bit {Q, I} words are
     transposed to channel order while still words (one strided copy), then widened
-    contiguously."""
+    contiguously. The payload's TX blocks are chirp slots; the cube's channels count TXs by
+    index (``model.array.slot_channels``)."""
     w = np.ascontiguousarray(words, dtype="<u4").reshape(
         cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+    if cfg.tx_sequence != tuple(range(cfg.num_tx)):
+        w = w[tx_slots(cfg)]                    # slot of each TX index
     t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
     t[...] = w.transpose(0, 3, 1, 2)
     iq = np.empty(t.shape + (2,), np.float32)

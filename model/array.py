@@ -65,3 +65,15 @@ def tx_slots(cfg: RadarConfig) -> np.ndarray:
     slots = np.empty(cfg.num_tx, dtype=int)
     slots[list(cfg.tx_sequence)] = np.arange(cfg.num_tx)
     return slots
+
+
+def slot_channels(cfg: RadarConfig) -> np.ndarray | None:
+    """The FPGA chain's channel of each virtual channel, int (n_virtual,), or None when they
+    are the same (TXs firing in index order). The chain's corner turn keeps chirp slots: its
+    cube's and its detection records' channel s * num_rx + r is RX r in chirp slot s, fired
+    by TX ``cfg.tx_sequence[s]``; ``chain[..., slot_channels(cfg)]`` is in the order of
+    virtual channel v = tx * num_rx + rx (TX by index), the float chain's and the host's."""
+    if cfg.tx_sequence == tuple(range(cfg.num_tx)):
+        return None
+    v = np.arange(cfg.n_virtual)
+    return tx_slots(cfg)[v // cfg.num_rx] * cfg.num_rx + v % cfg.num_rx

@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from model.array import slot_channels
 from model.axis_packetizer import (
     check_geometry,
     cube_to_payload,
@@ -41,8 +42,9 @@ from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
-from model.hdl import hdl_parameters
+from model.hdl import DATA_W, hdl_parameters
 from model.profile_fields import check_preset_chain
+from model.reference import hann_periodic
 from model.static_removal import remove_static_planar
 
 RANGE_SCALE_SCH = 0xFFF
@@ -180,6 +182,27 @@ def chain_gain(cfg: RadarConfig, params: PipelineParams) -> float:
             * _stage_gain(cfg.n_doppler, params.doppler_scale_sch))
 
 
+def range_scale_for_peak(cfg: RadarConfig, peak: float, params: PipelineParams | None = None
+                         ) -> int:
+    """RANGE_SCALE_SCH for ADC frames whose I and Q codes stay within +-``peak``: the first
+    stages of the range FFT halve, as few as keep the worst case (a tone of that peak on I
+    and Q, coherent over the frame's samples and chirps, through the windows of ``params``
+    and its Doppler schedule) within the DATA_W-bit cube, so no such frame can saturate;
+    :data:`RANGE_SCALE_SCH` (every stage, the default) when even that is needed. A capture
+    far below full scale (the OpenRadar frame peaks at 265 of 32767) then keeps its noise
+    above the rounding instead of a cube of zeros (docs/profiles.md)."""
+    params = params or PipelineParams()
+    mean_w = (hann_periodic(cfg.n_range).mean() * hann_periodic(cfg.n_doppler).mean()
+              if params.window else 1.0)
+    limit = (2 ** (DATA_W - 1) - 1) / (max(float(peak), 1.0) * np.sqrt(2.0) * mean_w)
+    stages = cfg.n_range.bit_length() - 1
+    for halved in range(stages):
+        sch = (1 << halved) - 1
+        if chain_gain(cfg, replace(params, range_scale_sch=sch)) <= limit:
+            return sch
+    return RANGE_SCALE_SCH
+
+
 @dataclass(frozen=True)
 class ChainOutput:
     """One frame through the chain.
@@ -268,10 +291,13 @@ def turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndar
 def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
                 ) -> np.ndarray:
     """The chain's cube as the host works with it: complex64 (n_virtual, n_range, n_doppler)
-    divided by :func:`chain_gain` (units of the float reference), identical to the cube
-    decoded from the DMA stream."""
+    divided by :func:`chain_gain` (units of the float reference), its channels by TX index
+    (``model.array.slot_channels``), identical to the cube decoded from the DMA stream."""
     params = params or PipelineParams()
-    return run_chain(adc, cfg, params).cube().astype(np.complex64) / chain_gain(cfg, params)
+    cube = run_chain(adc, cfg, params).cube()
+    order = slot_channels(cfg)
+    return (cube if order is None else cube[order]).astype(np.complex64) / chain_gain(cfg,
+                                                                                      params)
 
 
 def record_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,

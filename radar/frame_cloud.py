@@ -12,6 +12,7 @@ import numpy as np
 
 from host.pipeline import DetectionParams, process_cube_nci, real_only
 from host.pointcloud import PointCloud
+from host.receiver import LinkFrame
 from host.record_points import process_records
 from host.records import DetectionFrame, RecordArrays, inside_map, outside_problem
 from model.config import RadarConfig
@@ -72,3 +73,22 @@ def frame_cloud(frame: np.ndarray | CubeFrame | DetectionFrame, cfg: RadarConfig
         problems.append(f"frame {frame_id}: {REAL_ONLY}")
         note_real_only(command, frame_id)
     return FrameCloud(cloud, cube=cube, nci=nci, problems=problems)
+
+
+def dma_frame_info(frame: LinkFrame, frame_id: int, command: str, max_detections: int = 0
+                   ) -> dict[str, object]:
+    """What a frame decoded from the chain's DMA bytes adds to its ``frame_info`` entry in
+    the point cloud JSON: for a record frame (``--detect fpga``) the records sent, the cells
+    past the CFAR, the truncated and complete flags; for a cube frame nothing. One-line
+    warnings (``radar <command>``) when it arrived damaged or was truncated at
+    ``max_detections``."""
+    records = isinstance(frame, DetectionFrame)
+    if records and frame.truncated:
+        warn([f"frame {frame_id}: {frame.detections} cells passed the CFAR, only "
+              f"--max-detections {max_detections} were sent"], command)
+    if not frame.complete:
+        warn([f"frame {frame_id} damaged: {'; '.join(frame.problems[:3])}"], command)
+    if not records:
+        return {}
+    return {"records": len(frame.records), "detections": frame.detections,
+            "truncated": frame.truncated, "complete": frame.complete}

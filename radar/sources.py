@@ -11,9 +11,12 @@ radar cubes complex (n_virtual, n_range, n_doppler) in the float reference's uni
   its DMA packets decoded like the board's (``host.receiver.chain_decoder``).
 
 With the on-chip detector (``radar detect --detect fpga``, ``OUTPUT_MODE = 1``) a source
-gives the frames' detection records instead (:meth:`FrameSource.record_frames`): ``model``
+gives the frames' detection records instead (:meth:`FrameSource.dma_frames`): ``model``
 runs the bit-accurate chain in mode 1 and ``rtl`` the Verilated top in mode 1; both send
 their DMA packets as bytes through :class:`host.records.RecordDecoder`, like the board's.
+``radar process`` takes the cube that way too (:meth:`FrameSource.cube_packets` through
+:class:`host.receiver.CubePayloadDecoder`), so a capture's model and RTL runs compare byte for
+byte.
 
 A new source is one :class:`FrameSource` subclass with a ``name``: it registers itself in
 :data:`SOURCES`.
@@ -28,13 +31,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from host.receiver import chain_decoder
-from host.records import DetectionFrame
+from host.receiver import LinkFrame, chain_decoder
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, check_hdl
-from model.radar_pipeline import PipelineParams, record_frames, scaled_cube
+from model.radar_pipeline import PipelineParams, dma_packets, record_frames, scaled_cube
 from model.reference import radar_cube
 
 SOURCES: dict[str, type[FrameSource]] = {}
@@ -105,13 +107,24 @@ class FrameSource:
         raise SourceError(f"--backend {self.name} has no on-chip detector (use model or rtl "
                           f"with --detect fpga)")
 
-    def record_frames(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
-                      dcfg: DetectConfig) -> Iterator[DetectionFrame]:
-        """Consecutive ADC frames -> their decoded record frames, in order: the DMA packets
-        of :meth:`record_packets` go through :class:`host.records.RecordDecoder` as bytes,
-        exactly as the board's would."""
+    def cube_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig
+                     ) -> Iterator[bytes]:
+        """DMA packets of the chain in ``OUTPUT_MODE = 0`` (the radar cube) as wire bytes,
+        header word first, the frames numbered from 0 as after one reset. SourceError when
+        the source has none."""
+        raise SourceError(f"--backend {self.name} sends no DMA stream (model and rtl do)")
+
+    def dma_frames(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
+                   dcfg: DetectConfig | None = None) -> Iterator[LinkFrame]:
+        """Consecutive ADC frames -> their frames as the host decodes the chain's DMA bytes
+        (``host.receiver.chain_decoder``), in order: the radar cube's frames
+        (:meth:`cube_packets`, ``dcfg`` None) or the on-chip detector's record frames
+        (:meth:`record_packets`, ``dcfg`` its configuration), exactly as the board's would
+        be decoded."""
         dec = chain_decoder(cfg, self.chain.packet_words, self.chain, dcfg)
-        for p in self.record_packets(adc_frames, cfg, dcfg):
+        packets = (self.cube_packets(adc_frames, cfg) if dcfg is None
+                   else self.record_packets(adc_frames, cfg, dcfg))
+        for p in packets:
             yield from dec.push_packet(p if isinstance(p, bytes) else words_to_bytes(p))
         yield from dec.flush()
 
@@ -125,6 +138,15 @@ class ModelSource(FrameSource):
         # complex64 like the cube decoded from the DMA stream, so both give identical clouds
         return scaled_cube(adc, cfg, self.chain)
 
+    def cube_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig
+                     ) -> Iterator[bytes]:
+        # one frame at a time, numbered as one stream after reset (as the RTL's)
+        for k, adc in enumerate(adc_frames):
+            try:
+                packets = dma_packets([adc], cfg, self.chain, first_frame_id=k)
+            except ValueError as exc:
+                raise SourceError(str(exc)) from None
+            yield from (words_to_bytes(p) for p in packets)
 
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:
@@ -199,6 +221,12 @@ class RtlSource(FrameSource):
                               f"status {status}")
         for f in sorted(decoded, key=lambda f: f.frame_id):
             yield f.cube()
+
+    def cube_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig
+                     ) -> Iterator[bytes]:
+        """All frames through the Verilated top (one simulation)."""
+        packets, _ = self._run(list(adc_frames), cfg, self.chain_for(cfg))
+        yield from packets
 
     def record_packets(self, adc_frames: Iterable[np.ndarray], cfg: RadarConfig,
                        dcfg: DetectConfig) -> Iterator[np.ndarray | bytes]:

@@ -127,9 +127,9 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
     elif case == "frames":
         extra = ["--frames", "1:3"]
         want = "--frames: 1:3"
-    elif case == "backend":
-        extra = ["--backend", "rtl"]
-        want = "runs only float"
+    elif case == "backend":                  # the float backend has no on-chip detector
+        extra = ["--detect", "fpga"]
+        want = "--detect fpga: the on-chip detector is the FPGA chain's"
     elif case == "json":
         code = main(["process", "--radar", radar, "--capture", capture, "--json",
                      str(tmp_path / "points.txt")])

@@ -50,7 +50,7 @@ from radar.common import (
     warn_clipped,
 )
 from radar.figures import detect_plots
-from radar.frame_cloud import frame_cloud
+from radar.frame_cloud import dma_frame_info, frame_cloud
 from radar.objects import describe, gnn_objects, object_boxes
 from radar.recording import add_mcap_options, close_recording, open_recording
 from radar.sources import SOURCES, SourceError, get_source
@@ -129,7 +129,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     stopped: str | None = None      # why the run ended early: what was done is written
     try:
         if dcfg is not None:
-            frames = source.record_frames(adc_frames(), cfg, dcfg)
+            frames = source.dma_frames(adc_frames(), cfg, dcfg)
             for f in frames:
                 t_start = time.perf_counter()
                 k = f.frame_id          # a damaged frame closes late: ids, not arrival
@@ -138,15 +138,9 @@ def cmd_detect(args: argparse.Namespace) -> int:
                 clouds.append(cloud)
                 n_clip = saturated[k] if k < len(saturated) else 0
                 per_frame.append({"frame": k, "points": len(cloud), "adc_saturated": n_clip,
-                                  "records": len(f.records), "detections": f.detections,
-                                  "truncated": f.truncated, "complete": f.complete,
+                                  **dma_frame_info(f, k, "detect", dcfg.max_detections),
                                   "problems": f.problems + fc.problems,
                                   "clipped": n_clip, "damaged": not f.complete})
-                if f.truncated:
-                    warn([f"frame {k}: {f.detections} cells passed the CFAR, only "
-                          f"--max-detections {dcfg.max_detections} were sent"], "detect")
-                if not f.complete:
-                    warn([f"frame {k} damaged: {'; '.join(f.problems[:3])}"], "detect")
                 finish_frame(k, cloud, t_start, complete=f.complete, truncated=f.truncated,
                              detections=f.detections, problems=f.problems + fc.problems)
         else:
