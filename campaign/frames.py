@@ -29,6 +29,8 @@ PITCH = 4
 """Bins between neighbouring targets' cells on both axes (at least)."""
 STRIDE = 27
 """Doppler stride of the layout (prime to the 64 columns)."""
+SIN_AZ_MAX = 0.3
+"""The targets' sin(az) is uniform in +-this."""
 
 
 def target_cells(cfg: RadarConfig) -> np.ndarray:

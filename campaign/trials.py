@@ -240,8 +240,8 @@ def _frame_errors(cube: np.ndarray, cfg: RadarConfig, truth: np.ndarray, sin_az:
 def estimation_frames(params: dict[str, Any], trials: range, seed: int, group: int
                       ) -> dict[str, Any]:
     """params: ``snr_db`` per-channel per-sample SNR, ``chains`` (of :data:`FRAME_CHAINS`).
-    One whole frame per trial (``campaign.frames``: 64 targets at random sub-bin positions
-    and azimuths within +-0.3 in sin(az)) through the float chain (``model.reference``) and
+    One whole frame per trial (``campaign.frames``: 64 targets at random sub-bin positions,
+    sin(az) uniform in +-``SIN_AZ_MAX``) through the float chain (``model.reference``) and
     the bit-accurate one (``model.radar_pipeline``, the ADC at its noise level, I and Q
     rounded); estimates by :func:`_frame_errors`. Returns ``trials`` (targets) and per chain
     ``<chain>:se_range_m``, ``<chain>:se_velocity_mps``, ``<chain>:se_azimuth_deg``, and
@@ -254,7 +254,7 @@ def estimation_frames(params: dict[str, Any], trials: range, seed: int, group: i
     for t in trials:
         rng = rng_of(seed, group, t)
         off = rng.random((frames.TARGETS, 2)) - 0.5
-        sin_az = rng.uniform(-0.3, 0.3, frames.TARGETS)
+        sin_az = rng.uniform(-frames.SIN_AZ_MAX, frames.SIN_AZ_MAX, frames.TARGETS)
         adc = frames.tone_frame(rng, cfg, snr, noise_adc, off, sin_az)
         truth = frames.target_cells(cfg) + off
         codes = np.rint(adc.real) + 1j * np.rint(adc.imag)

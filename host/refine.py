@@ -20,10 +20,11 @@ rounding's amplification (docs/curves.md gives both).
 :func:`refine_offsets` starts from the interpolated peak of each detected cell and maximises
 J by coordinate-wise Newton steps, range with the Doppler frequency fixed and the reverse,
 :data:`ROUNDS` times; each 1-D step works on the projection of the samples on the other
-axis' tone (a matrix product over the whole frame). With several cells each is refined on
-the samples less the other cells' fitted tones (one RELAX pass: Li and Stoica, "Efficient
-mixed-spectrum estimation with applications to target feature extraction", IEEE Trans. SP
-44(2), 1996), so a strong neighbour's unwindowed sidelobes do not pull a weak cell. The
+axis' tone (a matrix product over the whole frame). With several cells each is then refined
+on the samples less the other cells' fitted tones, :data:`RELAX_PASSES` times (RELAX: Li
+and Stoica, "Efficient mixed-spectrum estimation with applications to target feature
+extraction", IEEE Trans. SP 44(2), 1996), so a strong neighbour's nearly unwindowed
+sidelobes do not pull a weak cell. The
 estimate stays within :data:`MAX_SHIFT_BINS` of the interpolated one, else that is kept.
 """
 
@@ -42,6 +43,8 @@ at the peak on centred samples: a second round moves the estimate by far less th
 error)."""
 NEWTON_STEPS = 4
 """Newton steps per axis and round."""
+RELAX_PASSES = 3
+"""Passes against the other cells' fitted tones (none for a single cell)."""
 MAX_STEP_BINS = 0.25
 """Largest single Newton step, bins."""
 MAX_SHIFT_BINS = 0.75
@@ -220,11 +223,13 @@ def refine_offsets(cube: np.ndarray, range_bin: np.ndarray, doppler_bin: np.ndar
     ok = first.j_to >= first.j_from
     fr = np.where(ok, first.fr, start[:, 0])
     fd = np.where(ok, first.fd, start[:, 1])
-    if len(offsets) > 1:        # one RELAX pass: each row against the others' tones removed
+    last = first
+    for _ in range(RELAX_PASSES if len(offsets) > 1 else 0):
+        # each row against the residual of every row's fitted tone, its own added back
         vr, vd = weights(ax[0], floor)[1], weights(ax[1], floor)[1]
         norm = np.sum(vr) * np.sum(vd)        # a tone of amplitude A projects to A norm
-        own = _Own(first.amp / norm, first.fr, first.fd, vr, vd, ax)
-        second = _fit(_Samples(raw - own.model()), first.fr, first.fd, start, ax, own)
-        keep = ok & (second.j_to >= second.j_from)
-        fr, fd = np.where(keep, second.fr, fr), np.where(keep, second.fd, fd)
+        own = _Own(last.amp / norm, last.fr, last.fd, vr, vd, ax)
+        last = _fit(_Samples(raw - own.model()), last.fr, last.fd, start, ax, own)
+        ok &= last.j_to >= last.j_from
+        fr, fd = np.where(ok, last.fr, fr), np.where(ok, last.fd, fd)
     return np.stack([fr - range_bin, fd - doppler_bin], axis=1)

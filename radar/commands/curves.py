@@ -28,6 +28,8 @@ def plan_of(args: argparse.Namespace) -> Plan:
         over["snr"] = tuple(args.snr)
     if args.pfa_cells is not None:
         over["pfa_cells"] = args.pfa_cells
+    if args.frame_trials is not None:
+        over["frame_trials"] = args.frame_trials
     plan = dataclasses.replace(plan, **over)
     try:
         plan.check()
@@ -88,6 +90,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     s.add_argument("--trials", type=int, default=None,
                    help="trials per point of every curve (default 2000 Pd targets, 1000 "
                         "estimation and resolution trials; --quick: 420 / 300)")
+    s.add_argument("--frame-trials", type=int, default=None, metavar="N",
+                   help="targets per SNR point of the whole-frame curves (refinement, "
+                        "bit-accurate chain; 64 per frame, about 15 s a frame; default 512, "
+                        "--quick 64; 0: none)")
     s.add_argument("--pfa", type=float, nargs="+", default=None,
                    help="false-alarm probabilities of the detection curves (default 1e-4 1e-6)")
     s.add_argument("--pfa-cells", type=int, default=None,
