@@ -70,7 +70,7 @@ def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
         ax.set_xlabel("per-channel, per-sample SNR, dB")
         ax.set_ylabel(f"{quantity.replace('_', ' ')}, {r['unit']}")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6, loc="upper right")
         fig.tight_layout()
         p = folder / f"crb_{quantity}.png"
         fig.savefig(p, dpi=110)
