@@ -24,8 +24,9 @@ axis' tone (a matrix product over the whole frame). With several cells each is t
 on the samples less the other cells' fitted tones, :data:`RELAX_PASSES` times (RELAX: Li
 and Stoica, "Efficient mixed-spectrum estimation with applications to target feature
 extraction", IEEE Trans. SP 44(2), 1996), so a strong neighbour's nearly unwindowed
-sidelobes do not pull a weak cell. The
-estimate stays within :data:`MAX_SHIFT_BINS` of the interpolated one, else that is kept.
+sidelobes do not pull a weak cell. The steps stay within :data:`MAX_SHIFT_BINS` of the
+interpolated peak; a cell whose periodogram would be lower after a pass than before it keeps
+the frequencies it had.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ RELAX_PASSES = 3
 MAX_STEP_BINS = 0.25
 """Largest single Newton step, bins."""
 MAX_SHIFT_BINS = 0.75
-"""Largest move from the interpolated peak, bins; beyond, the interpolated one is kept."""
+"""Largest move from the interpolated peak, bins (the steps are clipped to it)."""
 FLOAT_FLOOR = 0.001
 """Weighting floor for a float cube (module docstring): its taper costs 0.22 dB of
 estimation (range or Doppler) and 0.07 dB of the other axis' SNR on a 256-sample Hann
@@ -210,7 +211,7 @@ def refine_offsets(cube: np.ndarray, range_bin: np.ndarray, doppler_bin: np.ndar
     (n, 2), by maximising the channel-summed periodogram of the whole frame's samples
     (module docstring); cube complex (n_virtual, n_range, n_doppler), float-reference
     units; ``windows``: (range, Doppler) Hann on. A row whose periodogram at the refined
-    frequencies is below that at the interpolated ones keeps the interpolated offsets (the
+    frequencies is below that at the interpolated ones keeps the interpolated offsets (a
     RELAX pass' move likewise, on its residual)."""
     offsets = np.asarray(offsets, dtype=float)
     if len(offsets) == 0:
@@ -224,10 +225,10 @@ def refine_offsets(cube: np.ndarray, range_bin: np.ndarray, doppler_bin: np.ndar
     fr = np.where(ok, first.fr, start[:, 0])
     fd = np.where(ok, first.fd, start[:, 1])
     last = first
+    vr, vd = weights(ax[0], floor)[1], weights(ax[1], floor)[1]
+    norm = np.sum(vr) * np.sum(vd)            # a tone of amplitude A projects to A norm
     for _ in range(RELAX_PASSES if len(offsets) > 1 else 0):
         # each row against the residual of every row's fitted tone, its own added back
-        vr, vd = weights(ax[0], floor)[1], weights(ax[1], floor)[1]
-        norm = np.sum(vr) * np.sum(vd)        # a tone of amplitude A projects to A norm
         own = _Own(last.amp / norm, last.fr, last.fd, vr, vd, ax)
         last = _fit(_Samples(raw - own.model()), last.fr, last.fd, start, ax, own)
         ok &= last.j_to >= last.j_from

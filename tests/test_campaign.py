@@ -96,6 +96,7 @@ def test_bad_campaign_inputs() -> None:
     ["--snr", "nan", "0", "1"],
     ["--snr", "-10", "-20", "1"],
     ["--workers", "0"],
+    ["--frame-trials", "-1"],
     ["--seed", "-1"],
     ["--ray-address", "127.0.0.1:1"],
     ["--ray-address", "nonsense"],
