@@ -163,3 +163,20 @@ def test_cli_refuses_refine_misfits(tmp_path, capsys, argv: list[str], message: 
     code = main(["detect", "--scene", "table1", "--json", str(tmp_path / "p.json"), *argv])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and message in err[0], err
+
+
+def test_refine_settings_pick_the_floor_of_the_source() -> None:
+    from argparse import Namespace
+
+    from radar.common import CliError, refine_settings
+    assert refine_settings(Namespace()) == {}
+    assert refine_settings(Namespace(refine=False, refine_floor=None)) == {}
+    assert refine_settings(Namespace(refine=True, refine_floor=None, backend="float")) == {
+        "refine": True, "refine_floor": FLOAT_FLOOR}
+    for backend in ("model", "rtl"):
+        assert refine_settings(Namespace(refine=True, refine_floor=None, backend=backend)
+                               )["refine_floor"] == FIXED_POINT_FLOOR
+    assert refine_settings(Namespace(refine=True, refine_floor=0.05, backend="model")
+                           )["refine_floor"] == 0.05
+    with pytest.raises(CliError, match="only with --refine"):
+        refine_settings(Namespace(refine=False, refine_floor=0.1))
