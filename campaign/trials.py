@@ -212,14 +212,14 @@ host's interpolation, and with the refinement; the bit-accurate chain with its w
 (``PipelineParams(window=False)``) and the refinement."""
 
 
-def _frame_errors(cube: np.ndarray, cfg: RadarConfig, truth: np.ndarray, sin_az: np.ndarray,
-                  noise: float, windows: tuple[bool, bool], floor: float | None
+def _frame_errors(cube: np.ndarray, cfg: RadarConfig, truth: np.ndarray, noise: float,
+                  windows: tuple[bool, bool], floor: float | None
                   ) -> tuple[np.ndarray, np.ndarray, float]:
     """(errors float (P, 2) of (range, Doppler) bins, sin(az) float (P,), seconds in
-    ``host.refine``) of the targets of
-    ``campaign.frames`` in ``cube`` (n_virtual, n_range, n_doppler): :func:`estimate` on the
-    5 x 5 cells around each target's cell, then (``floor`` not None) ``host.refine`` from
-    there; ``truth`` float (P, 2) the targets' (range, Doppler) bins."""
+    ``host.refine``) of the targets of ``campaign.frames`` in ``cube`` (n_virtual, n_range,
+    n_doppler; noise power ``noise`` per channel and cell): :func:`estimate` on the 5 x 5
+    cells around each target's cell, then (``floor`` not None) ``host.refine`` from there;
+    ``truth`` float (P, 2) the targets' (range, Doppler) bins."""
     cells = frames.target_cells(cfg)
     k = np.arange(-2, 3)
     rows = (cells[:, 0, None] + k) % cube.shape[1]              # both axes circular
@@ -272,8 +272,7 @@ def estimation_frames(params: dict[str, Any], trials: range, seed: int, group: i
                 floor = FIXED_POINT_FLOOR if chain.endswith("refined") else None
             # noise per channel and cell of the cube (rect windows: 1 / 0.375^2 more)
             noise = cell_noise / (1.0 if windows[0] else maps.HANN_NOISE_GAIN ** 2)
-            err, sin_est, seconds = _frame_errors(cube, cfg, truth, sin_az, noise, windows,
-                                                  floor)
+            err, sin_est, seconds = _frame_errors(cube, cfg, truth, noise, windows, floor)
             if floor is not None:
                 out[f"{chain}:refine_s"] = out.get(f"{chain}:refine_s", 0.0) + seconds
             az = np.degrees(np.arcsin(np.clip(sin_est, -1.0, 1.0)))
