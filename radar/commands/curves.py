@@ -58,7 +58,8 @@ def cmd_curves(args: argparse.Namespace) -> int:
     doc["quick"] = bool(args.quick)
     out.write_text(json.dumps(doc, indent=1) + "\n")
     print(f"wrote {out} ({len(doc['detection'])} detection curves, "
-          f"{len(doc['estimation'])} estimation curves; campaign results in {results})")
+          f"{len(doc['estimation'])} estimation curves, {len(doc['estimation_frames'])} "
+          f"whole-frame ones; campaign results in {results})")
     if plots is not None:
         from campaign.plots import detection_figures, estimation_figures
         files = detection_figures(doc, plots) + estimation_figures(doc, plots)
