@@ -17,14 +17,15 @@ from typing import Any
 
 import numpy as np
 
-from campaign import maps
+from campaign import frames, maps
 from campaign import trials as tr
 from campaign.runner import CampaignError, Task, merge, run, split
 from host.cfar import CfarParams, effective_cells
+from host.refine import FIXED_POINT_FLOOR, FLOAT_FLOOR, weights
 from model import cfar_2d, cfar_stats
 from model import detection_theory as dt
 from model.config import PRESETS, RadarConfig
-from model.reference import fft_axes
+from model.reference import FftAxis, fft_axes
 
 MAP_SHAPE = (64, 128)
 """(range, Doppler) cells of each synthetic detection map."""
@@ -57,6 +58,7 @@ class Plan:
     res_trials: int = 1000
     res_cell_snr_db: float = 20.0
     azimuth_deg: float = 10.0
+    frame_trials: int = 512
 
     @property
     def pfa_cond_cells(self) -> int:
@@ -68,7 +70,8 @@ class Plan:
     def quick() -> Plan:
         return Plan(cell_snr_sw0=(-8.0, 2.0, 2.0), cell_snr_sw1=(-6.0, 16.0, 2.0),
                     pd_trials=420, pfa_cells=1_200_000, snr=(-64.0, -20.0, 4.0),
-                    est_trials=300, separations=(0.3, 1.5, 0.2), res_trials=300)
+                    est_trials=300, separations=(0.3, 1.5, 0.2), res_trials=300,
+                    frame_trials=64)
 
     def check(self) -> None:
         """CampaignError for a plan that cannot run (module limits, Pfa in (0, 1))."""
@@ -79,6 +82,8 @@ class Plan:
                         ("--trials", self.res_trials), ("--pfa-cells", self.pfa_cells)):
             if n < 1:
                 raise CampaignError(f"{name}: must be at least 1, got {n}")
+        if self.frame_trials < 0:
+            raise CampaignError(f"--frame-trials: must be 0 or more, got {self.frame_trials}")
         for name, g, (lo, hi) in (("--cell-snr", self.cell_snr_sw0, CELL_SNR_LIMITS),
                                   ("--cell-snr", self.cell_snr_sw1, CELL_SNR_LIMITS),
                                   ("--snr", self.snr, SNR_LIMITS)):
@@ -103,7 +108,7 @@ def cell_gain_db(cfg: RadarConfig) -> float:
 
 def tasks(plan: Plan) -> dict[str, list[Task]]:
     """The campaign's tasks by curve (``"pfa"``, ``"sw0:<cell snr>"``, ``"sw1:..."``,
-    ``"est:<snr>"``, ``"res:<sep>"``)."""
+    ``"est:<snr>"``, ``"frames:<snr>"`` (one whole frame per task), ``"res:<sep>"``)."""
     cells_per_map = MAP_SHAPE[0] * MAP_SHAPE[1]
     per_map = len(maps.target_grid(MAP_SHAPE, _reach()))
     pfas = list(plan.pfas)
@@ -123,6 +128,11 @@ def tasks(plan: Plan) -> dict[str, list[Task]]:
     for s in grid(plan.snr, "--snr", *SNR_LIMITS):
         out[f"est:{s}"] = split("estimation", {"snr_db": s, "azimuth_deg": plan.azimuth_deg,
                                                "chains": list(CHAINS)}, plan.est_trials, 250)
+    if plan.frame_trials:
+        for s in grid(plan.snr, "--snr", *SNR_LIMITS):
+            out[f"frames:{s}"] = split("estimation_frames", {
+                "snr_db": s, "chains": list(tr.FRAME_CHAINS)},
+                -(-plan.frame_trials // frames.TARGETS), 1)
     for s in grid(plan.separations, "--separations", 0.05, 10.0):
         out[f"res:{s}"] = split("resolution", {"sep_bw": s,
                                                "cell_snr_db": plan.res_cell_snr_db},
@@ -220,41 +230,98 @@ def detection_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> list
     return rows
 
 
+def _specs(cfg: RadarConfig, sec_az: float) -> dict[str, tuple[str, str, int, int, float]]:
+    """quantity -> (unit, result key, aperture, looks, cycles per sample -> unit); sec_az:
+    1 / cos(az) of the targets (RMS over them)."""
+    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
+    return {"range": ("m", "se_range_m", nr, nd * nv, nr * cfg.range_bin_m),
+            "radial_velocity": ("m/s", "se_velocity_mps", nd, nr * nv,
+                                nd * cfg.velocity_bin_mps),
+            "azimuth": ("deg", "se_azimuth_deg", nv, nr * nd, 2.0 * sec_az * 180.0 / math.pi)}
+
+
+def _row(quantity: str, chain: str, snr: list[float], res: list[dict[str, Any]],
+         cfg: RadarConfig, sec_az: float, against_crb: bool = False) -> dict[str, Any]:
+    """One ``estimation`` entry: RMSE of ``chain`` against the whole data's CRB and against
+    the bound of what the estimator is given (the array's for azimuth, the three cells' for
+    range and velocity); the threshold against the latter, or (``against_crb``) the CRB."""
+    unit, key, n, looks, to_unit = _specs(cfg, sec_az)[quantity]
+    gain = cell_gain_db(cfg)
+    rmse = [math.sqrt(r[f"{chain}:{key}"] / r["trials"]) for r in res]
+    crb = [dt.tone_frequency_crb(10 ** (s / 10), n, looks) * to_unit for s in snr]
+    row = {"quantity": quantity, "chain": chain, "unit": unit, "snr_db": snr,
+           "cell_snr_db": [round(s + gain, 3) for s in snr],
+           "n_elements" if quantity == "azimuth" else "n_samples": n, "looks": looks,
+           "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],
+           "excess_db": _excess(rmse, crb), "trials": res[0]["trials"]}
+    if quantity == "azimuth":      # the array's bound for the one-cell snapshot
+        bound = [dt.tone_frequency_crb(10 ** ((s + gain) / 10), n) * to_unit for s in snr]
+        row["crb_array"] = [float(f"{v:.5g}") for v in bound]
+        row["excess_array_db"] = _excess(rmse, bound)
+    else:                          # the bound of the three cells the interpolator reads
+        axes = fft_axes(cfg)
+        ax = axes if quantity == "range" else axes[::-1]
+        bound = [dt.three_cell_crb(10 ** (s / 10), (ax[0].window(), ax[0].n_fft),
+                                   (ax[1].window(), ax[1].n_fft), cfg.n_virtual) * to_unit
+                 for s in snr]
+        row["crb_cells"] = [float(f"{v:.5g}") for v in bound]
+        row["excess_cells_db"] = _excess(rmse, bound)
+    row.update(_threshold(snr, _excess(rmse, crb if against_crb else bound)))
+    return row
+
+
 def estimation_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> list[dict]:
     """The ``estimation`` entries: RMSE and CRB per quantity (docs/curves.md)."""
     snr = grid(plan.snr, "--snr", *SNR_LIMITS)
-    gain = cell_gain_db(cfg)
-    nr, nd, nv = cfg.n_range, cfg.n_doppler, cfg.n_virtual
-    cos_az = math.cos(math.radians(plan.azimuth_deg))
-    axes = fft_axes(cfg)
-    specs = (  # quantity, unit, result key, aperture, looks, cycles -> unit
-        ("range", "m", "se_range_m", nr, nd * nv, nr * cfg.range_bin_m),
-        ("radial_velocity", "m/s", "se_velocity_mps", nd, nr * nv, nd * cfg.velocity_bin_mps),
-        ("azimuth", "deg", "se_azimuth_deg", nv, nr * nd, 2.0 / cos_az * 180.0 / math.pi))
+    res = [merged[f"est:{s}"] for s in snr]
+    sec_az = 1.0 / math.cos(math.radians(plan.azimuth_deg))
+    return [_row(q, chain, snr, res, cfg, sec_az)
+            for q, chain in itertools.product(("range", "radial_velocity", "azimuth"), CHAINS)]
+
+
+def frame_rows(plan: Plan, merged: dict[str, Any], cfg: RadarConfig) -> list[dict]:
+    """The ``estimation_frames`` entries (docs/curves.md, "Whole frames"): as
+    ``estimation``'s, per chain of ``campaign.trials.FRAME_CHAINS``; range and velocity for
+    every chain (a refined chain's threshold against ``crb``, with ``taper_loss_db`` the
+    weighting's derived loss and ``refine_ms_per_cell`` the time in ``host.refine``),
+    azimuth for the bit-accurate chain (the refinement leaves the angle as it is)."""
+    if not plan.frame_trials:
+        return []
+    snr = grid(plan.snr, "--snr", *SNR_LIMITS)
+    res = [merged[f"frames:{s}"] for s in snr]
+    # sin(az) uniform in +-S: the bound's variance averaged over the targets, mean 1/cos^2
+    s_max = frames.SIN_AZ_MAX
+    sec_az = math.sqrt(math.atanh(s_max) / s_max)
     rows = []
-    for (quantity, unit, key, n, looks, to_unit), chain in itertools.product(specs, CHAINS):
-        res = [merged[f"est:{s}"] for s in snr]
-        rmse = [math.sqrt(r[f"{chain}:{key}"] / r["trials"]) for r in res]
-        crb = [dt.tone_frequency_crb(10 ** (s / 10), n, looks) * to_unit for s in snr]
-        row = {"quantity": quantity, "chain": chain, "unit": unit, "snr_db": snr,
-               "cell_snr_db": [round(s + gain, 3) for s in snr],
-               "n_elements" if quantity == "azimuth" else "n_samples": n, "looks": looks,
-               "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],
-               "excess_db": _excess(rmse, crb), "trials": res[0]["trials"]}
-        if quantity == "azimuth":      # the array's bound for the one-cell snapshot
-            bound = [dt.tone_frequency_crb(10 ** ((s + gain) / 10), n) * to_unit for s in snr]
-            row["crb_array"] = [float(f"{v:.5g}") for v in bound]
-            row["excess_array_db"] = _excess(rmse, bound)
-        else:                          # the bound of the three cells the interpolator reads
-            ax = axes if quantity == "range" else axes[::-1]
-            bound = [dt.three_cell_crb(10 ** (s / 10), (ax[0].window(), ax[0].n_fft),
-                                       (ax[1].window(), ax[1].n_fft), nv) * to_unit
-                     for s in snr]
-            row["crb_cells"] = [float(f"{v:.5g}") for v in bound]
-            row["excess_cells_db"] = _excess(rmse, bound)
-        row.update(_threshold(snr, _excess(rmse, bound)))
-        rows.append(row)
+    for chain in tr.FRAME_CHAINS:
+        refined = chain.endswith("refined")
+        hann = chain != "bit_accurate_rect_refined"
+        floor = FLOAT_FLOOR if chain.startswith("float") else FIXED_POINT_FLOOR
+        for q in ("range", "radial_velocity", "azimuth"):
+            if q == "azimuth" and refined:
+                continue
+            row = _row(q, chain, snr, res, cfg, sec_az, against_crb=refined)
+            if refined:
+                axes = fft_axes(cfg, hann, hann)
+                ax = axes if q == "range" else axes[::-1]
+                row["refine_floor"] = floor
+                row["taper_loss_db"] = round(taper_loss_db(ax[0], ax[1], floor), 3)
+                row["refine_ms_per_cell"] = round(1e3 * sum(
+                    r[f"{chain}:refine_s"] for r in res) / sum(r["trials"] for r in res), 2)
+            rows.append(row)
     return rows
+
+
+def taper_loss_db(axis: FftAxis, other: FftAxis, floor: float) -> float:
+    """MSE over the CRB, dB, of the periodogram peak of samples weighted by
+    ``host.refine.weights`` (v = w^2 / (w^2 + floor^2) per axis) along ``axis``, to first
+    order: sum(v^2 t^2) sum(t^2) / (sum(v t^2))^2 along the axis (t centred) times
+    N sum(v^2) / (sum v)^2 across it (the other axis' SNR loss); docs/curves.md."""
+    v, t = weights(axis, floor)[1], np.arange(axis.n_samples) - axis.n_samples / 2
+    u = weights(other, floor)[1]
+    est = np.sum(v ** 2 * t ** 2) * np.sum(t ** 2) / np.sum(v * t ** 2) ** 2
+    snr = len(u) * np.sum(u ** 2) / np.sum(u) ** 2
+    return float(10 * np.log10(est * snr))
 
 
 def _excess(rmse: list[float], bound: list[float]) -> list[float]:
@@ -287,6 +354,7 @@ def document(plan: Plan, seed: int, merged: dict[str, Any]) -> dict[str, Any]:
         "fpga_noise_lsb": round(tr.fpga_noise_lsb(cfg), 4),
         "detection": detection_rows(plan, merged, cfg),
         "estimation": estimation_rows(plan, merged, cfg),
+        "estimation_frames": frame_rows(plan, merged, cfg),
         "resolution": {"cell_snr_db": plan.res_cell_snr_db, "separation_bw": seps,
                        "beamwidth_deg": round(math.degrees(cfg.angle_resolution_rad), 3),
                        "probability": [r["resolved"] / r["trials"] for r in res],

@@ -46,13 +46,15 @@ def detection_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
 
 
 def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
-    """RMSE against the CRB per quantity, and the resolution probability."""
+    """RMSE against the CRB per quantity (the cells' chains, then the whole frames'), and
+    the resolution probability."""
     out = []
+    every = doc["estimation"] + doc.get("estimation_frames", [])
     for quantity in dict.fromkeys(r["quantity"] for r in doc["estimation"]):
-        rows = [r for r in doc["estimation"] if r["quantity"] == quantity]
+        rows = [r for r in every if r["quantity"] == quantity]
         r = rows[0]
         fig, ax = plt.subplots(figsize=(4.6, 3.4))
-        for row, style in zip(rows, ("o-", "s--"), strict=False):
+        for row, style in zip(rows, ("o-", "s--", "^-", "v-", "d--", "x-"), strict=False):
             ax.semilogy(row["snr_db"], row["rmse"], style, ms=3,
                         label=f"RMSE, {row['chain']} chain")
         ax.semilogy(r["snr_db"], r["crb"], "k--", lw=1, label="Cramer-Rao bound")
@@ -68,7 +70,7 @@ def estimation_figures(doc: dict[str, Any], folder: Path) -> list[Path]:
         ax.set_xlabel("per-channel, per-sample SNR, dB")
         ax.set_ylabel(f"{quantity.replace('_', ' ')}, {r['unit']}")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6, loc="upper right")
         fig.tight_layout()
         p = folder / f"crb_{quantity}.png"
         fig.savefig(p, dpi=110)

@@ -203,16 +203,20 @@ def _run_on_ray(todo: list[tuple[Task, str]], seed: int, out: Path, done: dict[s
                disable=not sys.stderr.isatty() if progress is None else not progress)
     pending: dict[Any, tuple[Task, str]] = {}
     queue = list(todo)
+
+    def submit() -> None:
+        while queue and len(pending) < workers:
+            t, k = queue.pop(0)
+            pending[remote.remote(t.kind, t.params, t.first, t.count, seed, t.group())] = (t, k)
+
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
         with open(out, "a") as f:
-            while queue or pending:
-                while queue and len(pending) < workers:
-                    t, k = queue.pop(0)
-                    ref = remote.remote(t.kind, t.params, t.first, t.count, seed, t.group())
-                    pending[ref] = (t, k)
+            submit()
+            while pending:
                 ready, _ = ray.wait(list(pending), num_returns=1)
                 t, k = pending.pop(ready[0])
+                submit()        # the freed worker gets its next task before the bookkeeping
                 result = ray.get(ready[0])
                 f.write(json.dumps({"key": k, "task": t.as_json(), "result": result}) + "\n")
                 f.flush()

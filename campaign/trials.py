@@ -9,12 +9,16 @@ Trial ``i`` draws from ``numpy.random.default_rng([seed, group, i])``.
 - ``estimation``: one target per trial in the float chain's cells around it (and those cells
   rounded to the FPGA's integer LSB); squared errors of range, radial velocity and azimuth
   from the host's estimators.
+- ``estimation_frames``: whole frames of 64 targets (``campaign.frames``) through the float
+  chain with the refinement (``host.refine``) and the bit-accurate chain
+  (``model.radar_pipeline``) with and without it: squared errors as for ``estimation``.
 - ``resolution``: two equal targets in one cell, ``sep_bw`` beamwidths apart; how often the
   host's angle estimator resolves them.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
@@ -22,15 +26,16 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from campaign import maps
+from campaign import frames, maps
 from host.angle import AngleParams, estimate_angles
 from host.cells import neighbour_offsets
 from host.cfar import CfarParams, cfar_threshold
+from host.refine import FIXED_POINT_FLOOR, FLOAT_FLOOR, refine_offsets
 from model import cfar_2d
 from model.config import PRESETS, RadarConfig
 from model.detect_chain import DetectConfig
-from model.radar_pipeline import PipelineParams, chain_gain
-from model.reference import fft_axes
+from model.radar_pipeline import PipelineParams, chain_gain, scaled_cube
+from model.reference import FftAxis, fft_axes, radar_cube
 
 DETECTORS = (("host", "ca"), ("host", "os"), ("fpga", "ca"), ("fpga", "go"), ("fpga", "so"))
 """(path, kind) of every detector the detection curves run: the host CFAR
@@ -137,13 +142,14 @@ def detection(params: dict[str, Any], trials: range, seed: int, group: int
     return out
 
 
-def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig,
+             axes: tuple[FftAxis, FftAxis] | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(range bins, Doppler bins, sin(az)) estimated from cells complex (n, L, 2 half + 1,
     2 half + 1) around each target (noise power ``noise`` per channel and cell): the cell of
     the integrated map's maximum among the 3 x 3 around the centre, the host's peak
-    interpolation (``host.cells``) and angle estimator (``host.angle``, strongest component);
-    bins relative to the centre cell."""
+    interpolation (``host.cells``, for ``axes``: default the Hann axes of ``cfg``) and angle
+    estimator (``host.angle``, strongest component); bins relative to the centre cell."""
     n = len(cube)
     nci = np.sum(cube.real ** 2 + cube.imag ** 2, axis=1)
     centre = nci[:, half - 1:half + 2, half - 1:half + 2].reshape(n, 9).argmax(axis=1)
@@ -151,7 +157,7 @@ def _estimate(cube: np.ndarray, noise: float, half: int, cfg: RadarConfig
     idx = np.arange(n)
     nb = np.stack([nci[idx, pr - 1, pd], nci[idx, pr + 1, pd], nci[idx, pr, pd - 1],
                    nci[idx, pr, pd + 1]], axis=1)
-    off = neighbour_offsets(nci[idx, pr, pd], nb, np.ones(n, bool), fft_axes(cfg))
+    off = neighbour_offsets(nci[idx, pr, pd], nb, np.ones(n, bool), axes or fft_axes(cfg))
     got = estimate_angles(cube[idx, :, pr, pd], np.full(n, noise), AngleParams())
     first = np.searchsorted(got.cell, idx)                 # strongest component of each row
     return pr - half + off[:, 0], pd - half + off[:, 1], got.sin_az[first]
@@ -161,7 +167,7 @@ def estimation(params: dict[str, Any], trials: range, seed: int, group: int
                ) -> dict[str, Any]:
     """params: ``snr_db`` per-channel per-sample SNR, ``azimuth_deg``, ``chains`` (a list
     of ``float``, ``quantised``). One target per trial at a random sub-bin position (and
-    azimuth within half a beamwidth of ``azimuth_deg``), estimated by :func:`_estimate` from
+    azimuth within half a beamwidth of ``azimuth_deg``), estimated by :func:`estimate` from
     the float chain's cells and, for ``quantised``, from the same cells in the FPGA's LSB
     (:func:`fpga_noise_lsb`) with I and Q rounded to integers. Returns ``trials`` and per
     chain the sums of squared errors ``<chain>:se_range_m``, ``<chain>:se_velocity_mps``,
@@ -182,11 +188,11 @@ def estimation(params: dict[str, Any], trials: range, seed: int, group: int
     out: dict[str, Any] = {"trials": n}
     for chain in params["chains"]:
         if chain == "float":
-            est = _estimate(cube, noise, half, cfg)
+            est = estimate(cube, noise, half, cfg)
         else:
             lsb = fpga_noise_lsb(cfg)
             q = cube * (lsb / np.sqrt(noise))
-            est = _estimate(np.rint(q.real) + 1j * np.rint(q.imag), lsb ** 2 + 1 / 6, half,
+            est = estimate(np.rint(q.real) + 1j * np.rint(q.imag), lsb ** 2 + 1 / 6, half,
                             cfg)
         az = np.degrees(np.arcsin(np.clip(est[2], -1.0, 1.0)))
         out[f"{chain}:se_range_m"] = float(np.sum(((est[0] - offsets[:, 0])
@@ -195,6 +201,86 @@ def estimation(params: dict[str, Any], trials: range, seed: int, group: int
                                                         * cfg.velocity_bin_mps) ** 2))
         out[f"{chain}:se_azimuth_deg"] = float(np.sum((az - np.degrees(np.arcsin(sin_az)))
                                                       ** 2))
+    return out
+
+
+FRAME_CHAINS = ("float_refined", "bit_accurate", "bit_accurate_refined",
+                "bit_accurate_rect_refined")
+"""Chains of :func:`estimation_frames`: the float chain with the refinement
+(``host.refine``); the bit-accurate chain (``model.radar_pipeline``, Hann windows) with the
+host's interpolation, and with the refinement; the bit-accurate chain with its windows off
+(``PipelineParams(window=False)``) and the refinement."""
+
+
+def _frame_errors(cube: np.ndarray, cfg: RadarConfig, truth: np.ndarray, noise: float,
+                  windows: tuple[bool, bool], floor: float | None
+                  ) -> tuple[np.ndarray, np.ndarray, float]:
+    """(errors float (P, 2) of (range, Doppler) bins, sin(az) float (P,), seconds in
+    ``host.refine``) of the targets of ``campaign.frames`` in ``cube`` (n_virtual, n_range,
+    n_doppler; noise power ``noise`` per channel and cell): :func:`estimate` on the 5 x 5
+    cells around each target's cell, then (``floor`` not None) ``host.refine`` from there;
+    ``truth`` float (P, 2) the targets' (range, Doppler) bins."""
+    cells = frames.target_cells(cfg)
+    k = np.arange(-2, 3)
+    rows = (cells[:, 0, None] + k) % cube.shape[1]              # both axes circular
+    cols = (cells[:, 1, None] + k) % cube.shape[2]
+    patch = cube[:, rows[:, :, None], cols[:, None, :]]
+    axes = fft_axes(cfg, *windows)
+    est_r, est_d, sin_est = estimate(np.moveaxis(patch, 0, 1), noise, 2, cfg, axes)
+    got = np.stack([est_r, est_d], axis=1) + cells
+    start = time.perf_counter()
+    if floor is not None:
+        cell = np.rint(got).astype(int)
+        off = refine_offsets(cube, cell[:, 0] % cube.shape[1], cell[:, 1] % cube.shape[2],
+                             got - cell, cfg, windows, floor)
+        got = cell + off
+    return got - truth, sin_est, time.perf_counter() - start
+
+
+def estimation_frames(params: dict[str, Any], trials: range, seed: int, group: int
+                      ) -> dict[str, Any]:
+    """params: ``snr_db`` per-channel per-sample SNR, ``chains`` (of :data:`FRAME_CHAINS`).
+    One whole frame per trial (``campaign.frames``: 64 targets at random sub-bin positions,
+    sin(az) uniform in +-``SIN_AZ_MAX``) through the float chain (``model.reference``) and
+    the bit-accurate one (``model.radar_pipeline``, the ADC at its noise level, I and Q
+    rounded); estimates by :func:`_frame_errors`. Returns ``trials`` (targets) and per chain
+    ``<chain>:se_range_m``, ``<chain>:se_velocity_mps``, ``<chain>:se_azimuth_deg``, and
+    ``<chain>:refine_s`` (seconds in ``host.refine``) for the refined chains."""
+    cfg = PRESETS[PRESET]
+    snr = 10 ** (params["snr_db"] / 10)
+    noise_adc = cfg.noise_power_lsb2
+    cell_noise = noise_adc * maps.patch_noise_per_channel(cfg.n_range, cfg.n_doppler)
+    out: dict[str, Any] = {"trials": 0}
+    for t in trials:
+        rng = rng_of(seed, group, t)
+        off = rng.random((frames.TARGETS, 2)) - 0.5
+        sin_az = rng.uniform(-frames.SIN_AZ_MAX, frames.SIN_AZ_MAX, frames.TARGETS)
+        adc = frames.tone_frame(rng, cfg, snr, noise_adc, off, sin_az)
+        truth = frames.target_cells(cfg) + off
+        codes = np.rint(adc.real) + 1j * np.rint(adc.imag)
+        cubes = {}
+        for chain in params["chains"]:
+            if chain == "float_refined":
+                cube, windows, floor = radar_cube(adc, cfg), (True, True), FLOAT_FLOOR
+            elif chain == "bit_accurate_rect_refined":
+                cube = scaled_cube(codes, cfg, PipelineParams(window=False))
+                windows, floor = (False, False), FIXED_POINT_FLOOR
+            else:
+                if "hann" not in cubes:
+                    cubes["hann"] = scaled_cube(codes, cfg)
+                cube, windows = cubes["hann"], (True, True)
+                floor = FIXED_POINT_FLOOR if chain.endswith("refined") else None
+            # noise per channel and cell of the cube (rect windows: 1 / 0.375^2 more)
+            noise = cell_noise / (1.0 if windows[0] else maps.HANN_NOISE_GAIN ** 2)
+            err, sin_est, seconds = _frame_errors(cube, cfg, truth, noise, windows, floor)
+            if floor is not None:
+                out[f"{chain}:refine_s"] = out.get(f"{chain}:refine_s", 0.0) + seconds
+            az = np.degrees(np.arcsin(np.clip(sin_est, -1.0, 1.0)))
+            for name, e in ((":se_range_m", err[:, 0] * cfg.range_bin_m),
+                            (":se_velocity_mps", err[:, 1] * cfg.velocity_bin_mps),
+                            (":se_azimuth_deg", az - np.degrees(np.arcsin(sin_az)))):
+                out[chain + name] = out.get(chain + name, 0.0) + float(np.sum(e ** 2))
+        out["trials"] += frames.TARGETS
     return out
 
 
@@ -228,5 +314,6 @@ def resolution(params: dict[str, Any], trials: range, seed: int, group: int
 
 
 TRIALS: dict[str, TrialFn] = {"detection": detection, "estimation": estimation,
+                              "estimation_frames": estimation_frames,
                               "resolution": resolution}
 """Trial functions by the name a :class:`campaign.runner.Task` gives."""

@@ -22,7 +22,8 @@ class Cells:
     ``power``: float (n,) non-coherent power sum_v |x_v|^2 of the cell; ``noise``: float
     (n,) the detector's mean noise power per cell of the non-coherent map; ``offsets``:
     float (n, 2) fractional (range, Doppler) offsets of the peak from the cell centre, bins
-    in (-0.5, 0.5) (:func:`neighbour_offsets`); ``snapshot``: complex (n, n_virtual) the
+    in (-0.5, 0.5) (:func:`neighbour_offsets`; up to 0.75 bin further after
+    ``host.refine``); ``snapshot``: complex (n, n_virtual) the
     cell's Doppler-FFT values per virtual channel v = tx * num_rx + rx; ``range_bias_m``:
     subtracted from the points' range (a calibration's, ``host.calibration``)."""
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from host.angle import AngleParams
 from host.calibration import check_calibration
 from host.cfar import CfarParams, check_window
+from host.refine import FLOAT_FLOOR
 from model.config import RadarConfig
 from model.profile import Calibration
 from model.reference import fft_axes
@@ -58,6 +59,9 @@ class DetectionParams:
     sidelobe_masked``; beyond the Hann main lobe); None turns the masking off.
     ``calibration``: channel gains and range bias applied to the detected cells before the
     angle estimation (``host.calibration.apply_calibration``); None: none.
+    ``refine``: on the cube path, the detected cells' range and Doppler re-estimated from
+    the whole frame (``host.refine``, weighting floor ``refine_floor``); needs a
+    complex-ADC radar.
     """
 
     detector: str = "ca"
@@ -73,6 +77,8 @@ class DetectionParams:
     max_speed_mps: float = MAX_RADIAL_SPEED_MPS
     sidelobe_margin_db: float | None = 10.0
     calibration: Calibration | None = None
+    refine: bool = False
+    refine_floor: float = FLOAT_FLOOR
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
@@ -86,11 +92,17 @@ class DetectionParams:
                 0.0 < self.max_speed_mps <= 3.0e4:
             raise ValueError(f"max_speed_mps: must be in (0, 30000] m/s, got "
                              f"{self.max_speed_mps!r}")
+        if not isinstance(self.refine_floor, int | float) or not \
+                0.0 < self.refine_floor <= 10.0:
+            raise ValueError(f"refine_floor: must be in (0, 10], got {self.refine_floor!r}")
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError when the settings do not fit ``cfg`` (CFAR window larger than the
         range-Doppler map, a calibration of another channel count)."""
         if self.calibration is not None:
             check_calibration(self.calibration, cfg)
+        if self.refine and cfg.adc != "complex":
+            raise ValueError(f"refine: needs a complex-ADC radar ({cfg.name!r} has a real ADC: "
+                             "its cube keeps half the range spectrum)")
         if self.detector != "paper":
             check_window(self.cfar, (cfg.n_range_bins, cfg.n_doppler))

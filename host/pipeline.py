@@ -8,7 +8,9 @@ Steps (docs/design.md section 1, host side):
    (the top range bins are negative beat frequencies), and cells within
    ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
 2. Range and Doppler refined by interpolation around each peak over the three integrated
-   powers along each axis, matched to the axis' window and padding (``host.cells``).
+   powers along each axis, matched to the axis' window and padding (``host.cells``); with
+   ``DetectionParams.refine``, then by maximising the whole frame's periodogram
+   (``host.refine``).
 3. TDM Doppler phase compensation per TX slot, with velocity unfolding. The measured
    Doppler fixes the velocity only modulo the alias period 2 vmax: the hypotheses are
    v + 2 m vmax for every integer m with |v + 2 m vmax| <= ``max_speed_mps`` (the fastest
@@ -49,6 +51,7 @@ from host.cfar import (
 from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
+from host.refine import refine_offsets
 from model.config import RadarConfig
 from model.reference import fft_axes, radar_cube, range_doppler_power
 
@@ -106,6 +109,10 @@ def process_cube_nci(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     offsets = peak_offsets(nci, cells, fft_axes(cfg, params.range_window,
                                                 params.doppler_window))
     r, d = cells[:, 0], cells[:, 1]
+    if params.refine:
+        offsets = refine_offsets(cube, r, d, offsets, cfg,
+                                 (params.range_window, params.doppler_window),
+                                 params.refine_floor)
     found = Cells(r, d, nci[r, d], noise, offsets, cube[:, r, d].T)
     return points_from_cells(found, cfg, params, frame), nci
 

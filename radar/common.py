@@ -22,6 +22,7 @@ from host.params import (
     default_guard,
     default_max_speed_mps,
 )
+from host.refine import FIXED_POINT_FLOOR, FLOAT_FLOOR
 from model.config import RadarConfig, get_preset
 from model.profile import Profile, load_profile, preset_profile
 from model.scene import Scene, check_ego_speed, default_ego_speed_mps, load_scene
@@ -133,7 +134,8 @@ def detection_params(args: argparse.Namespace, scene_bf: bool = True,
         params = DetectionParams(detector=args.detector, cfar=cfar,
                                  paper_threshold_db=args.threshold_db, tx_beamforming=scene_bf,
                                  max_speed_mps=speed,
-                                 angle=AngleParams(array_error_db=args.array_error_db))
+                                 angle=AngleParams(array_error_db=args.array_error_db),
+                                 **refine_settings(args))
         if cfg is not None:
             params.check(cfg)
         return params
@@ -272,6 +274,35 @@ def add_detection_options(p: argparse.ArgumentParser) -> None:
                         "what it and the noise explain (default "
                         f"{AngleParams.array_error_db:g}, an uncalibrated array; about -25 "
                         "after `radar calibrate`; docs/profiles.md \"Angles\")")
+
+
+def add_refine_options(p: argparse.ArgumentParser, fixed_point: str) -> None:
+    """``--refine`` and ``--refine-floor`` (:func:`refine_settings`); ``fixed_point``: the
+    sources whose cube is the fixed-point chain's (they get its floor by default)."""
+    p.add_argument("--refine", action="store_true",
+                   help="re-estimate each detected cell's range and Doppler from the whole "
+                        "frame (the channel-summed periodogram's peak, host.refine; 7 dB "
+                        "lower MSE on a float cube, about 30 ms per cell; complex ADC only; "
+                        "docs/curves.md)")
+    p.add_argument("--refine-floor", type=float, default=None, metavar="F",
+                   help="--refine: weighting floor against the rounding after the windows "
+                        f"(default {FLOAT_FLOOR:g} for a float cube, {FIXED_POINT_FLOOR:g} "
+                        f"for {fixed_point})")
+
+
+def refine_settings(args: argparse.Namespace) -> dict[str, object]:
+    """``refine`` / ``refine_floor`` of :class:`DetectionParams` from the options of
+    :func:`add_refine_options` (none for a command without them): the floor of the
+    fixed-point chain when ``args.backend`` is ``model`` or ``rtl``."""
+    if not getattr(args, "refine", False):
+        if getattr(args, "refine_floor", None) is not None:
+            raise CliError("--refine-floor: only with --refine")
+        return {}
+    floor = args.refine_floor
+    if floor is None:
+        floor = FIXED_POINT_FLOOR if getattr(args, "backend", "float") in ("model", "rtl") \
+            else FLOAT_FLOOR
+    return {"refine": True, "refine_floor": floor}
 
 
 def add_command(sub: argparse._SubParsersAction, name: str, summary: str,

@@ -96,6 +96,7 @@ def test_bad_campaign_inputs() -> None:
     ["--snr", "nan", "0", "1"],
     ["--snr", "-10", "-20", "1"],
     ["--workers", "0"],
+    ["--frame-trials", "-1"],
     ["--seed", "-1"],
     ["--ray-address", "127.0.0.1:1"],
     ["--ray-address", "nonsense"],
@@ -120,7 +121,7 @@ def test_radar_curves_tiny_run_and_resume(local_ray, tmp_path: Path) -> None:
     out = tmp_path / "curves.json"
     argv = ["curves", "--quick", "--json", str(out), "--trials", "70", "--pfa-cells", "8192",
             "--pfa", "1e-3", "--cell-snr", "-2", "2", "4", "--snr", "-40", "-30", "10",
-            "--workers", "2", "--plots", str(tmp_path / "img")]
+            "--workers", "2", "--plots", str(tmp_path / "img"), "--frame-trials", "0"]
     assert main(argv) == 0
     doc = json.loads(out.read_text())
     assert len(doc["detection"]) == 5 * 2           # 5 detectors x 2 Swerling cases

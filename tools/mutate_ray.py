@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterator
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -18,10 +19,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from campaign.runner import RaySession  # noqa: E402 - after the repository is on sys.path
 
 
-def _one(mutant: Any, timeout: float, quick: bool) -> tuple[str, float]:
-    """One mutant on a Ray worker (imports tools.mutate there)."""
-    from tools.mutate import run_mutant
-    return run_mutant(mutant, timeout, quick=quick)
+def _one(fields: dict[str, Any], timeout: float, quick: bool) -> tuple[str, float]:
+    """One mutant (its fields: the class lives in tools/mutate_gen.py, which a worker
+    imports through tools.mutate) on a Ray worker."""
+    from tools.mutate import Mutant, run_mutant
+    return run_mutant(Mutant(**fields), timeout, quick=quick)
 
 
 def run_on_ray(mutants: list[Any], timeout: float, quick: bool, workers: int,
@@ -37,7 +39,7 @@ def run_on_ray(mutants: list[Any], timeout: float, quick: bool, workers: int,
         while queue or pending:
             while queue and len(pending) < workers:
                 m = queue.pop(0)
-                pending[remote.remote(m, timeout, quick)] = m
+                pending[remote.remote(asdict(m), timeout, quick)] = m
             ready, _ = ray.wait(list(pending), num_returns=1)
             m = pending.pop(ready[0])
             verdict, secs = ray.get(ready[0])

@@ -28,6 +28,8 @@ def plan_of(args: argparse.Namespace) -> Plan:
         over["snr"] = tuple(args.snr)
     if args.pfa_cells is not None:
         over["pfa_cells"] = args.pfa_cells
+    if args.frame_trials is not None:
+        over["frame_trials"] = args.frame_trials
     plan = dataclasses.replace(plan, **over)
     try:
         plan.check()
@@ -56,7 +58,8 @@ def cmd_curves(args: argparse.Namespace) -> int:
     doc["quick"] = bool(args.quick)
     out.write_text(json.dumps(doc, indent=1) + "\n")
     print(f"wrote {out} ({len(doc['detection'])} detection curves, "
-          f"{len(doc['estimation'])} estimation curves; campaign results in {results})")
+          f"{len(doc['estimation'])} estimation curves, {len(doc['estimation_frames'])} "
+          f"whole-frame ones; campaign results in {results})")
     if plots is not None:
         from campaign.plots import detection_figures, estimation_figures
         files = detection_figures(doc, plots) + estimation_figures(doc, plots)
@@ -88,6 +91,10 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     s.add_argument("--trials", type=int, default=None,
                    help="trials per point of every curve (default 2000 Pd targets, 1000 "
                         "estimation and resolution trials; --quick: 420 / 300)")
+    s.add_argument("--frame-trials", type=int, default=None, metavar="N",
+                   help="targets per SNR point of the whole-frame curves (refinement, "
+                        "bit-accurate chain; 64 per frame, about 15 s a frame; default 512, "
+                        "--quick 64; 0: none)")
     s.add_argument("--pfa", type=float, nargs="+", default=None,
                    help="false-alarm probabilities of the detection curves (default 1e-4 1e-6)")
     s.add_argument("--pfa-cells", type=int, default=None,

@@ -34,6 +34,7 @@ from radar.common import (
     add_command,
     add_detection_options,
     add_radar_option,
+    add_refine_options,
     check_source,
     count,
     detection_params,
@@ -92,6 +93,9 @@ def detect_config_of(args: argparse.Namespace) -> DetectConfigOf:
 
 def cmd_detect(args: argparse.Namespace) -> int:
     refuse_detection_misfits(args, args.detect == "fpga")
+    if args.refine and args.detect == "fpga":
+        raise CliError("--refine: needs the radar cube, which --detect fpga does not send "
+                       "(use --detect host)")
     scene, profile = scene_profile(args)
     cfg = scene.config
     source = get_source(args.backend, PipelineParams(static_removal=args.remove_static))
@@ -232,6 +236,7 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "(--backend model or rtl)")
     add_fpga_options(d)
     add_detection_options(d)
+    add_refine_options(d, "--backend model and rtl")
     d.add_argument("--remove-static", action="store_true",
                    help="static-clutter removal: each range bin's mean over the frame's "
                         "chirps, per channel, subtracted before the Doppler FFT (float: "

@@ -43,6 +43,7 @@ from radar.common import (
     CliError,
     add_command,
     add_detection_options,
+    add_refine_options,
     check_source,
     detection_params,
     out_file,
@@ -343,4 +344,5 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
                         "range-azimuth map and x-y point cloud")
     add_mcap_options(p)
     add_detection_options(p)
+    add_refine_options(p, "a fixed-point cube")
     p.set_defaults(func=cmd_process)
