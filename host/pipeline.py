@@ -46,11 +46,12 @@ from host.cfar import (
     paper_threshold,
     sidelobe_masked,
 )
+from host.cube import frame_cube
 from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from model.config import RadarConfig
-from model.reference import fft_axes, radar_cube, range_doppler_power
+from model.reference import fft_axes, range_doppler_power
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
@@ -136,7 +137,8 @@ def real_only(cube: np.ndarray) -> bool:
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
                   frame: int = 0) -> PointCloud:
     """ADC frame, complex or real (n_chirps, num_rx, n_samples) -> point cloud, through the float
-    reference of the FPGA chain (``model.reference.radar_cube``) and :func:`process_cube`."""
+    reference of the FPGA chain (``model.reference.radar_cube``, computed by its fast
+    equivalent ``host.cube.frame_cube``) and :func:`process_cube`."""
     params = params or params_for(cfg)
-    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window)
+    cube = frame_cube(adc, cfg, params.range_window, params.doppler_window)
     return process_cube(cube, cfg, params, frame)

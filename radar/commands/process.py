@@ -132,10 +132,11 @@ def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionPara
                         frame_id: int, remove_static: bool) -> FrameCloud:
     """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
     codes, -> its cube (the float reference's, ``model.reference.radar_cube``, computed fast
-    by ``host.cube.frame_cube``, static clutter removed if asked) and point cloud
+    by ``host.cube.frame_cube`` in single precision: complex64, within ``host.cube.
+    SINGLE_RTOL`` of it; static clutter removed if asked) and point cloud
     (``radar.frame_cloud``), as ``radar process`` does."""
     cube = frame_cube(adc, cfg, params.range_window, params.doppler_window,
-                      remove_static_clutter=remove_static)
+                      remove_static_clutter=remove_static, single=True)
     return frame_cloud(cube, cfg, params, frame_id, "process")
 
 
