@@ -4,9 +4,11 @@ Steps (docs/design.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel
-   0; peak grouping keeps local maxima; only ``RadarConfig.detection_bins`` are reported
-   (the top range bins are negative beat frequencies), and cells within
-   ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
+   0; optionally only cells ``min_snr_db`` above the noise estimate; peak grouping keeps
+   local maxima (of the 3 x 3 neighbourhood, or along Doppler only:
+   ``DetectionParams.grouping``); only ``RadarConfig.detection_bins`` are reported (the top
+   range bins are negative beat frequencies), and cells within ``sidelobe_margin_db`` of a
+   stronger cell's window sidelobes are dropped.
 2. Range and Doppler refined by interpolation around each peak over the three integrated
    powers along each axis, matched to the axis' window and padding (``host.cells``).
 3. TDM Doppler phase compensation per TX slot, with velocity unfolding. The measured
@@ -53,6 +55,19 @@ from host.points import points_from_cells
 from model.config import RadarConfig
 from model.reference import fft_axes, range_doppler_power
 
+GROUPING_SIZE = {"peak": (3, 3), "doppler": (1, 3)}
+"""The (range, Doppler) neighbourhood a detected cell must be the maximum of
+(``host.cfar.local_peaks``), by ``DetectionParams.grouping``."""
+
+
+def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
+             params: DetectionParams) -> np.ndarray:
+    """``mask`` (bool (n_range, n_doppler)) less the cells whose ``power`` is not
+    ``params.min_snr_db`` above ``noise`` (both float of that shape); unchanged if None."""
+    if params.min_snr_db is None:
+        return mask
+    return mask & (power > noise * 10.0 ** (params.min_snr_db / 10.0))
+
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -68,15 +83,17 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     cf = params.cfar if params.detector != "os" else CfarParams(
         pfa=params.cfar.pfa, guard=params.cfar.guard, train=params.cfar.train, kind="os",
         os_rank=params.cfar.os_rank)
+    size = GROUPING_SIZE[params.grouping]
     if params.detector == "paper":
         mask, p0 = paper_threshold(cube, params.paper_threshold_db)
-        cells = local_peaks(p0, mask, mirrored=mirrored)
         noise_map = np.full(nci.shape, np.median(nci))
+        cells = local_peaks(p0, _min_snr(mask, nci, noise_map, params), size, mirrored)
     else:
         if params.detector == "ca":
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
         threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
-        cells = local_peaks(nci, nci > threshold, mirrored=mirrored)
+        cells = local_peaks(nci, _min_snr(nci > threshold, nci, noise_map, params), size,
+                            mirrored)
     ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]
     if params.sidelobe_margin_db is not None and len(cells):

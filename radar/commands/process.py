@@ -23,7 +23,7 @@ from host.adc_capture import NpyCapture, open_capture
 from host.calibration import check_calibration, load_calibration
 from host.cube import frame_cube
 from host.dca1000 import Dca1000Capture
-from host.params import DetectionParams
+from host.params import GROUPINGS, DetectionParams
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
 from model.array import has_vertical_extent
@@ -120,12 +120,17 @@ def capture_of(args: argparse.Namespace, profile: Profile, command: str
 
 def process_params(args: argparse.Namespace, profile: Profile) -> tuple[DetectionParams, str]:
     """``radar process``'s detection settings from its options (``radar.common.
-    detection_params``: the profile's maximum speed and guard by default) with the
-    calibration applied before angle estimation (:func:`calibration_of`), and that
-    calibration's name for the output; CliError if they do not fit."""
+    detection_params``: the profile's maximum speed and guard by default; ``--grouping``,
+    ``--min-snr-db``) with the calibration applied before angle estimation
+    (:func:`calibration_of`), and that calibration's name for the output; CliError if they
+    do not fit."""
     params = detection_params(args, cfg=profile.config)
     calibration, cal_name = calibration_of(args.calibration, profile)
-    return replace(params, calibration=calibration), cal_name
+    try:
+        return replace(params, calibration=calibration, grouping=args.grouping,
+                       min_snr_db=args.min_snr_db), cal_name
+    except ValueError as exc:
+        raise CliError(f"--{str(exc).replace('_', '-')}") from None
 
 
 def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
@@ -198,7 +203,8 @@ def cmd_process(args: argparse.Namespace) -> int:
                                              has_vertical_extent(cfg.virtual_positions_hw))
     doc.update({"backend": args.backend, "detector": args.detector, "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
-                "calibration": cal_name,
+                "calibration": cal_name, "grouping": params.grouping,
+                "min_snr_db": params.min_snr_db,
                 "max_speed_mps": params.max_speed_mps,
                 "min_detection_range_m": cfg.min_detection_range_m,
                 "frame_info": per_frame})
@@ -240,6 +246,13 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     p.add_argument("--plots", default=None,
                    help="folder for the last frame's range-Doppler map with its detections, "
                         "range-azimuth map and x-y point cloud")
+    p.add_argument("--grouping", choices=GROUPINGS, default="peak",
+                   help="peak: one detection per peak of the range-Doppler map (default); "
+                        "doppler: one per range bin of a return that spans several (a "
+                        "person, a car's body), the peaks along Doppler only")
+    p.add_argument("--min-snr-db", type=float, default=None, metavar="DB",
+                   help="detected cells must also be this far above their noise estimate "
+                        "(mean SNR per channel; default: the CFAR's Pfa alone decides)")
     add_mcap_options(p)
     add_detection_options(p)
     p.set_defaults(func=cmd_process)
