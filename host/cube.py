@@ -4,17 +4,20 @@
 The reference takes the steps of the FPGA chain one by one (cast, range window, range FFT
 scaled 1/n_range, corner turn, optional static-clutter removal, Doppler window, Doppler FFT
 scaled 1/n_doppler), each a pass over the cube. Both windows and both scales are linear
-per axis, so here they are one precomputed (n_samples, n_loops) weight, applied while the
-frame is cast to float64 and turned into cube order (a single pass); then one 2-D FFT (a real
-ADC: a real FFT along range, which gives bins 0..n_range/2 directly). Static-clutter removal
+per axis, so here they are one precomputed (n_loops, n_samples) weight, applied while the
+frame is cast (a single pass, in the frame's own order); then one 2-D FFT over the loops and
+the samples (a real ADC: a real FFT along range, which gives bins 0..n_range/2 directly), and
+the cube is that array with its axes reordered, a view (no corner-turn copy: numpy reads it
+as any array, in memory order where it can). Static-clutter removal
 (``model.reference.remove_static``: each slow-time vector less its Doppler-window weighted
 mean c = sum(w x) / sum(w)) is linear too, and done after the FFT: the Doppler FFT of
 w (x - c) is Y[k] - c W[k] / n_doppler with W the DFT of the window (zero-padded to
-n_doppler), and Y[0] = c W[0] / n_doppler, so it is Y[k] - Y[0] W[k] / W[0] (:func:`_static_
-response`): a few bins touched instead of two passes over the samples (three for an
-unwindowed zero-padded axis, whose W is dense). ``radar process`` builds its cubes here
-(``radar.commands.process.capture_frame_cloud``), as do ``host.pipeline.process_frame`` and
-the float frame source (``radar.sources``); the tests hold it to the reference.
+n_doppler), and Y[0] = c W[0] / n_doppler, so it is Y[k] - Y[0] W[k] / W[0]
+(:func:`_static_response`): a few bins touched instead of two passes over the samples (all
+of them for an unwindowed zero-padded axis, whose W is dense). ``radar process`` builds its
+cubes here in single precision (``radar.commands.process.capture_frame_cloud``), as do
+``host.pipeline.process_frame`` and the float frame source (``radar.sources``) in double;
+the tests hold it to the reference.
 """
 
 from __future__ import annotations
@@ -42,11 +45,11 @@ as 0 in :func:`_static_response`: such bins are left as they are."""
 def _weights(cfg: RadarConfig, range_window: bool, doppler_window: bool, single: bool
              ) -> np.ndarray:
     """Both windows (``model.reference.fft_axes``) and both FFT scales,
-    w_r[s] w_d[l] / (n_range n_doppler), float64 (n_samples, n_loops) (``single``:
-    float32)."""
+    w_d[l] w_r[s] / (n_range n_doppler), float64 (n_loops, 1, 1, n_samples) (``single``:
+    float32), to broadcast over a frame's (loops, tx, rx, samples)."""
     ax_r, ax_d = fft_axes(cfg, range_window, doppler_window)
-    w = np.outer(ax_r.window(), ax_d.window() / (cfg.n_range * cfg.n_doppler))
-    w = w.astype(np.float32 if single else np.float64)
+    w = np.outer(ax_d.window() / (cfg.n_range * cfg.n_doppler), ax_r.window())
+    w = w.astype(np.float32 if single else np.float64)[:, None, None, :]
     w.flags.writeable = False
     return w
 
@@ -82,18 +85,18 @@ def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
     x = np.asarray(adc).reshape(cfg.n_loops, cfg.num_tx, cfg.num_rx, cfg.n_samples)
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         x = x[:, tx_slots(cfg)]                 # slot of each TX index
-    x = x.transpose(1, 2, 3, 0)                 # (tx, rx, samples, loops)
     real = cfg.adc == "real"
     y = np.empty(x.shape, (np.float32 if real else np.complex64) if single else
                  (np.float64 if real else np.complex128))
-    np.multiply(x, w, out=y)
+    np.multiply(x, w, out=y)                    # (loops, tx, rx, samples)
     if real:
-        y = scipy.fft.rfft(y, n=cfg.n_range, axis=2)[:, :, :cfg.n_range_bins]
-        y = scipy.fft.fft(y, n=cfg.n_doppler, axis=3, overwrite_x=True)
+        y = scipy.fft.rfft(y, n=cfg.n_range, axis=3)[..., :cfg.n_range_bins]
+        y = scipy.fft.fft(y, n=cfg.n_doppler, axis=0, overwrite_x=True)
     else:
-        y = scipy.fft.fft2(y, s=(cfg.n_range, cfg.n_doppler), axes=(2, 3), overwrite_x=True)
+        y = scipy.fft.fft2(y, s=(cfg.n_doppler, cfg.n_range), axes=(0, 3), overwrite_x=True)
     if remove_static_clutter:
         bins, ratio = _static_response(cfg, doppler_window)
-        y[..., bins] -= y[..., :1] * ratio.astype(y.dtype)
-        y[..., 0] = 0.0
-    return y.reshape(cfg.cube_shape)
+        y[bins] -= y[:1] * ratio.astype(y.dtype)[:, None, None, None]
+        y[0] = 0.0
+    # (Doppler, tx, rx, range) -> the cube's axes, a view: no corner-turn copy
+    return y.transpose(1, 2, 3, 0).reshape(cfg.cube_shape)
