@@ -161,17 +161,21 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             r = (r + nr) % nr
         for j in range(nd + 2 * pd):
             row[j] = power[r, (j - pd + nd) % nd]
+        # every cell's sums at once, offset by offset (the same additions per cell, in
+        # offset order; independent across cells, so they vectorise)
+        s = side[i]
+        g = full[i]
+        s[:] = 0.0
+        g[:] = 0.0
+        for o in range(2 * pd + 1):
+            if o < pd - guard_d or o > pd + guard_d:
+                for d in range(nd):
+                    s[d] += row[d + o]
+            else:
+                for d in range(nd):
+                    g[d] += row[d + o]
         for d in range(nd):
-            s = 0.0
-            for j in range(d, d + pd - guard_d):
-                s += row[j]
-            for j in range(d + pd + guard_d + 1, d + 2 * pd + 1):
-                s += row[j]
-            g = 0.0
-            for j in range(d + pd - guard_d, d + pd + guard_d + 1):
-                g += row[j]
-            side[i, d] = s
-            full[i, d] = s + g
+            g[d] += s[d]
     out = np.empty((nr, nd))
     a = np.empty(nd)
     b = np.empty(nd)
