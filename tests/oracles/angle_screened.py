@@ -78,6 +78,27 @@ def _no_components() -> AngleArrays:
     return AngleArrays(np.zeros(0, np.int64), z, z.astype(complex), z)
 
 
+def _residual_peak(xs: np.ndarray, a1: np.ndarray, st1: np.ndarray, noise: np.ndarray,
+                   params: AngleParams, find: PeakFinder, steer: Steering
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The residual's strongest peak after the first component (amplitude a1 complex (n,),
+    steering st1 complex (n, n_ch)) of rows xs (complex (n, n_ch)), found by ``find`` with
+    steering vectors of ``steer``: (residual complex (n, n_ch), its peak's sin s2 float (n,)
+    and amplitude a2 complex (n,), the SNR and dynamic-range ``gates`` bool (n,), and
+    ``more`` bool (n,): the gates and the model-order test passed)."""
+    n = xs.shape[1]
+    p1 = np.abs(a1) ** 2
+    res = xs - a1[:, None] * st1
+    s2, _ = find(res, params.n_fft)
+    st2 = steer(s2, n)
+    a2 = np.sum(np.conj(st2) * res, axis=1) / n
+    p2 = np.abs(a2) ** 2
+    with np.errstate(divide="ignore"):
+        gates = (10 * np.log10(p2 * n / noise) >= params.min_snr_db) & (
+            10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
+    return res, s2, a2, gates, gates & beyond_model_error(p2, p1, noise, params)
+
+
 def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams,
                          first_sin: np.ndarray | None = None) -> AngleArrays:
     """:func:`estimate_angles_batch` as flat arrays, the angle peaks by
@@ -94,15 +115,8 @@ def estimate_angles_fast(x: np.ndarray, noise_per_channel: np.ndarray, params: A
     more = np.zeros(n_rows, bool)
     pairs = None
     if params.max_targets > 1:
-        res = xs - a1[:, None] * st1
-        s2, _ = peak_sin_fast(res, params.n_fft)
-        st2 = _steering_rows(s2, n)
-        a2 = np.sum(np.conj(st2) * res, axis=1) / n
-        p2 = np.abs(a2) ** 2
-        with np.errstate(divide="ignore"):
-            gates = (10 * np.log10(p2 * n / noise) >= params.min_snr_db) & (
-                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
-        more = gates & beyond_model_error(p2, p1, noise, params)
+        res, s2, a2, gates, more = _residual_peak(xs, a1, st1, noise, params, peak_sin_fast,
+                                                  _steering_rows)
         pairs = split_step(xs, noise, params, np.arange(n_rows), s1, a1, s2, a2,
                            gates & split_screen(res, st1, noise, params), more)
     got = _components(xs, noise, params, s1, a1, p1, more)
@@ -285,6 +299,12 @@ def _with_pairs(got: AngleArrays, rows: np.ndarray, s_p: np.ndarray, a_p: np.nda
                                       for f in ("sin_az", "amplitude", "snr_db")))
 
 
+def _plane_waves(s: np.ndarray, n: int) -> np.ndarray:
+    """exp(-j pi v s) for v = 0..n-1 of every s (float (m,)), complex (m, n), evaluated as
+    :func:`estimate_angles_batch` always has (``_steer``'s values to rounding)."""
+    return np.exp(-1j * np.pi * s[:, None] * np.arange(n)[None, :])
+
+
 def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleParams
                           ) -> list[list[AngleComponent]]:
     """:func:`estimate_angles` of every row of ``x``, complex (n, n_channels), with
@@ -296,23 +316,15 @@ def estimate_angles_batch(x: np.ndarray, noise_per_channel: np.ndarray, params: 
     noise = np.maximum(np.asarray(noise_per_channel, dtype=float), 1e-30)
     if not n_rows:
         return []
-    ch = np.arange(n)
     s1, _ = peak_sin_batch(xs, params.n_fft)
-    st1 = np.exp(-1j * np.pi * s1[:, None] * ch[None, :])
+    st1 = _plane_waves(s1, n)
     a1 = np.sum(np.conj(st1) * xs, axis=1) / n
     p1 = np.abs(a1) ** 2
     more = np.zeros(n_rows, bool)
     pairs: dict[int, list[AngleComponent]] = {}
     if params.max_targets > 1:
-        res = xs - a1[:, None] * st1
-        s2, _ = peak_sin_batch(res, params.n_fft)
-        st2 = np.exp(-1j * np.pi * s2[:, None] * ch[None, :])
-        a2 = np.sum(np.conj(st2) * res, axis=1) / n
-        p2 = np.abs(a2) ** 2
-        with np.errstate(divide="ignore"):
-            gates = (10 * np.log10(p2 * n / noise) >= params.min_snr_db) & (
-                10 * np.log10(p1 / np.maximum(p2, 1e-300)) <= params.dynamic_range_db)
-        more = gates & beyond_model_error(p2, p1, noise, params)
+        res, s2, a2, gates, more = _residual_peak(xs, a1, st1, noise, params, peak_sin_batch,
+                                                  _plane_waves)
         rows, s_p, a_p = split_step(xs, noise, params, np.arange(n_rows), s1, a1, s2, a2,
                                     gates & split_screen(res, st1, noise, params), more,
                                     peak_sin_batch, _steer)
