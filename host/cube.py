@@ -77,8 +77,9 @@ def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
 
     adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
     (n_virtual, n_range_bins, n_doppler), equal to the reference's to float64 rounding
-    (with ``remove_static_clutter`` the zero-Doppler bin is exactly 0). ``single``:
-    computed in single precision, complex64 (:data:`SINGLE_RTOL`).
+    (with ``remove_static_clutter`` the zero-Doppler bin is exactly 0); not C-contiguous
+    (Doppler outermost in memory). ``single``: computed in single precision, complex64
+    (:data:`SINGLE_RTOL`).
     """
     check_frame(adc, cfg)
     w = _weights(cfg, range_window, doppler_window, single)
