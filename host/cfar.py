@@ -34,7 +34,7 @@ from functools import lru_cache
 import numpy as np
 from scipy import stats
 
-from host.kernels import njit
+from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
     RECT_POWER_CORRELATION,
@@ -190,6 +190,13 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             b += side[i]
         out[r] = a + b
     return out
+
+
+@warm_up
+def _compile_training_sum() -> None:
+    """Compile :func:`_training_sum` for the argument types of :func:`cfar_threshold`'s
+    call (``host.kernels.compile_data_dependent``: the FPGA detector's runs never reach it)."""
+    _training_sum(np.zeros((3, 3)), 0, 0, 1, 1, False)
 
 
 @lru_cache(maxsize=64)
