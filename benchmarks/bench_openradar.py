@@ -30,7 +30,10 @@ our points in a cell, and every point), our points that are not part of a cluste
 (no peer detection within the bins, or none also within the array's angle resolution); host
 time per frame of each, timed in the same run (``--repeat`` runs after a warm-up, in
 ``--rounds`` rounds that alternate between the chains, so a change of the machine's load
-falls on all; median) with the load average. Each goal of issue 29 is reported, met or
+falls on all; median) with the load average. Both run one thread: ours does, and the peer's
+numpy is held to one BLAS thread (``--peer-threads``; with its default, one per core, it ran
+2-3 times slower on the machine loaded by other jobs: a median of 52 ms against 24 ms at
+load 16, a loss that is no speed of ours). Each goal of issue 29 is reported, met or
 missed, for each setting of ours; none is asserted in tests.
 """
 
@@ -228,10 +231,10 @@ def _goals(run: Run, t_peer_ms: float, threshold_db: float) -> list[str]:
 
 
 def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
-          load: tuple[float, ...]) -> str:
+          load: tuple[float, ...], peer_threads: int = 1) -> str:
     """The printed comparison (see the module docstring): one column per setting of ours
-    (``runs``) and of the peer, then each of ours against the peer's ``threshold_db``
-    detections and the goals."""
+    (``runs``) and of the peer (its BLAS threads ``peer_threads``, 0: its default), then
+    each of ours against the peer's ``threshold_db`` detections and the goals."""
     demo, db = peer_doc["settings"]["demo"], peer_doc["settings"][f"{threshold_db:g} dB"]
     v = peer_doc["versions"]
     t_db, t_demo = median_ms(db["times_s"]), median_ms(demo["times_s"])
@@ -244,8 +247,9 @@ def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
         f"OpenRadar {v['openradar']} (numpy {v['numpy']}, scikit-learn {v['scikit-learn']}) "
         "vs ours, static-clutter removal in both",
         f"{len(runs[0].times_s)} timed runs each, median; load average "
-        f"{' '.join(f'{x:.2f}' for x in load)} ({os.cpu_count()} cores); near: <= "
-        f"{MATCH_BINS} range and {MATCH_BINS} Doppler bins",
+        f"{' '.join(f'{x:.2f}' for x in load)} ({os.cpu_count()} cores); peer BLAS "
+        f"threads {peer_threads or 'its default'}, ours 1",
+        f"near: <= {MATCH_BINS} range and {MATCH_BINS} Doppler bins",
         "",
         f"{'':<36}{names}{db_name:>14}{'peer demo':>12}",
         f"{'CFAR cells':<36}{dashes}{db['cfar_cells']:>14}{demo['cfar_cells']:>12}",
@@ -263,12 +267,19 @@ def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
     return "\n".join(rows)
 
 
+BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+"""The variables that set the BLAS thread count of the peer's numpy (``--peer-threads``)."""
+
+
 def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
-             threshold_db: float, repeat: int) -> dict[str, Any]:
+             threshold_db: float, repeat: int, threads: int = 1) -> dict[str, Any]:
     """The peer runner's JSON, run by ``python`` (OpenRadar's virtualenv) in a clean
-    environment; ``shape`` = (chirps, rx, samples, tx)."""
+    environment; ``shape`` = (chirps, rx, samples, tx); ``threads``: its BLAS threads (0:
+    its default, one per core)."""
     env = {k: v for k, v in os.environ.items()
-           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", *BLAS_THREADS)}
+    if threads:
+        env.update({k: str(threads) for k in BLAS_THREADS})
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "peer.json"
         chirps, rx, samples, tx = shape
@@ -290,8 +301,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--threshold-db", type=float, default=15.0,
                     help="the peer's CFAR threshold compared with (default 15)")
     ap.add_argument("--repeat", type=int, default=20, help="timed runs per chain")
-    ap.add_argument("--rounds", type=int, default=4,
+    ap.add_argument("--rounds", type=int, default=10,
                     help="the timed runs alternate between the chains in this many rounds")
+    ap.add_argument("--peer-threads", type=int, default=1,
+                    help="BLAS threads of the peer's numpy (default 1, as ours runs; 0: its "
+                         "default, one per core, 2-3 times slower on a loaded machine)")
     args = ap.parse_args(argv)
     if not args.peer_python.exists():
         print(f"bench_openradar: no {args.peer_python}: `make bench-openradar` creates "
@@ -313,7 +327,7 @@ def main(argv: list[str] | None = None) -> int:
     for n in np.diff(np.linspace(0, args.repeat, args.rounds + 1).round().astype(int)):
         doc = run_peer(args.peer_python, args.capture,
                        (cfg.n_chirps, cfg.num_rx, cfg.n_samples, cfg.num_tx),
-                       args.threshold_db, int(n))
+                       args.threshold_db, int(n), args.peer_threads)
         for name, setting in doc["settings"].items():
             setting["times_s"] = peer_doc.get("settings", {}).get(name, {}).get(
                 "times_s", []) + setting["times_s"]
@@ -332,7 +346,7 @@ def main(argv: list[str] | None = None) -> int:
                         compare(ours, peer, cfg.n_doppler, cfg.angle_resolution_deg)))
     print(f"{os.path.relpath(args.capture)} ({cfg.num_tx} TX x {cfg.num_rx} RX, "
           f"{cfg.n_loops} loops x {cfg.n_samples} samples), profile {os.path.relpath(args.radar)}")
-    print(table(peer_doc, runs, args.threshold_db, load))
+    print(table(peer_doc, runs, args.threshold_db, load, args.peer_threads))
     return 0
 
 

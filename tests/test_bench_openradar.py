@@ -68,7 +68,8 @@ def test_table_reports_against_the_goals():
     text = table(doc, runs, 15.0, (1.0, 1.5, 2.0))
     lines = text.splitlines()
     assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[1]
-    assert lines[3].split() == ["default", "peer-ca", "peer", "15", "dB", "peer", "demo"]
+    assert "peer BLAS threads 1, ours 1" in lines[1] and lines[2].startswith("near: <= 2")
+    assert lines[4].split() == ["default", "peer-ca", "peer", "15", "dB", "peer", "demo"]
     row = next(line for line in lines if line.startswith("host time per frame"))
     assert row.split()[-4:] == ["11.00", "25.00", "50.00", "250.00"]
     row = next(line for line in lines if line.startswith("detections"))
