@@ -30,11 +30,12 @@ our points in a cell, and every point), our points that are not part of a cluste
 (no peer detection within the bins, or none also within the array's angle resolution); host
 time per frame of each, timed in the same run (``--repeat`` runs after a warm-up, in
 ``--rounds`` rounds that alternate between the chains, so a change of the machine's load
-falls on all; median) with the load average. Both run one thread: ours does, and the peer's
-numpy is held to one BLAS thread (``--peer-threads``; with its default, one per core, it ran
-2-3 times slower on the machine loaded by other jobs: a median of 52 ms against 24 ms at
-load 16, a loss that is no speed of ours). Each goal of issue 29 is reported, met or
-missed, for each setting of ours; none is asserted in tests.
+falls on all; median) with the load average, and each process' CPU time per frame (on a
+machine loaded by other jobs the wall time is mostly waiting for a core). Both run one
+thread: ours does, and the peer's numpy is held to one BLAS thread (``--peer-threads``; with
+its default, one per core, it ran 2-3 times slower on the machine loaded by other jobs: a
+median of 52 ms against 24 ms at load 16, a loss that is no speed of ours). Each goal of
+issue 29 is reported, met or missed, for each setting of ours; none is asserted in tests.
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ from typing import Any
 import numpy as np
 
 from host.adc_capture import open_capture
+from host.allocator import keep_freed_memory
 from host.pointcloud import PointCloud
 from radar.cli import build_parser
 from radar.commands.process import capture_frame_cloud, process_params, profile_of
@@ -177,13 +179,15 @@ def verdict(ok: bool) -> str:
 @dataclass(frozen=True)
 class Run:
     """One setting of ours: its ``name``, the ``radar process`` options it adds
-    (``options``), its detections, host times per frame (s) and agreement with the peer."""
+    (``options``), its detections, host times per frame (s) and agreement with the peer;
+    ``cpu_s``: the process' CPU time per frame (s), if measured."""
 
     name: str
     options: tuple[str, ...]
     ours: Detections
     times_s: list[float]
     agreement: Agreement
+    cpu_s: list[float] | None = None
 
 
 def modes(threshold_db: float) -> dict[str, tuple[str, ...]]:
@@ -198,7 +202,8 @@ def modes(threshold_db: float) -> dict[str, tuple[str, ...]]:
     return {"default": (), "peer-ca": matched, "peer-os": ("--detector", "os", *matched)}
 
 
-def _goals(run: Run, t_peer_ms: float, threshold_db: float) -> list[str]:
+def _goals(run: Run, t_peer_ms: float, threshold_db: float,
+           cpu_peer_ms: float | None = None) -> list[str]:
     """The agreement rows of one of our settings, each against its goal (issue 29)."""
     a = run.agreement
     found = a.peer_moving - len(a.missed)
@@ -220,6 +225,10 @@ def _goals(run: Run, t_peer_ms: float, threshold_db: float) -> list[str]:
         f"{'  our time / the peer time (' + format(threshold_db, 'g') + ' dB)':<44}"
         f"{ratio:.2f}  goal <= 1/3: {verdict(ratio <= GOAL_TIME_RATIO)}",
     ]
+    if run.cpu_s and cpu_peer_ms:
+        cpu = median_ms(run.cpu_s) / cpu_peer_ms
+        rows.append(f"{'  ... CPU time / its CPU time':<44}{cpu:.2f}  goal <= 1/3: "
+                    f"{verdict(cpu <= GOAL_TIME_RATIO)}")
     notes = []
     if a.missed:
         notes.append("  the peer's that ours misses (range bin,Doppler bin): "
@@ -257,8 +266,13 @@ def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
         f"{len(db['detections']['range_bin']):>14}{len(demo['detections']['range_bin']):>12}",
         f"{'host time per frame, ms':<36}{times}{t_db:>14.2f}{t_demo:>12.2f}",
     ]
+    cpu_db = median_ms(db["cpu_s"]) if db.get("cpu_s") else None
+    if cpu_db and all(r.cpu_s for r in runs):
+        cpus = "".join(f"{median_ms(r.cpu_s or []):>10.2f}" for r in runs)
+        rows.append(f"{'... its CPU time (process), ms':<36}{cpus}{cpu_db:>14.2f}"
+                    f"{median_ms(demo['cpu_s']):>12.2f}")
     for run in runs:
-        rows += ["", *_goals(run, t_db, threshold_db)]
+        rows += ["", *_goals(run, t_db, threshold_db, cpu_db)]
     crash = peer_doc.get("tdm_compensation_error")
     if crash:
         rows.append(textwrap.fill(
@@ -319,31 +333,36 @@ def main(argv: list[str] | None = None) -> int:
     cfg = profile.config
     params = {name: process_params(opts, profile)[0] for name, opts in settings.items()}
     capture = open_capture(args.capture, profile)
+    keep_freed_memory()                 # as radar process does
     load0 = os.getloadavg()
     clouds = {name: capture_frame_cloud(capture.frame(0), cfg, p, 0, True).cloud
               for name, p in params.items()}
     peer_doc: dict[str, Any] = {}
     times: dict[str, list[float]] = {name: [] for name in params}
+    cpu: dict[str, list[float]] = {name: [] for name in params}
     for n in np.diff(np.linspace(0, args.repeat, args.rounds + 1).round().astype(int)):
         doc = run_peer(args.peer_python, args.capture,
                        (cfg.n_chirps, cfg.num_rx, cfg.n_samples, cfg.num_tx),
                        args.threshold_db, int(n), args.peer_threads)
         for name, setting in doc["settings"].items():
-            setting["times_s"] = peer_doc.get("settings", {}).get(name, {}).get(
-                "times_s", []) + setting["times_s"]
+            for key in ("times_s", "cpu_s"):
+                setting[key] = peer_doc.get("settings", {}).get(name, {}).get(
+                    key, []) + setting[key]
         peer_doc = doc
         for _ in range(n):
             for name, p in params.items():
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 capture_frame_cloud(capture.frame(0), cfg, p, 0, True)
                 times[name].append(time.perf_counter() - t0)
+                cpu[name].append(time.process_time() - c0)
     load = tuple((a + b) / 2 for a, b in zip(load0, os.getloadavg(), strict=True))
     peer = Detections.of_peer(peer_doc["settings"][f"{args.threshold_db:g} dB"]["detections"])
     runs = []
     for name, extra in modes(args.threshold_db).items():
         ours = Detections.of_cloud(clouds[name])
         runs.append(Run(name, extra, ours, times[name],
-                        compare(ours, peer, cfg.n_doppler, cfg.angle_resolution_deg)))
+                        compare(ours, peer, cfg.n_doppler, cfg.angle_resolution_deg),
+                        cpu[name]))
     print(f"{os.path.relpath(args.capture)} ({cfg.num_tx} TX x {cfg.num_rx} RX, "
           f"{cfg.n_loops} loops x {cfg.n_samples} samples), profile {os.path.relpath(args.radar)}")
     print(table(peer_doc, runs, args.threshold_db, load, args.peer_threads))

@@ -62,9 +62,11 @@ def test_table_reports_against_the_goals():
     first = ours()
     second = Detections(*(x[[0, 2, 3]] for x in (first.range_bin, first.doppler_bin,
                                                   first.azimuth_deg, first.strength)))
-    runs = [Run("default", (), first, [0.01, 0.012, 0.011], a),
+    runs = [Run("default", (), first, [0.01, 0.012, 0.011], a, [0.004] * 3),
             Run("peer-ca", modes(15.0)["peer-ca"], second, [0.02, 0.03, 0.025],
-                compare(second, peer, N_DOPPLER, angle_tol_deg=14.3))]
+                compare(second, peer, N_DOPPLER, angle_tol_deg=14.3), [0.005] * 3)]
+    for setting, cpu in (("15 dB", 0.01), ("demo", 0.05)):
+        doc["settings"][setting]["cpu_s"] = [cpu] * 3
     text = table(doc, runs, 15.0, (1.0, 1.5, 2.0))
     lines = text.splitlines()
     assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[1]
@@ -72,6 +74,8 @@ def test_table_reports_against_the_goals():
     assert lines[4].split() == ["default", "peer-ca", "peer", "15", "dB", "peer", "demo"]
     row = next(line for line in lines if line.startswith("host time per frame"))
     assert row.split()[-4:] == ["11.00", "25.00", "50.00", "250.00"]
+    row = next(line for line in lines if line.startswith("... its CPU time"))
+    assert row.split()[-4:] == ["4.00", "5.00", "10.00", "50.00"]
     row = next(line for line in lines if line.startswith("detections"))
     assert row.split()[-4:] == ["5", "3", "6", "50"]
     default, matched = text.split("ours default (no options) vs the peer's 15 dB")[1].split(
@@ -80,6 +84,7 @@ def test_table_reports_against_the_goals():
     assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in default
     assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in default
     assert "0.22  goal <= 1/3: met" in default
+    assert "CPU time / its CPU time               0.40  goal <= 1/3: MISSED" in default
     assert "ours misses (range bin,Doppler bin): (80,5)" in default
     assert "(range bin,Doppler bin,az deg): (60,7,40) (100,3,0)" in default
     assert "0 of 3 (0 %)  goal <= 10 %: met" in matched

@@ -3,6 +3,7 @@ streamed and selected, static-clutter removal, the profile's maximum speed, and 
 one line with exit status 2 and nothing written."""
 
 import json
+import platform
 from dataclasses import replace
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import numpy as np
 import pytest
 
 from host.adc_capture import open_capture, write_npy
+from host.allocator import keep_freed_memory
 from host.params import MAX_RADIAL_SPEED_MPS, DetectionParams
 from host.pipeline import process_frame
 from model.config import PRESETS
@@ -110,6 +112,12 @@ def test_plots_written(tmp_path, capsys):
     for name in ("range_doppler.png", "range_azimuth.png", "point_cloud.png"):
         assert (tmp_path / "figs" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
+
+
+def test_keep_freed_memory():
+    """glibc's thresholds raised for the frame loop (host.allocator); a no-op elsewhere."""
+    assert keep_freed_memory() is (platform.libc_ver()[0] == "glibc")
+    assert keep_freed_memory() is (platform.libc_ver()[0] == "glibc")      # again: the same
 
 
 def test_grouping_and_min_snr_on_the_real_frame(tmp_path):
