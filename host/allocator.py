@@ -3,7 +3,7 @@
 Each frame allocates a few arrays of a few MB (the frame, the cube, the map). glibc serves
 blocks that large with fresh ``mmap`` pages (above its mmap threshold) or returns them to the
 system when the heap's top is freed (its trim threshold), so every frame touches new pages:
-thousands of page faults, about 1 ms a frame of the OpenRadar profile on a loaded 2-core
+about a thousand page faults, some 1 ms a frame of the OpenRadar profile on a loaded 2-core
 machine (docs/profiles.md "Compared with OpenRadar"), more than its FFTs. Raising both
 thresholds keeps freed blocks in the heap for the next frame. Memory the process frees stays
 mapped up to :data:`TRIM_THRESHOLD_BYTES`.
