@@ -13,8 +13,8 @@ interpolation of the magnitudes around it.
 
 :func:`class_peaks` runs the search on blocks of (row, TDM phasor) pairs: the coarse FFT
 vectorised over a block (the pairs innermost), the fine search per pair. The oracle (the
-numpy implementation it replaced, and the ``n_fft``-point FFT's definition) is in
-``tests/oracles/angle.py``. Floating-point sums run in another order than numpy's
+numpy implementation it replaced) is ``tests/oracles/angle_peaks.py``, the ``n_fft``-point
+FFT's definition ``tests/oracles/angle.py``. Floating-point sums run in another order than numpy's
 (``fastmath`` lets the compiler reorder them): results agree to rounding; a decision that
 rests on an exact tie may go the other way.
 """

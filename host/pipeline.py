@@ -4,9 +4,11 @@ Steps (docs/design.md section 1, host side):
 
 1. Detection on the range-Doppler map: 2-D CA-CFAR (default) or OS-CFAR on the map
    integrated non-coherently over all virtual channels, or the paper's threshold on channel
-   0; peak grouping keeps local maxima; only ``RadarConfig.detection_bins`` are reported
-   (the top range bins are negative beat frequencies), and cells within
-   ``sidelobe_margin_db`` of a stronger cell's window sidelobes are dropped.
+   0; optionally only cells ``min_snr_db`` above the noise estimate; peak grouping keeps
+   local maxima (of the 3 x 3 neighbourhood, or along Doppler only:
+   ``DetectionParams.grouping``); only ``RadarConfig.detection_bins`` are reported (the top
+   range bins are negative beat frequencies), and cells within ``sidelobe_margin_db`` of a
+   stronger cell's window sidelobes are dropped.
 2. Range and Doppler refined by interpolation around each peak over the three integrated
    powers along each axis, matched to the axis' window and padding (``host.cells``); with
    ``DetectionParams.refine``, then by maximising the whole frame's periodogram
@@ -48,12 +50,26 @@ from host.cfar import (
     paper_threshold,
     sidelobe_masked,
 )
+from host.cube import frame_cube
 from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
 from host.refine import refine_offsets
 from model.config import RadarConfig
-from model.reference import fft_axes, radar_cube, range_doppler_power
+from model.reference import fft_axes, range_doppler_power
+
+GROUPING_SIZE = {"peak": (3, 3), "doppler": (1, 3)}
+"""The (range, Doppler) neighbourhood a detected cell must be the maximum of
+(``host.cfar.local_peaks``), by ``DetectionParams.grouping``."""
+
+
+def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
+             params: DetectionParams) -> np.ndarray:
+    """``mask`` (bool (n_range, n_doppler)) less the cells whose ``power`` is not
+    ``params.min_snr_db`` above ``noise`` (both float of that shape); unchanged if None."""
+    if params.min_snr_db is None:
+        return mask
+    return mask & (power > noise * 10.0 ** (params.min_snr_db / 10.0))
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
@@ -70,15 +86,17 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     cf = params.cfar if params.detector != "os" else CfarParams(
         pfa=params.cfar.pfa, guard=params.cfar.guard, train=params.cfar.train, kind="os",
         os_rank=params.cfar.os_rank)
+    size = GROUPING_SIZE[params.grouping]
     if params.detector == "paper":
         mask, p0 = paper_threshold(cube, params.paper_threshold_db)
-        cells = local_peaks(p0, mask, mirrored=mirrored)
         noise_map = np.full(nci.shape, np.median(nci))
+        cells = local_peaks(p0, _min_snr(mask, nci, noise_map, params), size, mirrored)
     else:
         if params.detector == "ca":
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
         threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
-        cells = local_peaks(nci, nci > threshold, mirrored=mirrored)
+        cells = local_peaks(nci, _min_snr(nci > threshold, nci, noise_map, params), size,
+                            mirrored)
     ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]
     if params.sidelobe_margin_db is not None and len(cells):
@@ -143,7 +161,8 @@ def real_only(cube: np.ndarray) -> bool:
 def process_frame(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,
                   frame: int = 0) -> PointCloud:
     """ADC frame, complex or real (n_chirps, num_rx, n_samples) -> point cloud, through the float
-    reference of the FPGA chain (``model.reference.radar_cube``) and :func:`process_cube`."""
+    reference of the FPGA chain (``model.reference.radar_cube``, computed by its fast
+    equivalent ``host.cube.frame_cube``) and :func:`process_cube`."""
     params = params or params_for(cfg)
-    cube = radar_cube(adc, cfg, params.range_window, params.doppler_window)
+    cube = frame_cube(adc, cfg, params.range_window, params.doppler_window)
     return process_cube(cube, cfg, params, frame)

@@ -6,7 +6,8 @@ radar cubes complex (n_virtual, n_range, n_doppler) in the float reference's uni
 
 - ``model``: bit-accurate model of ``radar_pipeline`` (:func:`model.radar_pipeline.scaled_cube`),
   exactly what the FPGA sends, divided by the chain's gain;
-- ``float``: the float64 reference of the chain (:func:`model.reference.radar_cube`), fast;
+- ``float``: the float64 reference of the chain (:func:`model.reference.radar_cube`, computed
+  by its fast equivalent :func:`host.cube.frame_cube`);
 - ``rtl``: the Verilated ``radar_pipeline`` (:func:`rtlsim.harness.run_pipeline`, the C++ harness),
   its DMA packets decoded like the board's (``host.receiver.chain_decoder``).
 
@@ -31,13 +32,13 @@ from typing import ClassVar
 
 import numpy as np
 
+from host.cube import frame_cube
 from host.receiver import LinkFrame, chain_decoder
 from model.axis_packetizer import packetize_stream, words_to_bytes
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.hdl import FPGA_CLOCK_HZ, FULL_AXI_DATA_W, check_hdl
 from model.radar_pipeline import PipelineParams, dma_packets, record_frames, scaled_cube
-from model.reference import radar_cube
 
 SOURCES: dict[str, type[FrameSource]] = {}
 """Registered sources by name, in definition order (model, float, rtl)."""
@@ -166,7 +167,7 @@ class FloatSource(FrameSource):
     help = "its float64 reference (faster)"
 
     def cube(self, adc: np.ndarray, cfg: RadarConfig) -> np.ndarray:
-        return radar_cube(adc, cfg, self.chain.window, self.chain.window,
+        return frame_cube(adc, cfg, self.chain.window, self.chain.window,
                           remove_static_clutter=self.chain.static_removal)
 
 

@@ -1,8 +1,8 @@
 """The compiled kernels of ``host.angle`` (``host._angle_peaks``, ``host._angle_relax``)
-against the numpy implementations they replaced (``tests.oracles.angle``: the fast peak
-search, the screened estimator, RELAX in step over rows): the same peaks and decisions,
-floats equal to rounding; and the same results with numba absent (the uncompiled fallback
-of ``host.kernels``)."""
+against the numpy implementations they replaced (``tests.oracles``: the fast peak search
+``angle_peaks``, the screened estimator ``angle_screened``, RELAX in step over rows
+``angle``): the same peaks and decisions, floats equal to rounding; and the same results
+with numba absent (the uncompiled fallback of ``host.kernels``)."""
 
 from __future__ import annotations
 
@@ -21,13 +21,11 @@ from host.angle import AngleParams, _relax, estimate_angles, peak_powers
 from host.tdm import tx_phasors
 from model.config import get_preset
 from radar.common import note_compile
-from tests.oracles.angle import (
-    _steering_rows,
-    estimate_angles_rows,
+from tests.oracles.angle import estimate_angles_rows
+from tests.oracles.angle_peaks import _steering_rows, peak_power_fast, peak_sin_fast
+from tests.oracles.angle_screened import (
     estimate_angles_screened,
     first_component_screen,
-    peak_power_fast,
-    peak_sin_fast,
     split_pairs,
 )
 from tests.oracles.points import tdm_compensate

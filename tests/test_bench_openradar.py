@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.bench_openradar import Detections, compare, main, near, table
+from benchmarks.bench_openradar import Detections, Run, compare, main, modes, near, table
 
 N_DOPPLER = 128
 
@@ -59,20 +59,44 @@ def test_table_reports_against_the_goals():
     doc = peer_doc()
     peer = Detections.of_peer(doc["settings"]["15 dB"]["detections"])
     a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
-    text = table(doc, ours(), [0.01, 0.012, 0.011], a, 15.0, (1.0, 1.5, 2.0))
+    first = ours()
+    second = Detections(*(x[[0, 2, 3]] for x in (first.range_bin, first.doppler_bin,
+                                                  first.azimuth_deg, first.strength)))
+    runs = [Run("default", (), first, [0.01, 0.012, 0.011], a, [0.004] * 3),
+            Run("peer-ca", modes(15.0)["peer-ca"], second, [0.02, 0.03, 0.025],
+                compare(second, peer, N_DOPPLER, angle_tol_deg=14.3), [0.005] * 3)]
+    for setting, cpu in (("15 dB", 0.01), ("demo", 0.05)):
+        doc["settings"][setting]["cpu_s"] = [cpu] * 3
+    text = table(doc, runs, 15.0, (1.0, 1.5, 2.0))
     lines = text.splitlines()
     assert "OpenRadar 1.0.1" in lines[0] and "load average 1.00 1.50 2.00" in lines[1]
+    assert "peer BLAS threads 1, ours 1" in lines[1] and lines[2].startswith("near: <= 2")
+    assert lines[4].split() == ["default", "peer-ca", "peer", "15", "dB", "peer", "demo"]
     row = next(line for line in lines if line.startswith("host time per frame"))
-    assert row.split()[-3:] == ["11.0", "50.0", "250.0"]
+    assert row.split()[-4:] == ["11.00", "25.00", "50.00", "250.00"]
+    row = next(line for line in lines if line.startswith("... its CPU time"))
+    assert row.split()[-4:] == ["4.00", "5.00", "10.00", "50.00"]
     row = next(line for line in lines if line.startswith("detections"))
-    assert row.split()[-3:] == ["5", "6", "50"]
-    assert "4 of 5  goal all: MISSED" in text
-    assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in text
-    assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in text
-    assert "0.22  goal <= 1/3: met" in text
-    assert "ours misses (range bin,Doppler bin): (80,5)" in text
-    assert "(range bin,Doppler bin,az deg): (60,7,40) (100,3,0)" in text
-    assert "TypeError: slice indices must be integers" in text
+    assert row.split()[-4:] == ["5", "3", "6", "50"]
+    default, matched = text.split("ours default (no options) vs the peer's 15 dB")[1].split(
+        "ours peer-ca (--grouping doppler --min-snr-db 15) vs the peer's 15 dB")
+    assert "4 of 5  goal all: MISSED" in default
+    assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in default
+    assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in default
+    assert "0.22  goal <= 1/3: met" in default
+    assert "CPU time / its CPU time               0.40  goal <= 1/3: MISSED" in default
+    assert "ours misses (range bin,Doppler bin): (80,5)" in default
+    assert "(range bin,Doppler bin,az deg): (60,7,40) (100,3,0)" in default
+    assert "0 of 3 (0 %)  goal <= 10 %: met" in matched
+    assert "0.50  goal <= 1/3: MISSED" in matched
+    assert "TypeError: slice indices must be integers" in matched
+
+
+def test_modes_match_the_peer_threshold_and_grouping():
+    m = modes(12.5)
+    assert m["default"] == ()
+    assert m["peer-ca"] == ("--grouping", "doppler", "--min-snr-db", "12.5")
+    assert m["peer-os"] == ("--detector", "os", *m["peer-ca"])
 
 
 def test_no_peer_virtualenv(tmp_path, capsys):
@@ -87,5 +111,6 @@ def test_table_without_angles(missing):
     peer = Detections.of_peer(doc["settings"]["15 dB"]["detections"])
     far = Detections(np.array([120] * len(missing)), np.array([40] * len(missing)),
                      np.array(missing), np.array(missing))
-    text = table(doc, far, [0.01], compare(far, peer, N_DOPPLER, 14.3), 15.0, (0.0, 0.0, 0.0))
+    run = Run("default", (), far, [0.01], compare(far, peer, N_DOPPLER, 14.3))
+    text = table(doc, [run], 15.0, (0.0, 0.0, 0.0))
     assert "every point" in text and "-  goal <= 2 deg: MISSED" in text

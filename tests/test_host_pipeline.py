@@ -6,7 +6,7 @@ import pytest
 
 from host.cfar import CfarParams, ca_factor, cfar_threshold, effective_cells, os_factor
 from host.evaluate import match_targets
-from host.pipeline import DetectionParams, process_cube, process_frame
+from host.pipeline import DetectionParams, detect_cells, process_cube, process_frame
 from model.config import get_preset
 from model.reference import radar_cube, range_doppler_power
 from model.scene import Scatterers, table1_scene
@@ -109,6 +109,34 @@ def test_bad_cfar_params():
         CfarParams(pfa=0.0)
     with pytest.raises(ValueError, match="detector"):
         DetectionParams(detector="magic")
+
+
+def test_bad_grouping_and_min_snr():
+    with pytest.raises(ValueError, match="grouping"):
+        DetectionParams(grouping="range")
+    for bad in (-1.0, 201.0, True):
+        with pytest.raises(ValueError, match="min_snr_db"):
+            DetectionParams(min_snr_db=bad)
+
+
+def test_grouping_and_min_snr_on_a_range_extended_return():
+    """A return over five range bins at one Doppler (an extended target: its range profile
+    peaks in the middle), with a weak point target elsewhere: ``peak`` grouping gives one
+    detection for the extended return, ``doppler`` one per range bin over the CFAR, and
+    ``min_snr_db`` drops the weak target and the extended return's weak edge bins."""
+    cfg = get_preset("paper-fpga")
+    rng = np.random.default_rng(5)
+    shape = cfg.cube_shape
+    cube = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) * np.sqrt(0.5)
+    for dr, gain in zip(range(-2, 3), (100, 300, 1000, 300, 100), strict=True):
+        cube[:, 30 + dr, 20] += gain
+    cube[:, 45, 50] += 8.0                                    # 18 dB over the noise
+    cells = {g: set(map(tuple, detect_cells(cube, cfg, DetectionParams(grouping=g))[0].tolist()))
+             for g in ("peak", "doppler")}
+    assert cells["peak"] == {(30, 20), (45, 50)}
+    assert {(30 + dr, 20) for dr in range(-2, 3)} | {(45, 50)} == cells["doppler"]
+    strong, _, _ = detect_cells(cube, cfg, DetectionParams(grouping="doppler", min_snr_db=30))
+    assert set(map(tuple, strong.tolist())) == {(29, 20), (30, 20), (31, 20)}
 
 
 def test_paper_fpga_end_to_end():

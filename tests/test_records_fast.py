@@ -43,14 +43,9 @@ from model.reference import fft_axes, radar_cube
 from model.scene import table1_scene
 from model.simulate import simulate_scene
 from tests.oracles.angle import estimate_angles as estimate_angles_row
-from tests.oracles.angle import (
-    estimate_angles_rows,
-    fine_peaks,
-    first_component_screen,
-    peak_sin_batch,
-    peak_sin_fast,
-    screened_components,
-)
+from tests.oracles.angle import estimate_angles_rows, peak_sin_batch
+from tests.oracles.angle_peaks import fine_peaks, peak_sin_fast
+from tests.oracles.angle_screened import first_component_screen, screened_components
 from tests.oracles.points import (
     assert_same_cloud,
     choose_fold,

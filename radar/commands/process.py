@@ -25,10 +25,11 @@ from typing import Any
 import numpy as np
 
 from host.adc_capture import NpyCapture, open_capture
+from host.allocator import keep_freed_memory
 from host.calibration import check_calibration, load_calibration
 from host.cube import frame_cube
 from host.dca1000 import Dca1000Capture
-from host.params import DetectionParams
+from host.params import GROUPINGS, DetectionParams
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
 from model.array import has_vertical_extent
@@ -134,12 +135,17 @@ def capture_of(args: argparse.Namespace, profile: Profile, command: str
 
 def process_params(args: argparse.Namespace, profile: Profile) -> tuple[DetectionParams, str]:
     """``radar process``'s detection settings from its options (``radar.common.
-    detection_params``: the profile's maximum speed and guard by default) with the
-    calibration applied before angle estimation (:func:`calibration_of`), and that
-    calibration's name for the output; CliError if they do not fit."""
+    detection_params``: the profile's maximum speed and guard by default; ``--grouping``,
+    ``--min-snr-db``) with the calibration applied before angle estimation
+    (:func:`calibration_of`), and that calibration's name for the output; CliError if they
+    do not fit."""
     params = detection_params(args, cfg=profile.config)
     calibration, cal_name = calibration_of(args.calibration, profile)
-    return replace(params, calibration=calibration), cal_name
+    try:
+        return replace(params, calibration=calibration, grouping=args.grouping,
+                       min_snr_db=args.min_snr_db), cal_name
+    except ValueError as exc:
+        raise CliError(f"--{str(exc).replace('_', '-')}") from None
 
 
 def hdl_frame(adc: np.ndarray) -> np.ndarray:
@@ -187,10 +193,11 @@ def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionPara
                         frame_id: int, remove_static: bool) -> FrameCloud:
     """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
     codes, -> its cube (the float reference's, ``model.reference.radar_cube``, computed fast
-    by ``host.cube.frame_cube``, static clutter removed if asked) and point cloud
+    by ``host.cube.frame_cube`` in single precision: complex64, within ``host.cube.
+    SINGLE_RTOL`` of it; static clutter removed if asked) and point cloud
     (``radar.frame_cloud``), as ``radar process`` does."""
     cube = frame_cube(adc, cfg, params.range_window, params.doppler_window,
-                      remove_static_clutter=remove_static)
+                      remove_static_clutter=remove_static, single=True)
     return frame_cloud(cube, cfg, params, frame_id, "process")
 
 
@@ -239,6 +246,7 @@ def cmd_process(args: argparse.Namespace) -> int:
     params, cal_name = process_params(args, profile)
     dcfg = fpga_config(args, cfg, params) if args.detect == "fpga" else None
     capture, frames = capture_of(args, profile, "process")
+    keep_freed_memory()             # frame after frame the same few MB (host.allocator)
     if source is not None:
         source = scaled_for(source, cfg, capture_peak(capture))
     t0 = time.perf_counter()
@@ -290,7 +298,8 @@ def cmd_process(args: argparse.Namespace) -> int:
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
-                "calibration": cal_name,
+                "calibration": cal_name, "grouping": params.grouping,
+                "min_snr_db": params.min_snr_db,
                 "max_speed_mps": params.max_speed_mps,
                 "min_detection_range_m": cfg.min_detection_range_m,
                 "frame_info": per_frame})
@@ -342,6 +351,13 @@ def add_parsers(sub: argparse._SubParsersAction, presets: list[str]) -> None:
     p.add_argument("--plots", default=None,
                    help="folder for the last frame's range-Doppler map with its detections, "
                         "range-azimuth map and x-y point cloud")
+    p.add_argument("--grouping", choices=GROUPINGS, default="peak",
+                   help="peak: one detection per peak of the range-Doppler map (default); "
+                        "doppler: one per range bin of a return that spans several (a "
+                        "person, a car's body), the peaks along Doppler only")
+    p.add_argument("--min-snr-db", type=float, default=None, metavar="DB",
+                   help="detected cells must also be this far above their noise estimate "
+                        "(mean SNR per channel; default: the CFAR's Pfa alone decides)")
     add_mcap_options(p)
     add_detection_options(p)
     add_refine_options(p, "a fixed-point cube")

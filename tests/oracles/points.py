@@ -30,12 +30,9 @@ from host.records import RecordArrays
 from host.tdm import choose_folds, tx_phasors
 from model.config import RadarConfig
 from model.reference import fft_axes, signed_bins, tdm_phase_compensation
-from tests.oracles.angle import (
-    estimate_angles_batch,
-    estimate_angles_fast,
-    peak_power_batch,
-    peak_power_fast,
-)
+from tests.oracles.angle import peak_power_batch
+from tests.oracles.angle_peaks import peak_power_fast
+from tests.oracles.angle_screened import estimate_angles_batch, estimate_angles_fast
 
 
 def tdm_comp(cfg: RadarConfig, k: np.ndarray | int) -> np.ndarray:
@@ -159,7 +156,7 @@ def points_from_cells_numpy(cells: np.ndarray, snapshots: np.ndarray, power: np.
                             params: DetectionParams, frame: int = 0) -> PointCloud:
     """The cube path's points before ``host.points.points_from_cells`` (steps 3 to 5 of
     ``host.pipeline``'s docstring). Vectorised over the cells: the TDM hypotheses' phasors,
-    their angle peaks (coarse FFT + fine-grid search, ``tests.oracles.angle.fine_peaks``, the
+    their angle peaks (coarse FFT + fine-grid search, ``tests.oracles.angle_peaks.fine_peaks``, the
     same peaks as ``AngleParams.n_fft``-point FFTs), the unfolding decision
     (:func:`choose_folds`) and the angles run on all cells at once. Arguments as
     :func:`points_from_cells_reference`."""
