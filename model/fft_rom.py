@@ -176,6 +176,11 @@ def render_rom_pkg() -> str:
         "  // Coefficient width (signed two's complement) and fraction bits (Q1.16).\n"
         f"  localparam int COEF_W = {COEF_W};\n"
         f"  localparam int COEF_FRAC = {COEF_FRAC};\n"
+        "  // 1 when fft_win_rom holds an n-point window (a power of two or WINDOW_LENGTHS).\n"
+        "  function automatic bit has_window(input int n);\n"
+        "    has_window = (n >= 2 && n <= ROM_SIZE && (n & (n - 1)) == 0)"
+        + "".join(f" || n == {n}" for n in WINDOW_LENGTHS) + ";\n"
+        "  endfunction\n"
         "endpackage\n/* verilator lint_on UNUSEDPARAM */\n\n`default_nettype wire\n"
     )
 

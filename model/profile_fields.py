@@ -79,18 +79,12 @@ def unsupported_features(cfg: RadarConfig) -> list[str]:
 
 def preset_chain_features(cfg: RadarConfig) -> list[str]:
     """What of ``cfg`` the presets' fixed-point chain (the bit-accurate model, the RTL) does
-    not run, one phrase each (empty for the presets): zero padding, a firing order other
-    than 0..num_tx-1, a real ADC, a virtual array other than the contiguous lambda/2 ULA."""
+    not run, one phrase each (empty for the presets): a firing order other than
+    0..num_tx-1, a virtual array other than the contiguous lambda/2 ULA (zero padding and a
+    real ADC it runs: N_SAMPLES, N_LOOPS, REAL_ADC, ``model.hdl.hdl_parameters``)."""
     out = []
-    if cfg.n_samples != cfg.n_range:
-        out.append(f"{cfg.n_samples} samples per chirp zero-padded to a {cfg.n_range}-point "
-                   "range FFT")
-    if cfg.n_loops != cfg.n_doppler:
-        out.append(f"{cfg.n_loops} loops zero-padded to a {cfg.n_doppler}-point Doppler FFT")
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         out.append(f"TX firing order {list(cfg.tx_sequence)}")
-    if cfg.adc != "complex":
-        out.append("real-valued ADC")
     if not cfg.uniform_linear_array:
         out.append("a virtual array other than the contiguous horizontal lambda/2 ULA")
     return out

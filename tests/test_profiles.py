@@ -145,8 +145,9 @@ def test_cfg_beyond_the_chain_loads_and_is_refused_by_the_chain():
     assert p.calibration.range_bias_m == 0.05
     assert p.calibration.channel_gain == (1,) * 4 + (1j,) * 4 + (-1,) * 4
     features = " ".join(preset_chain_features(c))
-    for word in ("200 samples", "255 loops", "firing order", "real-valued ADC", "ULA"):
+    for word in ("firing order", "ULA"):        # zero padding and a real ADC it runs
         assert word in features
+    assert "samples" not in features and "real" not in features
     assert c.unsupported_features() == []                 # the float chain takes them all
     c.check_adc(np.zeros(c.adc_shape))
     assert simulate_frame(c, Scatterers(*(np.ones(1),) * 4, np.zeros(1, dtype=int))
