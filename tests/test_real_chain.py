@@ -17,6 +17,7 @@ from host.pipeline import process_cube, process_frame
 from model.array import steering
 from model.cfar_stats import HANN_POWER_CORRELATION
 from model.config import PRESETS, RadarConfig
+from model.hdl import check_hdl
 from model.radar_pipeline import PipelineParams, run_chain, scaled_cube
 from model.reference import FftAxis, corner_turn, fft_axes, radar_cube, range_doppler_power
 from model.scene import Scatterers
@@ -179,7 +180,8 @@ def test_fixed_point_chain_tracks_the_float_chain(changes):
 
 def test_fixed_point_chain_matches_its_oracle_on_a_profile():
     """run_chain (planar fast path) = the stage-by-stage int64 oracle on a 200-of-256
-    sample, 15-of-32 loop real-ADC profile (tests/oracles/chain.py), in both read orders."""
+    sample, 15-of-32 loop real-ADC profile (tests/oracles/chain.py), in both read orders;
+    through the external frame store the same payload (all loops: it refuses fewer)."""
     cfg = replace(BASE, n_doppler=32, samples_per_chirp=200, loops=15, adc="real")
     frame = simulate_frame(cfg, SCENE, rng=np.random.default_rng(0)).samples
     for params in (PipelineParams(), PipelineParams(output_mode=1)):
@@ -189,6 +191,14 @@ def test_fixed_point_chain_matches_its_oracle_on_a_profile():
         assert (a.range_overflow, a.doppler_overflow) == (b.range_overflow, b.doppler_overflow)
         if params.output_mode:
             assert np.array_equal(a.records, b.records)
+    with pytest.raises(ValueError, match="external frame store"):
+        PipelineParams(frame_store=True).check(cfg)
+    with pytest.raises(ValueError, match="201 samples per chirp .no window ROM"):
+        check_hdl(replace(cfg, samples_per_chirp=201))
+    whole = replace(cfg, loops=32)          # all loops: the external store takes it too
+    frame = simulate_frame(whole, SCENE, rng=np.random.default_rng(1)).samples
+    assert np.array_equal(run_chain(frame, whole).payload,
+                          run_chain(frame, whole, PipelineParams(frame_store=True)).payload)
 
 
 def test_padded_noise_keeps_the_configured_pfa():
