@@ -14,8 +14,10 @@
 //
 // Any radar's shape (docs/profiles.md): N_SAMPLES samples per chirp and N_LOOPS loops per
 // frame below the FFT lengths are windowed over their own count and zero-filled by the FFTs
-// (fft_axis N_IN; the ping-pong, frame alignment and corner turn count the samples and loops
-// that exist, so the fill costs no memory and no throughput). REAL_ADC = 1: real samples in
+// (fft_axis N_IN: each FFT inserts its zeros while its input waits, N clocks a vector as for
+// N inputs, so a chirp period of N_RANGE clocks is still all the chain needs; the ping-pong,
+// frame alignment and corner turn count the samples and loops that exist, the corner turn's
+// memory stays N_DOPPLER loops deep). REAL_ADC = 1: real samples in
 // the I half of each lane (bits [15:0] of lane r; the Q half is ignored), and the range FFT
 // keeps bins 0..N_RANGE/2-1 (N_RBINS below): the corner turn, the detector and the DMA
 // see N_RANGE/2 range bins (half the frame memory and half the link).
