@@ -54,7 +54,7 @@ def fpga_detect_config(cfg: RadarConfig, cfar: CfarParams, kind: str = "ca",
     (``report``: REPORT_LO/REPORT_HI, the host's rule; the other rows stay training cells,
     as in the host CFAR, and as ``PipelineParams.detect_config``'s default). ValueError on
     settings the detector refuses."""
-    return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+    return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range_bins,
                         n_doppler=cfg.n_doppler, guard=tuple(cfar.guard),
                         train=tuple(cfar.train), kind=kind,
                         max_detections=max_detections, pfa=cfar.pfa, windowed=windowed,

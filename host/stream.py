@@ -46,8 +46,9 @@ MAX_STREAM_PROBLEMS = 1000
 
 
 def cube_frame_words(cfg: RadarConfig) -> int:
-    """Payload words of one radar-cube frame, num_tx * n_range * n_doppler."""
-    return cfg.num_tx * cfg.n_range * cfg.n_doppler
+    """Payload words of one radar-cube frame, num_tx * n_range_bins * n_doppler (a real
+    ADC's frame keeps range bins 0..n_range/2-1)."""
+    return cfg.num_tx * cfg.n_range_bins * cfg.n_doppler
 
 
 def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
@@ -97,7 +98,7 @@ def geometry_from_packet(data: bytes, configs: Iterable[RadarConfig],
 def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig, gain: float = 1.0
                           ) -> np.ndarray:
     """Frame payload, uint32 (frame_words, num_rx) in DMA order -> radar cube complex64
-    (n_virtual, n_range, n_doppler), divided by ``gain`` (the chain's gain over the float
+    (n_virtual, n_range_bins, n_doppler), divided by ``gain`` (the chain's gain over the float
     reference, ``model.radar_pipeline.chain_gain``: float-reference units; 1.0: LSB). Same
     result as ``model.reference.dma_order_to_cube(model.axis_packetizer.payload_to_cube(
     ...)) / gain``, several times faster on a ``full`` frame: the 32-bit {Q, I} words are
@@ -105,10 +106,10 @@ def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig, gain: float = 1.0
     contiguously. The payload's TX blocks are chirp slots; the cube's channels count TXs by
     index (``model.array.slot_channels``)."""
     w = np.ascontiguousarray(words, dtype="<u4").reshape(
-        cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx)
+        cfg.num_tx, cfg.n_range_bins, cfg.n_doppler, cfg.num_rx)
     if cfg.tx_sequence != tuple(range(cfg.num_tx)):
         w = w[tx_slots(cfg)]                    # slot of each TX index
-    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler), np.uint32)
+    t = np.empty((cfg.num_tx, cfg.num_rx, cfg.n_range_bins, cfg.n_doppler), np.uint32)
     t[...] = w.transpose(0, 3, 1, 2)
     iq = np.empty(t.shape + (2,), np.float32)
     iq[...] = t.view("<i2").reshape(t.shape + (2,))  # I: low half of the word, Q: high
@@ -121,9 +122,9 @@ def payload_words_to_cube(words: np.ndarray, cfg: RadarConfig, gain: float = 1.0
 class Frame:
     """One decoded frame.
 
-    ``cube``: complex64 (n_virtual, n_range, n_doppler) in the payload's LSB, zeros where
-    words are missing.
-    ``valid``: bool (num_tx, n_range, n_doppler): True where the word arrived intact.
+    ``cube``: complex64 (n_virtual, n_range_bins, n_doppler) in the payload's LSB, zeros
+    where words are missing.
+    ``valid``: bool (num_tx, n_range_bins, n_doppler): True where the word arrived intact.
     ``problems``: what is wrong with the frame (empty when ``complete``).
     """
 
@@ -425,5 +426,5 @@ class StreamDecoder(PacketDecoder[Frame]):
                     problems: list[str]) -> Frame:
         cfg = self.cfg
         return Frame(frame_id=fid, cube=payload_words_to_cube(words, cfg),
-                     valid=valid.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler),
+                     valid=valid.reshape(cfg.num_tx, cfg.n_range_bins, cfg.n_doppler),
                      problems=problems)

@@ -13,6 +13,11 @@ Output order (Doppler vectors): word ``j = (t * n_range + r) * n_doppler + d``, 
 ``j = (r * num_tx + t) * n_doppler + d``, i.e. ``(n_range, num_tx, n_doppler, num_rx)``.
 Order 0 maps output j to input ``p(j) = rotl(j, ROT)``; order 1 to a bit permutation
 ``p(j)[a] = j[sigma(a)]``; the in-place scheme writes frame k at ``p^k`` for both.
+
+``n_loops < n_doppler`` (the RTL's N_LOOPS: fewer loops than the Doppler FFT length): a frame
+is the ``n_loops`` chirps per TX (the input indices i < num_tx * n_range * n_loops) and each
+output vector ``n_loops`` words (the output indices with d < n_loops); the memory and the
+address scheme stay those of ``n_doppler`` loops, the counters skip the missing words.
 """
 
 from __future__ import annotations
@@ -28,16 +33,17 @@ def _log2(n: int, name: str) -> int:
 
 
 def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
-                read_order: int = 0) -> np.ndarray:
+                read_order: int = 0, n_loops: int | None = None) -> np.ndarray:
     """Reorder one frame from chirp order to Doppler-vector order.
 
-    frame: ``(num_tx * n_doppler * n_range, num_rx)`` words in input order.
-    Returns ``(num_tx * n_range * n_doppler, num_rx)`` words in output order
+    frame: ``(num_tx * n_loops * n_range, num_rx)`` words in input order (``n_loops``
+    default ``n_doppler``).
+    Returns ``(num_tx * n_range * n_loops, num_rx)`` words in output order
     (``read_order`` 0: (t, r, d); 1: (r, t, d)).
     """
     frame = np.asarray(frame)
     num_rx = frame.shape[-1]
-    cube = frame.reshape(n_doppler, num_tx, n_range, num_rx)
+    cube = frame.reshape(n_doppler if n_loops is None else n_loops, num_tx, n_range, num_rx)
     axes = (1, 2, 0, 3) if read_order == 0 else (2, 1, 0, 3)
     return np.ascontiguousarray(cube.transpose(*axes)).reshape(-1, num_rx)
 
@@ -92,26 +98,38 @@ def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
 
 
 def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
-                    n_doppler: int, read_order: int = 0) -> list[np.ndarray]:
-    """Run the in-place address scheme on a one-frame memory (checks the method itself).
+                    n_doppler: int, read_order: int = 0, n_loops: int | None = None
+                    ) -> list[np.ndarray]:
+    """Run the in-place address scheme on a one-frame memory (checks the method itself),
+    writing and reading only the words of ``n_loops`` loops (default ``n_doppler``), in
+    the RTL's order: word i of frame k+1 is written only after read i of frame k.
 
-    frames: list of input frames ``(frame_words, num_rx)``. Returns the output frames. Raises
-    AssertionError if a slot would be overwritten before being read.
+    frames: list of input frames ``(num_tx * n_loops * n_range, num_rx)``. Returns the
+    output frames. Raises AssertionError if a slot would be overwritten before being read.
     """
     if not frames:
         return []
     b, _ = address_bits(num_tx, n_range, n_doppler)
+    n_loops = n_doppler if n_loops is None else n_loops
+    live_in = np.arange(num_tx * n_range * n_loops)            # input indices that exist
+    live_out = np.flatnonzero(np.arange(1 << b) % n_doppler < n_loops)
     mem = np.zeros((1 << b,) + frames[0].shape[1:], dtype=frames[0].dtype)
-    read = np.ones(1 << b, dtype=bool)
+    unread = np.zeros(1 << b, dtype=bool)
     out = []
     for k, f in enumerate(frames):
-        wa = write_addresses(k, num_tx, n_range, n_doppler, read_order)
-        assert read[wa].all(), "in-place scheme overwrote an unread slot"
-        mem[wa] = f
-        read[:] = False
-        ra = read_addresses(k, num_tx, n_range, n_doppler, read_order)
+        wa = write_addresses(k, num_tx, n_range, n_doppler, read_order)[live_in]
+        ra = read_addresses(k - 1, num_tx, n_range, n_doppler, read_order) if k else []
+        done = 0                                        # frame k-1's reads issued
+        for i, slot in zip(live_in, wa, strict=True):   # its reads j <= i came first
+            while k and done < len(live_out) and live_out[done] <= i:
+                unread[ra[live_out[done]]] = False
+                done += 1
+            assert not unread[slot], "in-place scheme overwrote an unread slot"
+            mem[slot] = f[i]
+        unread[:] = False
+        ra = read_addresses(k, num_tx, n_range, n_doppler, read_order)[live_out]
+        unread[ra] = True
         out.append(mem[ra].copy())
-        read[ra] = True
     return out
 
 

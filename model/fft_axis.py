@@ -6,6 +6,9 @@ Arithmetic (identical in RTL and model, stage by stage, lane by lane):
 - Internal width ``W = DATA_W + 1 + GUARD_W`` bits per I/Q component: one integer guard bit
   and ``GUARD_W`` fraction bits. The input is ``x << GUARD_W`` or, with the window,
   ``rnd(x * HANN[n*4096/N], 16 - GUARD_W)``.
+- Zero fill (the RTL's N_IN < N): a vector of ``n_in`` samples is windowed over its own count
+  (``model.fft_rom.hann_window(n_in)``), then zeros up to N; the RTL's N_OUT keeps the
+  first bins of the natural-order output (the caller slices them).
 - Decimation in frequency, ``L = log2 N`` radix-2 butterfly stages ``s = 0..L-1`` of span
   ``D = N >> (s+1)``, grouped in radix-2^2 pairs (s even = BF-I, s odd = BF-II). BF-II
   multiplies its second input by ``-j`` (``+j`` for the inverse) when bit ``log2(2D)`` of the
@@ -108,6 +111,11 @@ def _check(n: int, data_w: int, guard_w: int) -> None:
         raise ValueError(f"GUARD_W={guard_w}: need 0..16 and DATA_W+1+GUARD_W <= 27")
 
 
+def _check_n_in(n_in: int, n: int) -> None:
+    if not 2 <= n_in <= n:
+        raise ValueError(f"N_IN={n_in}: must be 2..N ({n})")
+
+
 def _as_frames(x: np.ndarray) -> np.ndarray:
     x = np.asarray(x)
     if x.ndim == 2:
@@ -119,17 +127,20 @@ def _as_frames(x: np.ndarray) -> np.ndarray:
 
 def fft_fixed_reference(x: np.ndarray, *, inverse: bool = False, window: bool = False,
                         scale_sch: int | None = None, data_w: int = 16,
-                        guard_w: int = 4) -> FftFixedResult:
+                        guard_w: int = 4, n_fft: int | None = None) -> FftFixedResult:
     """Bit-accurate fixed-point FFT of ``fft_axis``, stage by stage in int64: the plain
     statement of the arithmetic above, kept as the reference of :func:`fft_fixed`.
 
-    ``x``: complex (frames, N, lanes) or (frames, N) with integer-valued I/Q in
-    ``[-2**(data_w-1), 2**(data_w-1)-1]``. ``scale_sch``: bit s = 1 divides stage s by 2
-    (default all ones: 1/N overall). Returns :class:`FftFixedResult` (natural order).
+    ``x``: complex (frames, N_IN, lanes) or (frames, N_IN) with integer-valued I/Q in
+    ``[-2**(data_w-1), 2**(data_w-1)-1]``; ``n_fft``: the transform length N (default N_IN;
+    larger: zero fill after the window). ``scale_sch``: bit s = 1 divides stage s by 2
+    (default all ones: 1/N overall). Returns :class:`FftFixedResult` (natural order, N bins).
     """
     x = _as_frames(x)
-    frames, n, lanes = x.shape
+    frames, n_in, lanes = x.shape
+    n = n_in if n_fft is None else n_fft
     _check(n, data_w, guard_w)
+    _check_n_in(n_in, n)
     lg = n.bit_length() - 1
     if scale_sch is None:
         scale_sch = default_scale_sch(n)
@@ -141,12 +152,15 @@ def fft_fixed_reference(x: np.ndarray, *, inverse: bool = False, window: bool = 
             or im.max(initial=0) >= lim:
         raise ValueError(f"input does not fit {data_w}-bit two's complement")
     if window:
-        h = hann_window(n)[None, :, None]
+        h = hann_window(n_in)[None, :, None]
         re = rnd(re * h, COEF_FRAC - guard_w)
         im = rnd(im * h, COEF_FRAC - guard_w)
     else:
         re = re << guard_w
         im = im << guard_w
+    if n > n_in:
+        pad = ((0, 0), (0, n - n_in), (0, 0))
+        re, im = np.pad(re, pad), np.pad(im, pad)
     ov = np.zeros((frames, n), dtype=bool)
     cos_t, sin_t = cos_table(), sin_table()
 
@@ -306,18 +320,21 @@ def _fft_chunk(p: np.ndarray, n: int, inverse: bool, scale_sch: int, w: int, gua
 
 
 def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = False,
-                     scale_sch: int | None = None, data_w: int = 16, guard_w: int = 4
-                     ) -> tuple[np.ndarray, np.ndarray]:
+                     scale_sch: int | None = None, data_w: int = 16, guard_w: int = 4,
+                     n_fft: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Fast bit-accurate ``fft_axis`` on planar I/Q, identical to :func:`fft_fixed_reference`.
 
-    ``p``: real array (frames, N, lanes, 2) of integer I (index 0) and Q (index 1) in
-    ``data_w``-bit range. Returns (array (frames, N, lanes, 2) of the integer outputs in
+    ``p``: real array (frames, N_IN, lanes, 2) of integer I (index 0) and Q (index 1) in
+    ``data_w``-bit range; ``n_fft``: the transform length N (default N_IN; larger: zero fill
+    after the window). Returns (array (frames, N, lanes, 2) of the integer outputs in
     natural bin order, dtype :func:`planar_dtype`; bool (frames, N) overflow per beat).
     """
     if p.ndim != 4 or p.shape[-1] != 2:
         raise ValueError("planar input must be (frames, N, lanes, 2)")
-    frames, n, lanes, _ = p.shape
+    frames, n_in, lanes, _ = p.shape
+    n = n_in if n_fft is None else n_fft
     _check(n, data_w, guard_w)
+    _check_n_in(n_in, n)
     lg = n.bit_length() - 1
     if scale_sch is None:
         scale_sch = default_scale_sch(n)
@@ -334,7 +351,7 @@ def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = Fal
             sgn = 1.0 if inverse else -1.0        # (re + j im) * (C -+ j S)
             tw[s] = (cos_t[kk] + 1j * sgn * sin_t[kk]) * 2.0 ** -COEF_FRAC
     # window and its rounding shift in one exact factor (x * h < 2**31, scaled by 2**-k)
-    h = (hann_window(n) * 2.0 ** (guard_w - COEF_FRAC))[None, :, None, None] if window \
+    h = (hann_window(n_in) * 2.0 ** (guard_w - COEF_FRAC))[None, :, None, None] if window \
         else None
     br = bitrev(n)
     y = np.empty((frames, n, lanes, 2), dtype=dt)
@@ -346,6 +363,8 @@ def fft_fixed_planar(p: np.ndarray, *, inverse: bool = False, window: bool = Fal
             x = np.rint(p[sl] * h).astype(dt, order="C")
         else:
             x = p[sl].astype(dt, order="C") * float(1 << guard_w)
+        if n > n_in:                                    # the zero fill
+            x = np.concatenate([x, np.zeros((x.shape[0], n - n_in, lanes, 2), dt)], axis=1)
         out, o = _fft_chunk(x, n, inverse, scale_sch, w, guard_w, data_w, tw)
         y[sl] = out[:, br]
         if o is not None:
@@ -369,33 +388,37 @@ def from_planar(p: np.ndarray) -> np.ndarray:
 
 def fft_fixed(x: np.ndarray, *, inverse: bool = False, window: bool = False,
               scale_sch: int | None = None, data_w: int = 16,
-              guard_w: int = 4) -> FftFixedResult:
+              guard_w: int = 4, n_fft: int | None = None) -> FftFixedResult:
     """Bit-accurate fixed-point FFT of ``fft_axis`` (fast path, identical results to
     :func:`fft_fixed_reference`).
 
-    ``x``: complex (frames, N, lanes) or (frames, N) with integer-valued I/Q in
-    ``[-2**(data_w-1), 2**(data_w-1)-1]``. ``scale_sch``: bit s = 1 divides stage s by 2
-    (default all ones: 1/N overall). Returns :class:`FftFixedResult` (natural order).
+    ``x``: complex (frames, N_IN, lanes) or (frames, N_IN) with integer-valued I/Q in
+    ``[-2**(data_w-1), 2**(data_w-1)-1]``; ``n_fft``: N (default N_IN; larger: zero fill).
+    ``scale_sch``: bit s = 1 divides stage s by 2 (default all ones: 1/N overall). Returns
+    :class:`FftFixedResult` (natural order, N bins).
     """
     x = _as_frames(x)
     y, ov = fft_fixed_planar(to_planar(x), inverse=inverse, window=window,
-                             scale_sch=scale_sch, data_w=data_w, guard_w=guard_w)
+                             scale_sch=scale_sch, data_w=data_w, guard_w=guard_w,
+                             n_fft=n_fft)
     return FftFixedResult(y=from_planar(y), overflow=ov)
 
 
 def fft_float(x: np.ndarray, *, inverse: bool = False, window: bool = False,
-              scale_sch: int | None = None) -> np.ndarray:
+              scale_sch: int | None = None, n_fft: int | None = None) -> np.ndarray:
     """float64 reference: complex128 (frames, N, lanes) = DFT (IDFT sign for ``inverse``)
-    of the (ideal periodic Hann windowed) input divided by 2**(number of scaled stages)."""
+    of the (ideal periodic Hann windowed over its N_IN samples, zero-filled to ``n_fft``)
+    input divided by 2**(number of scaled stages)."""
     x = _as_frames(x).astype(np.complex128)
-    n = x.shape[1]
+    n_in = x.shape[1]
+    n = n_in if n_fft is None else n_fft
     if scale_sch is None:
         scale_sch = default_scale_sch(n)
     lg = n.bit_length() - 1
     scale = 2.0 ** -bin(scale_sch & ((1 << lg) - 1)).count("1")
     if window:
-        x = x * (0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n) / n))[None, :, None]
-    y = np.fft.ifft(x, axis=1) * n if inverse else np.fft.fft(x, axis=1)
+        x = x * (0.5 - 0.5 * np.cos(2 * np.pi * np.arange(n_in) / n_in))[None, :, None]
+    y = np.fft.ifft(x, n=n, axis=1) * n if inverse else np.fft.fft(x, n=n, axis=1)
     return y * scale
 
 

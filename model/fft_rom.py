@@ -1,6 +1,6 @@
 """Single source of the FFT coefficient ROMs shared by the RTL (``rtl/fft/fft_rom_pkg.sv``,
-``rtl/fft/fft_twiddle_rom.sv``, ``rtl/fft/fft_hann_rom.sv``) and the bit-accurate model
-(:mod:`model.fft_axis`).
+``rtl/fft/fft_twiddle_rom.sv``, ``rtl/fft/fft_hann_rom.sv``, ``rtl/fft/fft_win_rom.sv``) and
+the bit-accurate models (:mod:`model.fft_axis`, :mod:`model.static_removal`).
 
 Two tables of ``ROM_SIZE = 4096`` entries define every coefficient for N = 16..4096:
 
@@ -9,6 +9,13 @@ Two tables of ``ROM_SIZE = 4096`` entries define every coefficient for N = 16..4
   ``W_M^e`` of an M-point stage is ``COS[e*4096/M] - j*SIN[e*4096/M]``.
 - ``HANN[k] = rint(2**16 * (0.5 - 0.5*cos(2*pi*k/4096)))``: periodic Hann, Q1.16, 0..65536;
   the N-point window is ``HANN[n*4096/N]`` (exactly the periodic N-point Hann sampled).
+
+A window over a count ``n`` that is not a power of two (a profile's samples per chirp or
+loops per frame below the FFT length, zero-padded, docs/profiles.md) is its own table,
+``rint(2**16 * (0.5 - 0.5*cos(2*pi*k/n)))`` for ``n`` in :data:`WINDOW_LENGTHS`, generated
+into ``fft_win_rom`` (which reads ``fft_hann_rom`` for powers of two, so both FFT axes and
+the static-clutter removal take every window from it). Every table sums to ``n * 2**15``
+like the powers of two (the static removal's divisor; :func:`check_window_sums`).
 
 ``rint`` is numpy's round-half-to-even. The model uses these full tables. The RTL stores only
 quarter waves and rebuilds every entry by symmetry from the quadrant ``q = k >> 10`` and the
@@ -56,6 +63,13 @@ RTL_FFT = Path(__file__).resolve().parents[1] / "rtl" / "fft"
 PKG_PATH = RTL_FFT / "fft_rom_pkg.sv"
 TWIDDLE_ROM_PATH = RTL_FFT / "fft_twiddle_rom.sv"
 HANN_ROM_PATH = RTL_FFT / "fft_hann_rom.sv"
+WIN_ROM_PATH = RTL_FFT / "fft_win_rom.sv"
+
+WINDOW_LENGTHS = (15, 50, 200, 255)
+"""Window lengths other than powers of two that ``fft_win_rom`` holds a table for: the TI
+settings' 200 samples per chirp and 255 loops, and the small shapes of the testbenches
+(15 of 16, 50 of 64). Another profile's count is added here and ``make gen`` run
+(``model.hdl.hdl_unsupported`` names it until then)."""
 
 
 def cos_table() -> np.ndarray:
@@ -77,8 +91,12 @@ def hann_table() -> np.ndarray:
 
 
 def hann_window(n: int) -> np.ndarray:
-    """int64 (n,): the quantized n-point periodic Hann window used by the RTL (Q1.16)."""
-    return hann_table()[np.arange(n) * (ROM_SIZE // n)]
+    """int64 (n,): the quantized n-point periodic Hann window used by the RTL (Q1.16):
+    ``HANN[k*4096/n]`` for a power of two n (exactly the n-point window rounded), else
+    ``rint(2**16 * hann_periodic(n))`` (the ``fft_win_rom`` table of n, n in 2..4096)."""
+    if n & (n - 1) == 0:
+        return hann_table()[np.arange(n) * (ROM_SIZE // n)]
+    return np.rint((1 << COEF_FRAC) * hann_periodic(n)).astype(np.int64)
 
 
 def twiddle_quarters() -> tuple[np.ndarray, np.ndarray]:
@@ -109,6 +127,15 @@ def hann_from_quarters(k: np.ndarray) -> np.ndarray:
     q, r = np.asarray(k) >> (ROM_LOG2 - 2), np.asarray(k) & (QUARTER - 1)
     one = 1 << COEF_FRAC
     return np.select([q == 0, q == 1, q == 2], [h0[r], one - h3[r], one - h0[r]], h3[r])
+
+
+def check_window_sums() -> None:
+    """Raise unless every window of :data:`WINDOW_LENGTHS` sums to ``n * 2**15`` exactly
+    (what ``static_removal`` divides by; the powers of two do by symmetry)."""
+    for n in WINDOW_LENGTHS:
+        if int(hann_window(n).sum()) != n << (COEF_FRAC - 1):
+            raise ValueError(f"the {n}-point window sums to {int(hann_window(n).sum())}, not "
+                             f"{n} * 2**{COEF_FRAC - 1}: static_removal's divisor needs it")
 
 
 def check_quarters() -> None:
@@ -149,6 +176,11 @@ def render_rom_pkg() -> str:
         "  // Coefficient width (signed two's complement) and fraction bits (Q1.16).\n"
         f"  localparam int COEF_W = {COEF_W};\n"
         f"  localparam int COEF_FRAC = {COEF_FRAC};\n"
+        "  // 1 when fft_win_rom holds an n-point window (a power of two or WINDOW_LENGTHS).\n"
+        "  function automatic bit has_window(input int n);\n"
+        "    has_window = (n >= 2 && n <= ROM_SIZE && (n & (n - 1)) == 0)"
+        + "".join(f" || n == {n}" for n in WINDOW_LENGTHS) + ";\n"
+        "  endfunction\n"
         "endpackage\n/* verilator lint_on UNUSEDPARAM */\n\n`default_nettype wire\n"
     )
 
@@ -212,11 +244,45 @@ def render_hann_rom() -> str:
     )
 
 
+def render_win_rom() -> str:
+    """Text of ``rtl/fft/fft_win_rom.sv``: the N-point window for any N of the chain."""
+    tables = []
+    for n in WINDOW_LENGTHS:
+        items = "".join(f"        {ROM_LOG2}'d{k}: w_o = {COEF_W}'h{int(v):05X};\n"
+                        for k, v in enumerate(hann_window(n)))
+        tables.append(f"  end else if (N == {n}) begin : g_{n}\n    always_comb begin\n"
+                      f"      case (k)\n{items}        default: w_o = '0;\n      endcase\n"
+                      "    end\n")
+    return (
+        _HEADER.format(what="Window ROM of any length N: HANN(k * 4096/N) of fft_hann_rom "
+                       "for a power of two N,\n// else the N-point table "
+                       "rint(2^16 (0.5 - 0.5 cos(2 pi k/N))) of WINDOW_LENGTHS")
+        + "module fft_win_rom #(\n"
+        "  // Window length (samples), 2..4096: a power of two or one of WINDOW_LENGTHS.\n"
+        "  parameter int N = 64\n"
+        ") (\n"
+        "  // Sample index 0..N-1 (0 past N-1).\n"
+        "  input  logic [fft_rom_pkg::ROM_LOG2-1:0] k,\n"
+        "  // Q1.16 window value 0..65536 (non-negative, 18-bit signed); combinational.\n"
+        "  output logic [fft_rom_pkg::COEF_W-1:0]   w_o\n"
+        ");\n"
+        "  if (N >= 2 && N <= fft_rom_pkg::ROM_SIZE && (N & (N - 1)) == 0) begin : g_pow2\n"
+        "    fft_hann_rom u_rom (.k(k << (fft_rom_pkg::ROM_LOG2 - $clog2(N))), .hann_o(w_o));\n"
+        + "".join(tables)
+        + "  end else begin : g_bad_n\n"
+        "    $fatal(1, \"%m: N=%0d: no window ROM of that length (add it to "
+        "model.fft_rom.WINDOW_LENGTHS, make gen)\", N);\n"
+        "  end\n"
+        "endmodule\n\n`default_nettype wire\n"
+    )
+
+
 def generated_files() -> dict[Path, str]:
     """Every generated RTL file and the text it must have (checked quarter tables)."""
     check_quarters()
+    check_window_sums()
     return {PKG_PATH: render_rom_pkg(), TWIDDLE_ROM_PATH: render_twiddle_rom(),
-            HANN_ROM_PATH: render_hann_rom()}
+            HANN_ROM_PATH: render_hann_rom(), WIN_ROM_PATH: render_win_rom()}
 
 
 def stale_files() -> list[Path]:

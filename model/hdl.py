@@ -6,6 +6,7 @@ width), in one place for the tests, the frame sources and synthesis."""
 from __future__ import annotations
 
 from model.config import RadarConfig
+from model.fft_rom import WINDOW_LENGTHS
 
 DATA_W = 16
 """Bits of I and of Q on every sample stream of the RTL (docs/design.md section 3)."""
@@ -22,10 +23,12 @@ ZCU106 PL DDR4 through MIG, 512-bit user interface at the 100 MHz fabric clock
 
 def hdl_parameters(cfg: RadarConfig, **overrides: int) -> dict[str, int]:
     """The HDL parameters a radar configuration gives the RTL: NUM_RX, NUM_TX, N_RANGE,
-    N_DOPPLER and DATA_W, then ``overrides`` (e.g. ``PACKET_WORDS=1024``) added or replacing.
-    The one place that maps a preset to HDL parameters (tests, RTL source, synthesis)."""
+    N_DOPPLER (the FFT lengths), N_SAMPLES (samples per chirp), N_LOOPS (loops per frame),
+    REAL_ADC and DATA_W, then ``overrides`` (e.g. ``PACKET_WORDS=1024``) added or replacing.
+    The one place that maps a profile to HDL parameters (tests, RTL source, synthesis)."""
     params = {"NUM_RX": cfg.num_rx, "NUM_TX": cfg.num_tx, "N_RANGE": cfg.n_range,
-              "N_DOPPLER": cfg.n_doppler, "DATA_W": DATA_W}
+              "N_DOPPLER": cfg.n_doppler, "N_SAMPLES": cfg.n_samples, "N_LOOPS": cfg.n_loops,
+              "REAL_ADC": int(cfg.adc == "real"), "DATA_W": DATA_W}
     params.update(overrides)
     return params
 
@@ -40,9 +43,17 @@ def hdl_unsupported(cfg: RadarConfig) -> list[str]:
     """What of ``cfg`` the ``radar_pipeline`` top refuses at elaboration
     (rtl/top/radar_pipeline.sv, its ``g_bad_*`` blocks), one phrase each (empty for the
     presets): more than MAX_NUM_RX RX, a TX count that is not a power of two up to
-    MAX_NUM_TX, ADC codes wider than the DATA_W-bit sample streams. Every RadarConfig's FFT
-    lengths (powers of two in 16..4096) are the top's already."""
+    MAX_NUM_TX, ADC codes wider than the DATA_W-bit sample streams, a sample or loop count
+    with no generated window ROM (a power of two or ``model.fft_rom.WINDOW_LENGTHS``; the
+    chain windows both axes), a single loop per frame. Every RadarConfig's FFT lengths
+    (powers of two in 16..4096) are the top's already."""
     out = []
+    for name, value in (("samples per chirp", cfg.n_samples), ("loops", cfg.n_loops)):
+        if value & (value - 1) and value not in WINDOW_LENGTHS:
+            out.append(f"{value} {name} (no window ROM of that length: add it to "
+                       "model.fft_rom.WINDOW_LENGTHS and run make gen)")
+    if cfg.n_loops < 2:
+        out.append("1 loop per frame (N_LOOPS at least 2)")
     if cfg.num_rx > MAX_NUM_RX:
         out.append(f"{cfg.num_rx} RX (NUM_RX at most {MAX_NUM_RX})")
     if cfg.num_tx > MAX_NUM_TX or cfg.num_tx & (cfg.num_tx - 1):

@@ -75,29 +75,3 @@ def unsupported_features(cfg: RadarConfig) -> list[str]:
     today (zero padding, a real ADC, any firing order, non-uniform and 2-D virtual arrays
     are processed); ``RadarConfig.check_processable`` and ``radar profile show`` read it."""
     return []
-
-
-def preset_chain_features(cfg: RadarConfig) -> list[str]:
-    """What of ``cfg`` the presets' fixed-point chain (the bit-accurate model, the RTL) does
-    not run, one phrase each (empty for the presets): zero padding, a real ADC. The TX
-    firing order and the array's geometry are the host's (the chain's channels are chirp
-    slots, ``model.array.slot_channels``; ``host.tdm`` and ``host.angle`` apply the rest)."""
-    out = []
-    if cfg.n_samples != cfg.n_range:
-        out.append(f"{cfg.n_samples} samples per chirp zero-padded to a {cfg.n_range}-point "
-                   "range FFT")
-    if cfg.n_loops != cfg.n_doppler:
-        out.append(f"{cfg.n_loops} loops zero-padded to a {cfg.n_doppler}-point Doppler FFT")
-    if cfg.adc != "complex":
-        out.append("real-valued ADC")
-    return out
-
-
-def check_preset_chain(cfg: RadarConfig) -> None:
-    """ValueError (one line) naming what of ``cfg`` the bit-accurate model and the RTL (the
-    presets' chain) do not handle (:func:`preset_chain_features`); the float chain
-    processes profiles."""
-    missing = preset_chain_features(cfg)
-    if missing:
-        raise ValueError(f"radar {cfg.name!r}: the bit-accurate model and the RTL do not "
-                         f"handle {'; '.join(missing)} yet (the float chain does)")

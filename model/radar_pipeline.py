@@ -8,6 +8,11 @@ the block models: ADC frame in, DMA packets out, identical to the RTL for loss-f
     -> Doppler ``fft_axis`` (Hann window, SCALE_SCH = doppler_scale_sch) model.fft_axis
     -> packetizer (header, PACKET_WORDS payload words, CRC word, TLAST)  model.axis_packetizer
 
+Any radar's shape (docs/profiles.md): ``cfg.n_samples`` samples per chirp and ``cfg.n_loops``
+loops per frame, each windowed over its own count and zero-filled to the FFT length inside
+the FFT (the RTL's N_SAMPLES, N_LOOPS); a real ADC (REAL_ADC) keeps range bins
+0..n_range/2-1, ``cfg.n_range_bins``, through the corner turn, the detector and the DMA.
+
 ``output_mode = 1`` (on-chip detection, docs/design.md 3.4, docs/detect.md): the corner turn reads
 (r, t, d) (``read_order = 1``), the Doppler FFT output goes through the detector
 (``model.detect_chain``: NCI, 2-D CFAR, records) and the record stream, a fixed
@@ -42,13 +47,18 @@ from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, from_planar, to_planar
 from model.frame_store_axi import StoreGeometry, store_frames
-from model.hdl import DATA_W, hdl_parameters
-from model.profile_fields import check_preset_chain
+from model.hdl import DATA_W, check_hdl, hdl_parameters
 from model.reference import hann_periodic
 from model.static_removal import remove_static_planar
 
 RANGE_SCALE_SCH = 0xFFF
 """Range FFT scaling schedule: every stage halves (1/N overall, the Xilinx default)."""
+REAL_RANGE_SCALE_SCH = 0xFFE
+"""Range FFT scaling schedule of a real ADC: the first stage unscaled (2/N). A real tone's
+amplitude splits between bin k and its mirror N - k, so its bin is half a complex tone's
+and the gain of 2 cannot overflow; at 1/N the range FFT's rounding (its noise then well
+under 1 LSB) puts Doppler spurs of strong targets above the CFAR threshold (4 false alarms
+in 8 simulated frames where the float chain has none, tests/test_real_chain.py)."""
 DOPPLER_SCALE_SCH = 0x555
 """Doppler FFT scaling schedule: every other stage halves (1/sqrt(N) for even log2 N)."""
 
@@ -62,7 +72,8 @@ class PipelineParams:
     """HDL parameters of ``radar_pipeline`` beyond the radar configuration.
 
     ``packet_words``: PACKET_WORDS; ``window``: WINDOW (periodic Hann before both FFTs);
-    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH; ``header``: HEADER;
+    ``range_scale_sch`` / ``doppler_scale_sch``: the FFTs' SCALE_SCH (``range_scale_sch``
+    None: :meth:`range_schedule` picks it by the ADC); ``header``: HEADER;
     ``frame_store``: FRAME_STORE (corner turn in external memory over AXI4, same payload),
     ``axi_data_w`` / ``fs_tile_r``: its AXI_DATA_W and FS_TILE_R (None:
     :meth:`store_tile_r` picks it); ``output_mode``:
@@ -76,7 +87,7 @@ class PipelineParams:
 
     packet_words: int = 1024
     window: bool = True
-    range_scale_sch: int = RANGE_SCALE_SCH
+    range_scale_sch: int | None = None
     doppler_scale_sch: int = DOPPLER_SCALE_SCH
     header: bool = True
     frame_store: bool = False
@@ -86,17 +97,24 @@ class PipelineParams:
     detect: DetectConfig | None = None
     static_removal: bool = False
 
+    def range_schedule(self, cfg: RadarConfig) -> int:
+        """RANGE_SCALE_SCH: ``range_scale_sch`` if given, else :data:`RANGE_SCALE_SCH`
+        (complex ADC) or :data:`REAL_RANGE_SCALE_SCH` (real ADC)."""
+        if self.range_scale_sch is not None:
+            return self.range_scale_sch
+        return REAL_RANGE_SCALE_SCH if cfg.adc == "real" else RANGE_SCALE_SCH
+
     def detect_config(self, cfg: RadarConfig) -> DetectConfig:
         """The detector of mode 1: ``detect`` (its sizes checked against ``cfg``) or the
         defaults of :class:`model.detect_chain.DetectConfig` sized for ``cfg``, windows as
         ``window``, reporting only ``cfg.detection_bins`` (the host CFAR's rule)."""
         if self.detect is None:
-            return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+            return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range_bins,
                                 n_doppler=cfg.n_doppler, windowed=(self.window, self.window),
                                 report=cfg.detection_bins)
         d = self.detect
         got = (d.num_tx, d.num_rx, d.n_range, d.n_doppler)
-        want = (cfg.num_tx, cfg.num_rx, cfg.n_range, cfg.n_doppler)
+        want = (cfg.num_tx, cfg.num_rx, cfg.n_range_bins, cfg.n_doppler)
         if got != want:
             raise ValueError(f"detect: sizes (num_tx, num_rx, n_range, n_doppler) {got} do not "
                              f"match the radar configuration's {want}")
@@ -111,21 +129,21 @@ class PipelineParams:
             return self.fs_tile_r
         group = cfg.num_tx if self.output_mode == 1 else 1
         beat_words = max(1, self.axi_data_w // (cfg.num_rx * 32))
-        return min(cfg.n_range, max(FS_TILE_WORDS // group, beat_words, 1))
+        return min(cfg.n_range_bins, max(FS_TILE_WORDS // group, beat_words, 1))
 
     def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
         """The external frame store's geometry (FRAME_STORE = 1); its read order is the
         corner turn's, ``output_mode`` ((t, r, d) for the cube, (r, t, d) for detection)."""
-        return StoreGeometry(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range,
+        return StoreGeometry(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range_bins,
                              n_doppler=cfg.n_doppler, tile_r=self.store_tile_r(cfg),
                              axi_data_w=self.axi_data_w, read_order=self.output_mode)
 
     def frame_words(self, cfg: RadarConfig) -> int:
-        """Payload words per frame: num_tx * n_range * n_doppler (mode 0), the record
+        """Payload words per frame: num_tx * n_range_bins * n_doppler (mode 0), the record
         stream's fixed ``DetectConfig.frame_words`` (mode 1)."""
         if self.output_mode == 1:
             return self.detect_config(cfg).frame_words
-        return cfg.num_tx * cfg.n_range * cfg.n_doppler
+        return cfg.num_tx * cfg.n_range_bins * cfg.n_doppler
 
     def hdl_parameters(self, cfg: RadarConfig) -> dict[str, int]:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
@@ -144,9 +162,9 @@ class PipelineParams:
                          BLANK_TOP=d["BLANK_TOP"], SCALE_W=d["SCALE_W"],
                          SCALE_FRAC=d["SCALE_FRAC"], MAX_DETECTIONS=d["MAX_DETECTIONS"],
                          REPORT_LO=d.get("REPORT_LO", 0),
-                         REPORT_HI=d.get("REPORT_HI", cfg.n_range))
+                         REPORT_HI=d.get("REPORT_HI", cfg.n_range_bins))
         return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
-                              RANGE_SCALE_SCH=self.range_scale_sch,
+                              RANGE_SCALE_SCH=self.range_schedule(cfg),
                               DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),
                               **store)
 
@@ -158,7 +176,11 @@ class PipelineParams:
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a radar or a combination the RTL refuses at elaboration."""
-        check_preset_chain(cfg)
+        check_hdl(cfg)
+        if self.frame_store and cfg.n_loops != cfg.n_doppler:
+            raise ValueError(f"radar {cfg.name!r}: {cfg.n_loops} loops of a "
+                             f"{cfg.n_doppler}-point Doppler FFT: the external frame store "
+                             "(FRAME_STORE = 1) holds whole N_DOPPLER loops only")
         self.check_mode(cfg)
         check_geometry(self.frame_words(cfg), self.packet_words)
 
@@ -178,7 +200,7 @@ def _stage_gain(n: int, sch: int) -> float:
 
 def chain_gain(cfg: RadarConfig, params: PipelineParams) -> float:
     """Gain of the fixed-point cube over ``model.reference.radar_cube`` (same windows)."""
-    return (_stage_gain(cfg.n_range, params.range_scale_sch)
+    return (_stage_gain(cfg.n_range, params.range_schedule(cfg))
             * _stage_gain(cfg.n_doppler, params.doppler_scale_sch))
 
 
@@ -207,7 +229,7 @@ def range_scale_for_peak(cfg: RadarConfig, peak: float, params: PipelineParams |
 class ChainOutput:
     """One frame through the chain.
 
-    ``payload``: complex (num_tx, n_range, n_doppler, num_rx) integer-valued, DMA order;
+    ``payload``: complex (num_tx, n_range_bins, n_doppler, num_rx) integer-valued, DMA order;
     ``range_overflow`` / ``doppler_overflow``: output beats of each FFT whose computation
     saturated (the RTL's event_overflow pulses); ``records`` (mode 1 only, else None): the
     detector's record stream of this frame as the first frame after reset, uint32
@@ -220,14 +242,15 @@ class ChainOutput:
     records: np.ndarray | None = None
 
     def cube(self) -> np.ndarray:
-        """Radar cube complex (n_virtual, n_range, n_doppler), integer-valued."""
+        """Radar cube complex (n_virtual, n_range_bins, n_doppler), integer-valued."""
         num_tx, n_range, n_doppler, num_rx = self.payload.shape
         return self.payload.transpose(0, 3, 1, 2).reshape(num_tx * num_rx, n_range, n_doppler)
 
 
 def run_chain(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
               ) -> ChainOutput:
-    """ADC frame complex (num_tx * n_doppler, num_rx, n_range) of int16 I/Q -> cube (and, in
+    """ADC frame (num_tx * n_loops, num_rx, n_samples) of int16 I/Q (complex, or real for a
+    real ADC) -> cube (and, in
     mode 1, the record stream of the frame as the first after reset). The FFTs run on planar
     I/Q (``model.fft_axis.fft_fixed_planar``); the stage-by-stage int64 FFT gives the same
     words (the oracle chain of tests/oracles/chain.py, tests/test_model_fast.py)."""
@@ -241,11 +264,12 @@ def chain_output(dop: np.ndarray, rng_ov: int, dop_ov: int, cfg: RadarConfig,
     """The :class:`ChainOutput` of the Doppler-FFT output words ``dop`` (integer-valued
     complex (frame words, num_rx) in the corner turn's read order) and the FFTs' overflow
     beats: the cube, and in mode 1 the frame's detection records."""
+    nr = cfg.n_range_bins
     if params.output_mode == 0:
-        return ChainOutput(dop.reshape(cfg.num_tx, cfg.n_range, cfg.n_doppler, cfg.num_rx),
+        return ChainOutput(dop.reshape(cfg.num_tx, nr, cfg.n_doppler, cfg.num_rx),
                            rng_ov, dop_ov)
     words = pack_iq(dop)
-    payload = dop.reshape(cfg.n_range, cfg.num_tx, cfg.n_doppler, cfg.num_rx)
+    payload = dop.reshape(nr, cfg.num_tx, cfg.n_doppler, cfg.num_rx)
     records = detect_stream([words], params.detect_config(cfg))[0]
     return ChainOutput(payload.transpose(1, 0, 2, 3), rng_ov, dop_ov, records)
 
@@ -255,44 +279,47 @@ def _doppler_out(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams
     """Doppler-FFT output words, integer-valued complex ``(frame words, num_rx)`` in the
     corner turn's read order (mode 0: (t, r, d); mode 1: (r, t, d)), and the overflow beats
     of the range and Doppler FFTs."""
-    check_preset_chain(cfg)
+    check_hdl(cfg)
     cfg.check_adc(adc)
-    order = params.output_mode
-    # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values
-    planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_range, rx, 2)
+    order, nr = params.output_mode, cfg.n_range_bins
+    # same steps on planar I/Q (last axis: I, Q); a word of num_rx lanes is num_rx * 2 values;
+    # a real ADC's samples are the I halves (Q zero)
+    planar = to_planar(np.asarray(adc)).transpose(0, 2, 1, 3)   # (chirps, n_samples, rx, 2)
     rng_p, rng_ov = fft_fixed_planar(planar, window=params.window,
-                                     scale_sch=params.range_scale_sch)
+                                     scale_sch=params.range_schedule(cfg), n_fft=cfg.n_range)
+    rng_p, rng_ov = rng_p[:, :nr], rng_ov[:, :nr]         # REAL_ADC: the positive half
     if params.frame_store:     # through the external layout's bursts and strip buffer
         words = from_planar(rng_p).reshape(-1, cfg.num_rx)
         turned = to_planar(turn(words, cfg, params)).astype(rng_p.dtype)
     else:
-        turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, cfg.n_range,
-                             cfg.n_doppler, read_order=order)
-    vectors = turned.reshape(-1, cfg.n_doppler, cfg.num_rx, 2)
+        turned = corner_turn(rng_p.reshape(-1, 2 * cfg.num_rx), cfg.num_tx, nr,
+                             cfg.n_doppler, read_order=order, n_loops=cfg.n_loops)
+    vectors = turned.reshape(-1, cfg.n_loops, cfg.num_rx, 2)
     if params.static_removal:
         vectors = remove_static_planar(vectors, window=params.window)[0].astype(vectors.dtype)
     dop_p, dop_ov = fft_fixed_planar(vectors, window=params.window,
-                                     scale_sch=params.doppler_scale_sch)
+                                     scale_sch=params.doppler_scale_sch, n_fft=cfg.n_doppler)
     return from_planar(dop_p).reshape(-1, cfg.num_rx), int(rng_ov.sum()), int(dop_ov.sum())
 
 
 def turn(words: np.ndarray, cfg: RadarConfig, params: PipelineParams) -> np.ndarray:
-    """Range-FFT words complex (num_tx * n_doppler * n_range, num_rx), chirp-major input
+    """Range-FFT words complex (num_tx * n_loops * n_range_bins, num_rx), chirp-major input
     order -> Doppler-vector order ((t, r, d) in mode 0, (r, t, d) in mode 1), through the
     on-chip corner turn or, with ``params.frame_store``, through the external store's bursts
     and group buffer in the same read order (the same payload:
     tests/test_frame_store_chain.py)."""
     if params.frame_store:
         return unpack_iq(store_frames([pack_iq(words)], params.store_geometry(cfg))[0])
-    return corner_turn(words, cfg.num_tx, cfg.n_range, cfg.n_doppler,
-                       read_order=params.output_mode)
+    return corner_turn(words, cfg.num_tx, cfg.n_range_bins, cfg.n_doppler,
+                       read_order=params.output_mode, n_loops=cfg.n_loops)
 
 
 def scaled_cube(adc: np.ndarray, cfg: RadarConfig, params: PipelineParams | None = None
                 ) -> np.ndarray:
-    """The chain's cube as the host works with it: complex64 (n_virtual, n_range, n_doppler)
-    divided by :func:`chain_gain` (units of the float reference), its channels by TX index
-    (``model.array.slot_channels``), identical to the cube decoded from the DMA stream."""
+    """The chain's cube as the host works with it: complex64 (n_virtual, n_range_bins,
+    n_doppler) divided by :func:`chain_gain` (units of the float reference), its channels by
+    TX index (``model.array.slot_channels``), identical to the cube decoded from the DMA
+    stream."""
     params = params or PipelineParams()
     cube = run_chain(adc, cfg, params).cube()
     order = slot_channels(cfg)

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from model.axis_packetizer import pack_iq, unpack_iq
-from model.fft_rom import COEF_FRAC, ROM_SIZE, hann_window
+from model.fft_rom import COEF_FRAC, ROM_SIZE, WINDOW_LENGTHS, hann_window
 
 
 def _clog2(n: int) -> int:
@@ -33,18 +33,22 @@ def _clog2(n: int) -> int:
 def weights(n_loops: int, window: bool = True) -> np.ndarray:
     """int64 (n_loops,): the weight of each slow-time sample in the mean -- the Doppler
     window's quantised periodic Hann (Q1.16, ``model.fft_rom.hann_window``, the
-    ``fft_hann_rom`` coefficients; ``n_loops`` a power of two >= 2) with ``window``, else
-    ones."""
+    ``fft_win_rom`` coefficients; ``n_loops`` a power of two in 2..4096 or one of
+    ``model.fft_rom.WINDOW_LENGTHS``) with ``window``, else ones."""
     if not window:
         return np.ones(n_loops, dtype=np.int64)
-    if n_loops < 2 or n_loops & (n_loops - 1) or n_loops > ROM_SIZE:
-        raise ValueError(f"window-weighted mean needs n_loops a power of two in 2..{ROM_SIZE}")
+    if not (2 <= n_loops <= ROM_SIZE and (n_loops & (n_loops - 1) == 0
+                                          or n_loops in WINDOW_LENGTHS)):
+        raise ValueError(f"window-weighted mean needs n_loops a power of two in 2..{ROM_SIZE} "
+                         f"or one of model.fft_rom.WINDOW_LENGTHS {WINDOW_LENGTHS}, got "
+                         f"{n_loops}")
     return hann_window(n_loops)
 
 
 def divisor(n_loops: int, window: bool = True) -> int:
     """sum of :func:`weights`: ``n_loops`` plain, ``n_loops * 2^15`` windowed (the RTL's
-    constant; equal to the table's sum, checked in tests/test_static_removal.py)."""
+    constant; equal to the table's sum, checked in tests/test_static_removal.py and, for
+    the lengths that are not powers of two, by ``model.fft_rom.check_window_sums``)."""
     return n_loops << (COEF_FRAC - 1) if window else n_loops
 
 

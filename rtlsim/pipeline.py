@@ -35,13 +35,15 @@ class PipelineTB(AxisTB):
         self.num_tx = param("NUM_TX")
         self.n_range = param("N_RANGE")
         self.n_doppler = param("N_DOPPLER")
+        # range bins out (REAL_ADC keeps 0..N_RANGE/2-1)
+        self.n_range_bins = self.n_range // 2 if param("REAL_ADC", 0) else self.n_range
         self.packet_words = param("PACKET_WORDS")
         self.header = bool(param("HEADER", 1))
         self.output_mode = param("OUTPUT_MODE", 0)
         self.max_detections = param("MAX_DETECTIONS", 256)
         self.frame_words = (record_frame_words(self.num_tx, self.num_rx, self.max_detections)
                             if self.output_mode == 1
-                            else self.num_tx * self.n_range * self.n_doppler)
+                            else self.num_tx * self.n_range_bins * self.n_doppler)
         self.dut.cfg_cfar_scale.value = 0
         # the register block idle until attach_regs (its reset settings hold: static-clutter
         # removal, when built in with STATIC_REMOVAL = 1, on for every frame)
@@ -83,10 +85,11 @@ class PipelineTB(AxisTB):
         self.dut.cfg_cfar_scale.value = int(value)
 
     async def send_frame(self, adc: np.ndarray) -> None:
-        """Queue one ADC frame, complex (n_chirps, num_rx, n_range) of int16 I/Q, one AXI
-        frame per chirp (TLAST on its last sample, TUSER[0] on the frame's first sample)."""
+        """Queue one ADC frame, (n_chirps, num_rx, n_samples) of int16 I/Q (complex, or real:
+        I only), one AXI frame per chirp (TLAST on its last sample, TUSER[0] on the frame's
+        first sample)."""
         words, _, sof = adc_frame_to_stream(adc)
-        per_chirp = self.n_range
+        per_chirp = adc.shape[2]
         for c in range(adc.shape[0]):
             sl = slice(c * per_chirp, (c + 1) * per_chirp)
             await self.send_words(words[sl], tuser=sof[sl].astype(int))

@@ -13,15 +13,17 @@ import pytest
 
 from host.cfar import MAIN_LOBE_BINS, CfarParams, cfar_threshold, sidelobe_envelope
 from host.params import default_guard, params_for
-from host.pipeline import process_frame
+from host.pipeline import process_cube, process_frame
 from model.array import steering
 from model.cfar_stats import HANN_POWER_CORRELATION
 from model.config import PRESETS, RadarConfig
-from model.radar_pipeline import PipelineParams, run_chain
+from model.hdl import check_hdl
+from model.radar_pipeline import PipelineParams, run_chain, scaled_cube
 from model.reference import FftAxis, corner_turn, fft_axes, radar_cube, range_doppler_power
 from model.scene import Scatterers
 from model.simulate import simulate_frame
 from radar.frame_cloud import frame_cloud
+from tests.oracles.chain import run_chain_reference
 
 BASE = RadarConfig(name="small", num_tx=2, num_rx=4, n_range=256, n_doppler=256,
                    sample_rate_hz=10e6, chirp_period_s=40e-6, design_max_range_m=9.0,
@@ -139,15 +141,64 @@ def test_window_quantities_of_padded_axes():
     assert default_guard(replace(BASE, samples_per_chirp=200, loops=255)) == (3, 3)
 
 
-def test_fixed_point_chain_refuses_profiles():
-    """The bit-accurate model (and the RTL) run the presets' chain: a padded or real-ADC
-    profile is refused with one line naming it, not mis-processed."""
-    cfg = replace(BASE, samples_per_chirp=200)
-    with pytest.raises(ValueError, match="bit-accurate model and the RTL do not handle "
-                                         "200 samples per chirp zero-padded"):
-        run_chain(np.zeros(cfg.adc_shape, complex), cfg, PipelineParams())
-    with pytest.raises(ValueError, match="real-valued ADC"):
-        PipelineParams().check(replace(BASE, adc="real"))
+SCENE = Scatterers(np.array([4.3, 8.0]), np.array([10.0, -20.0]), np.array([1.1, -2.0]),
+                   np.array([0.01, 0.1]), np.array([-1, -1]))
+"""Two targets (range m, azimuth deg, radial velocity m/s, RCS m^2) for the simulator."""
+
+
+@pytest.mark.parametrize("changes", [dict(samples_per_chirp=200, loops=255), dict(adc="real"),
+                                     dict(samples_per_chirp=200, loops=255, adc="real")],
+                         ids=["padded", "real-adc", "padded-real"])
+def test_fixed_point_chain_tracks_the_float_chain(changes):
+    """The bit-accurate model (the RTL's chain with N_SAMPLES, N_LOOPS, REAL_ADC) on padded
+    and real-ADC profiles: on the simulator's frames the same detections as the float chain
+    (each target once, same cell, same angle within 0.2 deg; no false alarm the float chain
+    has not) -- the zero fill and the real ADC's half spectrum follow the float chain's
+    definitions (model.reference)."""
+    cfg = replace(BASE, **changes)
+    params = PipelineParams()
+    params.check(cfg)
+    hdl = params.hdl_parameters(cfg)
+    assert (hdl["N_SAMPLES"], hdl["N_LOOPS"], hdl["REAL_ADC"]) == (
+        cfg.n_samples, cfg.n_loops, int(cfg.adc == "real"))
+    extra = 0
+    for seed in range(3):
+        frame = simulate_frame(cfg, SCENE, rng=np.random.default_rng(seed)).samples
+        fixed = process_cube(scaled_cube(frame, cfg, params), cfg)
+        ref = process_cube(radar_cube(frame, cfg), cfg)
+        near = [np.flatnonzero(np.abs(p.range_m - 4.3) < 0.3) for p in (fixed, ref)]
+        far = [np.flatnonzero(np.abs(p.range_m - 8.0) < 0.3) for p in (fixed, ref)]
+        for (i, j) in (near, far):
+            assert len(i) == len(j) == 1, (seed, fixed.range_m, ref.range_m)
+            assert abs(fixed.range_m[i[0]] - ref.range_m[j[0]]) < 0.05 * cfg.range_bin_m
+            assert abs(fixed.radial_velocity_mps[i[0]] - ref.radial_velocity_mps[j[0]]) \
+                < 0.05 * cfg.velocity_bin_mps
+            assert abs(fixed.azimuth_deg[i[0]] - ref.azimuth_deg[j[0]]) < 0.2
+        extra += max(0, len(fixed) - len(ref))
+    assert extra == 0
+
+
+def test_fixed_point_chain_matches_its_oracle_on_a_profile():
+    """run_chain (planar fast path) = the stage-by-stage int64 oracle on a 200-of-256
+    sample, 15-of-32 loop real-ADC profile (tests/oracles/chain.py), in both read orders;
+    through the external frame store the same payload (all loops: it refuses fewer)."""
+    cfg = replace(BASE, n_doppler=32, samples_per_chirp=200, loops=15, adc="real")
+    frame = simulate_frame(cfg, SCENE, rng=np.random.default_rng(0)).samples
+    for params in (PipelineParams(), PipelineParams(output_mode=1)):
+        a, b = run_chain(frame, cfg, params), run_chain_reference(frame, cfg, params)
+        assert a.payload.shape == (2, 128, 32, 4)
+        assert np.array_equal(a.payload, b.payload)
+        assert (a.range_overflow, a.doppler_overflow) == (b.range_overflow, b.doppler_overflow)
+        if params.output_mode:
+            assert np.array_equal(a.records, b.records)
+    with pytest.raises(ValueError, match="external frame store"):
+        PipelineParams(frame_store=True).check(cfg)
+    with pytest.raises(ValueError, match="201 samples per chirp .no window ROM"):
+        check_hdl(replace(cfg, samples_per_chirp=201))
+    whole = replace(cfg, loops=32)          # all loops: the external store takes it too
+    frame = simulate_frame(whole, SCENE, rng=np.random.default_rng(1)).samples
+    assert np.array_equal(run_chain(frame, whole).payload,
+                          run_chain(frame, whole, PipelineParams(frame_store=True)).payload)
 
 
 def test_padded_noise_keeps_the_configured_pfa():

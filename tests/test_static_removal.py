@@ -24,7 +24,8 @@ from model.static_removal import (
 )
 
 
-@pytest.mark.parametrize("n_loops", [1, 2, 3, 13, 200, 255, 256, 4095, 2 << 15, 256 << 15])
+@pytest.mark.parametrize("n_loops", [1, 2, 3, 13, 200, 255, 256, 4095, 2 << 15, 256 << 15,
+                                     255 << 15])
 def test_mean_is_rounded_half_away_for_every_sum(n_loops: int) -> None:
     """Divisors: plain means of n_loops samples and windowed ones (n_loops * 2^15)."""
     lo, hi = -(1 << 15) * n_loops, ((1 << 15) - 1) * n_loops
@@ -38,10 +39,10 @@ def test_mean_is_rounded_half_away_for_every_sum(n_loops: int) -> None:
     assert mean(s, n_loops).min() >= -(1 << 15) and mean(s, n_loops).max() < 1 << 15
 
 
-@pytest.mark.parametrize("n", [2, 4, 16, 256, 4096])
+@pytest.mark.parametrize("n", [2, 4, 16, 256, 4096, 15, 50, 200, 255])
 def test_window_sum_is_the_rtl_divisor(n: int) -> None:
-    """The quantised Hann's sum is n * 2^15 (HANN[k] + HANN[k + 2048] = 65536 exactly), the
-    constant the RTL divides by."""
+    """The quantised Hann's sum is n * 2^15 (HANN[k] + HANN[k + 2048] = 65536 exactly; the
+    generated lengths that are not powers of two too), the constant the RTL divides by."""
     assert int(weights(n).sum()) == divisor(n) == n << 15
 
 

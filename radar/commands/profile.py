@@ -6,8 +6,8 @@ import argparse
 
 import numpy as np
 
+from model.hdl import hdl_unsupported
 from model.profile import LVDS_LAYOUTS, Profile, load_profile
-from model.profile_fields import preset_chain_features
 from radar.common import CliError, add_command
 
 
@@ -78,9 +78,8 @@ def describe(profile: Profile) -> list[str]:
     missing = c.unsupported_features()
     rows.append(("processing", "supported by the chain" if not missing else
                  "not yet: " + "; ".join(missing)))
-    fixed = preset_chain_features(c)
-    rows.append(("model / RTL", "run it" if not fixed else
-                 "the presets' shapes only, not " + "; ".join(fixed)))
+    fixed = hdl_unsupported(c)
+    rows.append(("model / RTL", "run it" if not fixed else "not yet: " + "; ".join(fixed)))
     width = max(len(k) for k, _ in rows)
     lines = [f"{k.ljust(width)}  {val}" for k, val in rows]
     lines.append("virtual array (channel numbers, half-wavelength grid, up is vertical):")

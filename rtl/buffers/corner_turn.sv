@@ -11,6 +11,12 @@
 // mod B) = W_{k+1}(j), so frame k+1's word i goes to the slot that frame k's read number i
 // has just freed. The writer only ever trails the reader (write count < read count), which
 // is when s_axis_tready is low. Details and memory figures: docs/buffers.md.
+//
+// N_LOOPS < N_DOPPLER (fewer loops than the Doppler FFT length, which zero-fills): a frame
+// is the first N_LOOPS chirps per TX (input words i < NUM_TX*N_RANGE*N_LOOPS, the top index
+// field is d) and a Doppler vector its first N_LOOPS words (d < N_LOOPS): both counters skip
+// the indices of the missing loops, so the scheme above holds unchanged on the words that
+// exist (a slot a frame's read skips held no word of that frame).
 `default_nettype none
 
 module corner_turn #(
@@ -20,8 +26,10 @@ module corner_turn #(
   parameter int NUM_RX = 4,
   // Range bins per chirp (words per input chirp), power of two, 2..4096.
   parameter int N_RANGE = 64,
-  // Chirps per TX per frame (output Doppler vector length), power of two, 2..4096.
+  // Chirps per TX per frame the memory holds (the Doppler FFT length), power of two, 2..4096.
   parameter int N_DOPPLER = 256,
+  // Chirps per TX per frame (loops; output Doppler vector length), 1..N_DOPPLER.
+  parameter int N_LOOPS = N_DOPPLER,
   // Bits of I and of Q per lane, 8..32.
   parameter int DATA_W = 16,
   // Output order. 0: for TX t, for range bin r (the radar cube, docs/design.md 3.2);
@@ -36,7 +44,7 @@ module corner_turn #(
   input  wire logic                          s_axis_tvalid,
   output logic                               s_axis_tready,
   input  wire logic                          s_axis_tlast,
-  // Doppler vectors: for TX t, for range bin r, N_DOPPLER words (chirps of TX t in order),
+  // Doppler vectors: for TX t, for range bin r, N_LOOPS words (chirps of TX t in order),
   // TLAST on the last word of every vector, TUSER[0] on the first word of every frame
   output logic      [NUM_RX*2*DATA_W-1:0]    m_axis_tdata,
   output logic                               m_axis_tvalid,
@@ -70,6 +78,9 @@ module corner_turn #(
   end
   if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << BD) != N_DOPPLER) begin : g_bad_n_doppler
     $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
+  end
+  if (N_LOOPS < 1 || N_LOOPS > N_DOPPLER) begin : g_bad_n_loops
+    $fatal(1, "%m: N_LOOPS=%0d not in 1..N_DOPPLER (%0d)", N_LOOPS, N_DOPPLER);
   end
   if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
     $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
@@ -128,10 +139,18 @@ module corner_turn #(
   logic            can_issue, rd_issue, rd_start;
   logic            p_last_q, p_sof_q, p2_last_q, p2_sof_q;
 
+  // Last input word of a frame and last read of a frame; the read skips d >= N_LOOPS.
+  localparam logic [B-1:0] WR_LAST = B'(NUM_TX * N_RANGE * N_LOOPS - 1);
+  localparam logic [B-1:0] RD_LAST = {{(B - BD){1'b1}}, BD'(N_LOOPS - 1)};
+  logic         rd_vec_end;
+  logic [B-1:0] rd_next;
+  assign rd_vec_end = (rd_cnt_q[BD-1:0] == BD'(N_LOOPS - 1));
+  assign rd_next    = rd_vec_end ? {rd_cnt_q[B-1:BD] + 1'b1, BD'(0)} : rd_cnt_q + 1'b1;
+
   // The writer may use slot W_{k+1}(i) = R_k(i) only once read i was issued (earlier clock).
   assign s_axis_tready = !rst && !pending_q && (!rd_active_q || (wr_cnt_q < rd_cnt_q));
   assign wr_beat       = s_axis_tvalid && s_axis_tready;
-  assign wr_frame_end  = (wr_cnt_q == '1);
+  assign wr_frame_end  = (wr_cnt_q == WR_LAST);
   assign chirp_end     = (wr_cnt_q[BR-1:0] == '1);
   assign ram_wr_en     = wr_beat;
 
@@ -178,7 +197,7 @@ module corner_turn #(
   end
 
   always_ff @(posedge clk) begin
-    p_last_q  <= (rd_cnt_q[BD-1:0] == '1);
+    p_last_q  <= rd_vec_end;
     p_sof_q   <= (rd_cnt_q == '0);
     p2_last_q <= p_last_q;
     p2_sof_q  <= p_sof_q;
@@ -198,7 +217,7 @@ module corner_turn #(
       rd_active_q   <= 1'b0;
     end else begin
       if (wr_beat) begin
-        wr_cnt_q <= wr_cnt_q + 1'b1;
+        wr_cnt_q <= wr_frame_end ? '0 : wr_cnt_q + 1'b1;
         if (s_axis_tlast != chirp_end) begin
           framing_q <= 1'b1;
           if (framing_cnt_q != '1) framing_cnt_q <= framing_cnt_q + 1'b1;
@@ -216,8 +235,8 @@ module corner_turn #(
         rd_shift_q  <= wr_shift_q;
       end
       if (rd_issue) begin
-        rd_cnt_q <= rd_cnt_q + 1'b1;
-        if (rd_cnt_q == '1) begin
+        rd_cnt_q <= rd_next;
+        if (rd_cnt_q == RD_LAST) begin
           rd_active_q  <= 1'b0;
           frames_out_q <= frames_out_q + 1'b1;
         end

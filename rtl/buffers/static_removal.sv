@@ -14,7 +14,7 @@
 //
 // Structure: a ping-pong of two vectors. The writer stores vector v in one bank while
 // accumulating sum(w[n] x[n]) over its first N_LOOPS words (per lane, I and Q, SUM_W-bit
-// exact sums; w[n] = HANN[n * 4096 / N_LOOPS] from fft_hann_rom, the fft_window block's
+// exact sums; w[n] the N_LOOPS-point window of fft_win_rom, the fft_window block's
 // coefficients, or 1 without WINDOW) in a DSP-style multiply-accumulate: operand, product
 // and sum registers; the reader streams the previous vector out of the other bank, less its
 // mean, through two extra registers that match the two MACC stages. One word per clock per
@@ -31,14 +31,16 @@
 //
 // Arithmetic (exact, model.static_removal.mean): sum s = sum(w x) over the vector's first
 // N_LOOPS samples of one lane's I (or Q); divisor D = sum(w) = N_LOOPS * 2^15 with WINDOW
-// (HANN[k] + HANN[k + 2048] = 65536 exactly; model.static_removal.divisor, checked against
+// (HANN[k] + HANN[k + 2048] = 65536 exactly, and every other generated window length sums
+// so too: model.fft_rom.check_window_sums; model.static_removal.divisor, checked against
 // the table in tests/test_static_removal.py), N_LOOPS without; mean
 // m = floor((s * RECIP + 2^(SH-1)) / 2^SH) with SH = SUM_W + clog2(D) + 1,
 // SUM_W = DATA_W + clog2(D) and RECIP = floor(2^SH / D) + 1. This is s / D rounded to
 // nearest, ties away from zero, for every s in range (|s| <= 2^(DATA_W-1) D; the error of
 // RECIP, |s| * (RECIP - 2^SH/D) / 2^SH < 1/(4 D), is below the 1/(2 D) that separates s / D
-// from a rounding boundary, and it has the sign of s at a tie). With D a power of two (always
-// with WINDOW) the product is a shift and an add (no multiplier). Output word d < N_LOOPS:
+// from a rounding boundary, and it has the sign of s at a tie). With D a power of two
+// (N_LOOPS a power of two) the product is a shift and an add (no multiplier); otherwise a
+// SUM_W x RCP_W multiply per value, once per vector. Output word d < N_LOOPS:
 // x - m saturated to DATA_W bits (sticky status_saturated); words d >= N_LOOPS (the zero fill
 // of a frame with fewer loops than N_DOPPLER) pass unchanged.
 //
@@ -50,7 +52,8 @@
 module static_removal #(
   // Receive lanes per word, 1..64.
   parameter int NUM_RX = 4,
-  // Words per slow-time vector (the Doppler FFT length), power of two, 2..4096.
+  // Words per slow-time vector (in the pipeline: the loops, the Doppler FFT zero-fills
+  // behind), 2..4096.
   parameter int N_DOPPLER = 256,
   // Chirp loops per frame whose mean is removed (the first N_LOOPS words of every vector),
   // 1..N_DOPPLER; any integer (the division is a reciprocal multiply, see above).
@@ -58,7 +61,7 @@ module static_removal #(
   // Bits of I and of Q per lane, 8..32.
   parameter int DATA_W = 16,
   // 1: the mean weighted by the Doppler window (the pipeline's WINDOW: the fft_window
-  // block's periodic Hann over N_LOOPS, N_LOOPS a power of two); 0: the plain mean.
+  // block's periodic Hann over N_LOOPS, fft_win_rom); 0: the plain mean.
   parameter bit WINDOW = 1'b1
 ) (
   input  wire logic                       clk,
@@ -88,7 +91,6 @@ module static_removal #(
   localparam int POS_W  = $clog2(N_DOPPLER);
   localparam int ROM_LOG2 = fft_rom_pkg::ROM_LOG2;
   localparam int COEF_W = fft_rom_pkg::COEF_W;        // signed weight (0..65536 windowed)
-  localparam int LBN    = $clog2(N_LOOPS);
   // divisor = sum of the weights: N_LOOPS * 2^15 windowed (HANN[k] + HANN[k+2048] = 65536,
   // model.static_removal.divisor, checked in tests/test_static_removal.py), N_LOOPS plain
   localparam int DIV    = WINDOW ? (N_LOOPS << (fft_rom_pkg::COEF_FRAC - 1)) : N_LOOPS;
@@ -97,23 +99,21 @@ module static_removal #(
   localparam int SH     = SUM_W + LB + 1;
   localparam bit POW2   = (DIV == (1 << LB));
   localparam int RCP_W  = SH - LB + 2;                // bits of RECIP (unsigned)
-  // (POW2: unused, and SH may exceed 63 there)
-  localparam longint unsigned RECIP = POW2 ? 64'd1 : ((64'd1 << SH) / 64'(DIV)) + 64'd1;
+  // (POW2: unused; SH reaches 71 for a windowed N_LOOPS = 4095, hence 128 bits)
+  localparam logic [127:0] RECIP = POW2 ? 128'd1 : ((128'd1 << SH) / 128'(DIV)) + 128'd1;
   localparam int PROD_W = SUM_W + RCP_W + 1;
 
   // ---- parameter checks -----------------------------------------------------------------
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
     $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
   end
-  if (N_DOPPLER < 2 || N_DOPPLER > 4096 || (1 << POS_W) != N_DOPPLER) begin : g_bad_n_doppler
-    $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 2..4096", N_DOPPLER);
+  if (N_DOPPLER < 2 || N_DOPPLER > 4096) begin : g_bad_n_doppler
+    $fatal(1, "%m: N_DOPPLER=%0d not in 2..4096", N_DOPPLER);
   end
   if (N_LOOPS < 1 || N_LOOPS > N_DOPPLER) begin : g_bad_n_loops
     $fatal(1, "%m: N_LOOPS=%0d not in 1..N_DOPPLER (%0d)", N_LOOPS, N_DOPPLER);
   end
-  if (WINDOW && (N_LOOPS < 2 || (1 << LBN) != N_LOOPS)) begin : g_bad_window
-    $fatal(1, "%m: WINDOW needs N_LOOPS=%0d a power of two >= 2", N_LOOPS);
-  end
+  // (WINDOW: fft_win_rom refuses an N_LOOPS it holds no window of)
   if (DATA_W < 8 || DATA_W > 32) begin : g_bad_data_w
     $fatal(1, "%m: DATA_W=%0d not in 8..32", DATA_W);
   end
@@ -123,7 +123,7 @@ module static_removal #(
   logic [POS_W:0]    ram_wr_addr, ram_rd_addr;
   logic [WORD_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(2 * N_DOPPLER)) u_ram (
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(2 << POS_W)) u_ram (
     .clk, .wr_en(ram_wr_en), .wr_addr(ram_wr_addr), .wr_data(s_axis_tdata),
     .rd_en(ram_rd_en), .rd_addr(ram_rd_addr), .rd_data(ram_rd_data)
   );
@@ -154,13 +154,11 @@ module static_removal #(
   assign ram_wr_en   = beat;
   assign ram_wr_addr = {wr_bank_q, wr_idx_q};
 
-  // the weight of word wr_idx_q: HANN[wr_idx_q * 4096 / N_LOOPS] (the fft_window block's
-  // coefficients, rtl/fft/fft_hann_rom.sv) windowed, 1 plain; 0 past the loops or without a beat
+  // the weight of word wr_idx_q: the N_LOOPS-point window (the fft_window block's
+  // coefficients, rtl/fft/fft_win_rom.sv) windowed, 1 plain; 0 past the loops or without a beat
   logic [COEF_W-1:0] coef;
   if (WINDOW) begin : g_win
-    logic [ROM_LOG2-1:0] rom_idx;
-    assign rom_idx = ROM_LOG2'(wr_idx_q) << (ROM_LOG2 - LBN);
-    fft_hann_rom u_rom (.k(rom_idx), .hann_o(coef));
+    fft_win_rom #(.N(N_LOOPS)) u_rom (.k(ROM_LOG2'(wr_idx_q)), .w_o(coef));
   end else begin : g_plain
     assign coef = COEF_W'(1);
   end
@@ -259,13 +257,13 @@ module static_removal #(
     end else begin
       push_q    <= {push_q[1:0], issue};
       if (beat) begin
-        wr_idx_q <= wr_idx_q + 1'b1;
+        wr_idx_q <= wr_last ? '0 : wr_idx_q + 1'b1;
         if (wr_first && s_axis_tuser[0]) en_frame_q <= enable;
         if (s_axis_tlast != wr_last) framing_q <= 1'b1;
         if (wr_last) wr_bank_q <= !wr_bank_q;
       end
       if (issue) begin
-        rd_idx_q <= rd_idx_q + 1'b1;
+        rd_idx_q <= rd_last ? '0 : rd_idx_q + 1'b1;
         if (rd_last) rd_bank_q <= !rd_bank_q;
       end
       // a bank fills on its last write and empties on its last read (never both: the

@@ -2,6 +2,12 @@
 // Streaming FFT/IFFT with AXI4-Stream interfaces (open replacement of the Xilinx FFT IP):
 // radix-2^2 single-path delay-feedback pipeline, one complex sample per clock per lane,
 // continuous frames, natural-order output, full backpressure, self-draining.
+//
+// Zero fill (N_IN < N): a vector is N_IN input samples (TLAST on the last), windowed over
+// their own count, then N - N_IN zeros the core inserts itself, one per clock, while
+// s_axis_tready is low (the fill never waits for the input: N clocks per vector as without
+// it). N_OUT < N: only bins 0..N_OUT-1 leave (TLAST on N_OUT-1), e.g. the positive half of
+// the transform of real samples.
 `default_nettype none
 
 module fft_axis #(
@@ -15,6 +21,10 @@ module fft_axis #(
   parameter bit INVERSE = 0,
   // Input window applied before the first butterfly: 0 none, 1 periodic Hann.
   parameter bit WINDOW = 0,
+  // Input samples per vector, 2..N (the rest of the N-point vector is zero-filled).
+  parameter int N_IN = N,
+  // Output bins per vector, 1..N: bins 0..N_OUT-1 in natural order.
+  parameter int N_OUT = N,
   // Scaling schedule, bit s = 1 divides radix-2 stage s (s = 0 first) by 2 with convergent
   // rounding; bits >= log2(N) are ignored. Default 'hFFF (all stages): round(DFT(x)/N).
   parameter int unsigned SCALE_SCH = 32'hFFF,
@@ -24,19 +34,19 @@ module fft_axis #(
 ) (
   // Clock and synchronous active-high reset.
   input  logic clk, rst,
-  // AXI4-Stream sink: time-domain samples, {Q, I} per lane, tlast on sample N-1.
+  // AXI4-Stream sink: time-domain samples, {Q, I} per lane, tlast on sample N_IN-1.
   input  logic [NUM_CH*2*DATA_W-1:0] s_axis_tdata,
   input  logic s_axis_tvalid,
   output logic s_axis_tready,
   input  logic s_axis_tlast,
-  // AXI4-Stream source: bins in natural order, tuser = bin index, tlast on bin N-1.
+  // AXI4-Stream source: bins in natural order, tuser = bin index, tlast on bin N_OUT-1.
   output logic [NUM_CH*2*DATA_W-1:0] m_axis_tdata,
   output logic m_axis_tvalid,
   input  logic m_axis_tready,
   output logic m_axis_tlast,
   output logic [$clog2(N)-1:0] m_axis_tuser,
-  // Events, one-cycle pulses, registered: tlast on a sample that is not N-1 / missing on
-  // sample N-1 (the frame count is not resynchronised, like the Xilinx core); an output beat
+  // Events, one-cycle pulses, registered: tlast on a sample that is not N_IN-1 / missing on
+  // sample N_IN-1 (the frame count is not resynchronised, like the Xilinx core); an output beat
   // whose computation saturated (any lane, any stage), the cycle after its handshake.
   output logic event_tlast_unexpected, event_tlast_missing, event_overflow
 );
@@ -50,6 +60,12 @@ module fft_axis #(
   // ---------------------------------------------------------------- parameter checks
   if (N < 16 || N > 4096 || (1 << LOG2N) != N) begin : g_bad_n
     $fatal(1, "%m: N=%0d must be a power of two in 16..4096", N);
+  end
+  if (N_IN < 2 || N_IN > N) begin : g_bad_n_in
+    $fatal(1, "%m: N_IN=%0d not in 2..N (%0d)", N_IN, N);
+  end
+  if (N_OUT < 1 || N_OUT > N) begin : g_bad_n_out
+    $fatal(1, "%m: N_OUT=%0d not in 1..N (%0d)", N_OUT, N);
   end
   if (NUM_CH < 1 || NUM_CH > 16) begin : g_bad_num_ch
     $fatal(1, "%m: NUM_CH=%0d must be in 1..16", NUM_CH);
@@ -66,9 +82,10 @@ module fft_axis #(
   // The whole pipeline moves on `adv`: a real input sample, or a bubble when the input is
   // idle at a frame boundary while valid samples are still inside (self-draining). Bubbles
   // carry a phantom index counting from 0 so every stage keeps its frame alignment.
+  // Samples N_IN..N-1 of a vector are zeros (`fill`), one per advance, the input held off.
   logic [LOG2N-1:0] in_cnt_q, ph_cnt_q;
   logic [CNT_W-1:0] inflight_q;
-  logic can_adv, in_fire, bubble, adv;
+  logic can_adv, in_fire, fill_q, zero_fire, take, bubble, adv;
 
   // last pipeline register (output conversion) and the reorder buffer write side
   logic [ODW:0]     cv_data_q;   // {overflow, data}
@@ -77,24 +94,31 @@ module fft_axis #(
   logic             wr_ok;
 
   assign can_adv       = !cv_vld_q || wr_ok;
-  assign s_axis_tready = can_adv;
-  assign in_fire       = s_axis_tvalid && can_adv;
+  assign s_axis_tready = can_adv && !fill_q;
+  assign in_fire       = s_axis_tvalid && s_axis_tready;
+  assign zero_fire     = fill_q && can_adv;
+  assign take          = in_fire || zero_fire;          // a sample of a vector enters
   assign bubble        = !s_axis_tvalid && can_adv && in_cnt_q == '0 && inflight_q != '0;
-  assign adv           = in_fire || bubble;
+  assign adv           = take || bubble;
 
   always_ff @(posedge clk) begin
     if (rst) begin
       in_cnt_q   <= '0;
       ph_cnt_q   <= '0;
       inflight_q <= '0;
+      fill_q     <= 1'b0;
     end else begin
-      if (in_fire) begin
+      if (take) begin
         in_cnt_q <= in_cnt_q + 1'b1;
         ph_cnt_q <= '0;
       end else if (bubble) begin
         ph_cnt_q <= ph_cnt_q + 1'b1;
       end
-      inflight_q <= inflight_q + CNT_W'(in_fire) - CNT_W'(adv && cv_vld_q);
+      if (N_IN < N) begin
+        if (in_fire && in_cnt_q == LOG2N'(N_IN - 1)) fill_q <= 1'b1;
+        if (zero_fire && in_cnt_q == LOG2N'(N - 1)) fill_q <= 1'b0;
+      end
+      inflight_q <= inflight_q + CNT_W'(take) - CNT_W'(adv && cv_vld_q);
     end
   end
 
@@ -107,10 +131,10 @@ module fft_axis #(
 
   fft_window #(
     .NUM_CH(NUM_CH), .DATA_W(DATA_W), .GUARD_W(GUARD_W), .W(W), .LOG2N(LOG2N),
-    .WINDOW(WINDOW)
+    .WINDOW(WINDOW), .N_IN(N_IN)
   ) u_window (
     .clk, .rst, .en(adv),
-    .in_data(s_axis_tdata), .in_vld(in_fire), .in_pos(in_fire ? in_cnt_q : ph_cnt_q),
+    .in_data(fill_q ? '0 : s_axis_tdata), .in_vld(take), .in_pos(take ? in_cnt_q : ph_cnt_q),
     .out_data(st_data[0]), .out_vld(st_vld[0]), .out_pos(st_pos[0])
   );
   assign st_ov[0] = 1'b0;
@@ -180,7 +204,7 @@ module fft_axis #(
   // ---------------------------------------------------------------- reorder + output
   logic [ODW:0] m_word;
 
-  fft_reorder #(.N(N), .WIDTH(ODW + 1)) u_reorder (
+  fft_reorder #(.N(N), .WIDTH(ODW + 1), .N_OUT(N_OUT)) u_reorder (
     .clk, .rst,
     .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
     .m_axis_tdata(m_word), .m_axis_tvalid(m_axis_tvalid), .m_axis_tready(m_axis_tready),
@@ -196,8 +220,8 @@ module fft_axis #(
       ev_miss_q  <= 1'b0;
       ev_ov_q    <= 1'b0;
     end else begin
-      ev_unexp_q <= in_fire && s_axis_tlast && in_cnt_q != LOG2N'(N - 1);
-      ev_miss_q  <= in_fire && !s_axis_tlast && in_cnt_q == LOG2N'(N - 1);
+      ev_unexp_q <= in_fire && s_axis_tlast && in_cnt_q != LOG2N'(N_IN - 1);
+      ev_miss_q  <= in_fire && !s_axis_tlast && in_cnt_q == LOG2N'(N_IN - 1);
       ev_ov_q    <= m_axis_tvalid && m_axis_tready && m_word[ODW];
     end
   end

@@ -9,7 +9,10 @@ module fft_reorder #(
   // Transform length, power of two, 16..4096.
   parameter int N = 64,
   // Word width (all lanes plus the overflow flag), >= 1.
-  parameter int WIDTH = 33
+  parameter int WIDTH = 33,
+  // Bins read out per frame, 1..N: bins 0..N_OUT-1 (TLAST on N_OUT-1); the rest are never
+  // read (their bank is released with bin N_OUT-1).
+  parameter int N_OUT = N
 ) (
   input  logic clk,
   input  logic rst,
@@ -30,6 +33,9 @@ module fft_reorder #(
   if (N < 2 || (1 << LOG2N) != N) begin : g_bad_n
     $fatal(1, "%m: N=%0d must be a power of two", N);
   end
+  if (N_OUT < 1 || N_OUT > N) begin : g_bad_n_out
+    $fatal(1, "%m: N_OUT=%0d not in 1..N (%0d)", N_OUT, N);
+  end
 
   logic [WIDTH-1:0] mem_q [2*N];
   logic [1:0]       full_q, full_d;      // bank holds a complete frame not yet fully read
@@ -49,7 +55,7 @@ module fft_reorder #(
   // Free bank, or the slot of the bank under read has already been read.
   assign wr_ok   = !full_q[wb_q] || (rb_q == wb_q && wr_addr < rd_ptr_q);
   assign pop     = full_q[rb_q] && (!m_valid_q || m_axis_tready);
-  assign rd_last = rd_ptr_q == LOG2N'(N - 1);
+  assign rd_last = rd_ptr_q == LOG2N'(N_OUT - 1);
   assign wr_last = wr_pos == LOG2N'(N - 1);
 
   always_comb begin
@@ -138,7 +144,7 @@ module fft_reorder #(
     if (wb_q != rb_q) assert (!full_q[wb_q]);
     if (wb_q == rb_q) assert (full_q[0] == full_q[1]);
     if (!full_q[rb_q]) assert (!full_q[!rb_q] && rd_ptr_q == '0 && wb_q == rb_q);
-    if (m_axis_tvalid) assert (m_axis_tlast == (m_axis_tuser == LOG2N'(N - 1)));
+    if (m_axis_tvalid) assert (m_axis_tlast == (m_axis_tuser == LOG2N'(N_OUT - 1)));
     // inductive form of the bank reuse rule: which slots hold unread samples
     for (int b = 0; b < 2; b++) begin
       for (int i = 0; i < N; i++) begin

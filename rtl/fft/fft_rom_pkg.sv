@@ -12,6 +12,10 @@ package fft_rom_pkg;
   // Coefficient width (signed two's complement) and fraction bits (Q1.16).
   localparam int COEF_W = 18;
   localparam int COEF_FRAC = 16;
+  // 1 when fft_win_rom holds an n-point window (a power of two or WINDOW_LENGTHS).
+  function automatic bit has_window(input int n);
+    has_window = (n >= 2 && n <= ROM_SIZE && (n & (n - 1)) == 0) || n == 15 || n == 50 || n == 200 || n == 255;
+  endfunction
 endpackage
 /* verilator lint_on UNUSEDPARAM */
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Input stage of the streaming FFT: widens each I/Q sample to the internal format
 // (GUARD_W fraction bits) and, with WINDOW = 1, multiplies it by the periodic Hann window
-// from the quarter-wave ROM fft_hann_rom (registered operands and product, convergent rounding).
+// of N_IN points from fft_win_rom (the quarter-wave fft_hann_rom when N_IN is a power of two;
+// registered operands and product, convergent rounding).
 `default_nettype none
 
 module fft_window #(
@@ -16,7 +17,10 @@ module fft_window #(
   // log2 of the transform length, 4..12.
   parameter int LOG2N = 6,
   // 0: no window (1 advance of latency); 1: periodic Hann (2 advances).
-  parameter bit WINDOW = 0
+  parameter bit WINDOW = 0,
+  // Window length: the samples of a vector (positions 0..N_IN-1), 2..2^LOG2N; the zero fill
+  // behind them is zero whatever it is multiplied by.
+  parameter int N_IN = 1 << LOG2N
 ) (
   input  logic clk,
   input  logic rst,
@@ -51,9 +55,9 @@ module fft_window #(
     logic [ROM_LOG2-1:0]        rom_idx;
     logic [COEF_W-1:0]          rom_hann;
 
-    assign rom_idx = ROM_LOG2'(in_pos) << (ROM_LOG2 - LOG2N);
-    // HANN(k): quarter-wave ROM (generated, combinational)
-    fft_hann_rom u_rom (.k(rom_idx), .hann_o(rom_hann));
+    assign rom_idx = ROM_LOG2'(in_pos);
+    // the N_IN-point window (generated, combinational)
+    fft_win_rom #(.N(N_IN)) u_rom (.k(rom_idx), .w_o(rom_hann));
 
     always_comb begin
       logic signed [63:0] p;

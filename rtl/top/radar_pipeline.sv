@@ -12,6 +12,16 @@
 // carry the DAMAGED header flag, the counters say how many chirps were lost and filled, and
 // the next frame is clean.
 //
+// Any radar's shape (docs/profiles.md): N_SAMPLES samples per chirp and N_LOOPS loops per
+// frame below the FFT lengths are windowed over their own count and zero-filled by the FFTs
+// (fft_axis N_IN: each FFT inserts its zeros while its input waits, N clocks a vector as for
+// N inputs, so a chirp period of N_RANGE clocks is still all the chain needs; the ping-pong,
+// frame alignment and corner turn count the samples and loops that exist, the corner turn's
+// memory stays N_DOPPLER loops deep). REAL_ADC = 1: real samples in
+// the I half of each lane (bits [15:0] of lane r; the Q half is ignored), and the range FFT
+// keeps bins 0..N_RANGE/2-1 (N_RBINS below): the corner turn, the detector and the DMA
+// see N_RANGE/2 range bins (half the frame memory and half the link).
+//
 // OUTPUT_MODE = 1 (on-chip detection, docs/design.md 3.4, docs/detect.md): the corner turn reads
 // (r, t, d), the Doppler FFT output goes through detect_chain (NCI, 2-D CFAR, records) and
 // the fixed-length record stream through the same packetizer (header, sequence numbers,
@@ -41,10 +51,16 @@ module radar_pipeline #(
   parameter int NUM_RX = 4,
   // TDM transmit slots per frame: chirp c of a frame is sent by TX c mod NUM_TX, 1..16.
   parameter int NUM_TX = 1,
-  // Samples per chirp = range FFT length, power of two, 16..4096.
+  // Range FFT length, power of two, 16..4096 (the samples per chirp are N_SAMPLES).
   parameter int N_RANGE = 64,
-  // Chirps per TX per frame = Doppler FFT length, power of two, 16..4096.
+  // Doppler FFT length, power of two, 16..4096 (the chirps per TX a frame are N_LOOPS).
   parameter int N_DOPPLER = 256,
+  // Samples per chirp, 8..N_RANGE (fewer than N_RANGE: the range FFT zero-fills).
+  parameter int N_SAMPLES = N_RANGE,
+  // Chirp loops per frame (chirps per TX), 2..N_DOPPLER (fewer: the Doppler FFT zero-fills).
+  parameter int N_LOOPS = N_DOPPLER,
+  // 1: real ADC samples (I half of each lane), range bins 0..N_RANGE/2-1 kept; 0: complex.
+  parameter bit REAL_ADC = 1'b0,
   // Bits of I and of Q; the DMA format is 32-bit {Q,I} lanes, so only 16 is legal.
   parameter int DATA_W = 16,
   // Payload words per DMA packet (TLAST period; the last packet of a frame may be shorter).
@@ -92,7 +108,7 @@ module radar_pipeline #(
   // Range rows that may report detections, REPORT_LO <= r < REPORT_HI: the host's
   // RadarConfig.detection_bins (PipelineParams sets them; docs/detect.md, range edges).
   parameter int REPORT_LO = 0,
-  parameter int REPORT_HI = N_RANGE,
+  parameter int REPORT_HI = REAL_ADC ? N_RANGE / 2 : N_RANGE,
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
   parameter int MAX_DETECTIONS = 256,
@@ -101,8 +117,9 @@ module radar_pipeline #(
 ) (
   input  wire logic                       clk,
   input  wire logic                       rst,
-  // ADC samples: lane r = RX r, {Q,I}; TLAST on the last sample of each chirp, TUSER[0] on
-  // the first sample of a frame. A real ADC does not wait: s_axis_adc_tready stays high.
+  // ADC samples: lane r = RX r, {Q,I} (REAL_ADC: the sample in I, Q ignored); N_SAMPLES a
+  // chirp, TLAST on the last sample of each chirp, TUSER[0] on the first sample of a frame.
+  // A real ADC does not wait: s_axis_adc_tready stays high.
   input  wire logic [NUM_RX*2*DATA_W-1:0] s_axis_adc_tdata,
   input  wire logic                       s_axis_adc_tvalid,
   output logic                            s_axis_adc_tready,
@@ -206,7 +223,9 @@ module radar_pipeline #(
 
   localparam int LANE_W      = 2 * DATA_W;
   localparam int WORD_W      = NUM_RX * LANE_W;
-  localparam int CUBE_WORDS  = NUM_TX * N_RANGE * N_DOPPLER;
+  localparam int N_RBINS     = REAL_ADC ? N_RANGE / 2 : N_RANGE;  // range bins out
+  localparam int CUBE_WORDS  = NUM_TX * N_RBINS * N_DOPPLER;
+  localparam int TURN_WORDS  = NUM_TX * N_RBINS * N_LOOPS;        // corner turn output
   localparam int HDR_WORDS   = (16 + NUM_RX - 1) / NUM_RX;       // detect_records header
   localparam int REC_WORDS   = MAX_DETECTIONS * (HDR_WORDS + NUM_TX) + HDR_WORDS;
   // words per frame into the packetizer: the cube (mode 0) or the record stream (mode 1)
@@ -230,6 +249,24 @@ module radar_pipeline #(
   begin : g_bad_n_doppler
     $fatal(1, "%m: N_DOPPLER=%0d must be a power of two in 16..4096", N_DOPPLER);
   end
+  if (N_SAMPLES < 8 || N_SAMPLES > N_RANGE) begin : g_bad_n_samples
+    $fatal(1, "%m: N_SAMPLES=%0d not in 8..N_RANGE (%0d)", N_SAMPLES, N_RANGE);
+  end
+  if (N_LOOPS < 2 || N_LOOPS > N_DOPPLER) begin : g_bad_n_loops
+    $fatal(1, "%m: N_LOOPS=%0d not in 2..N_DOPPLER (%0d)", N_LOOPS, N_DOPPLER);
+  end
+  if (WINDOW && !fft_rom_pkg::has_window(N_SAMPLES)) begin : g_bad_n_samples_window
+    $fatal(1, "%m: N_SAMPLES=%0d has no window ROM (model.fft_rom.WINDOW_LENGTHS, make gen)",
+           N_SAMPLES);
+  end
+  if (WINDOW && !fft_rom_pkg::has_window(N_LOOPS)) begin : g_bad_n_loops_window
+    $fatal(1, "%m: N_LOOPS=%0d has no window ROM (model.fft_rom.WINDOW_LENGTHS, make gen)",
+           N_LOOPS);
+  end
+  if (FRAME_STORE && N_LOOPS != N_DOPPLER) begin : g_bad_n_loops_frame_store
+    $fatal(1, "%m: N_LOOPS=%0d: the external frame store (FRAME_STORE = 1) needs N_DOPPLER",
+           N_LOOPS);
+  end
   if (OUTPUT_MODE < 0 || OUTPUT_MODE > 1) begin : g_bad_output_mode
     $fatal(1, "%m: OUTPUT_MODE=%0d not 0 (cube) or 1 (detection records)", OUTPUT_MODE);
   end
@@ -249,11 +286,19 @@ module radar_pipeline #(
   logic              pp_framing;
   logic [31:0]       pp_drop_samples, pp_framing_count, pp_chirps_out;
 
+  // REAL_ADC: the Q halves cleared (constant zero through the ping-pong and frame alignment)
+  logic [WORD_W-1:0] adc_tdata;
+  for (genvar r = 0; r < NUM_RX; r++) begin : g_adc_lane
+    assign adc_tdata[r*LANE_W +: LANE_W] =
+        REAL_ADC ? {{DATA_W{1'b0}}, s_axis_adc_tdata[r*LANE_W +: DATA_W]}
+                 : s_axis_adc_tdata[r*LANE_W +: LANE_W];
+  end
+
   chirp_pingpong #(
-    .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .DATA_W(DATA_W), .ADC_BACKPRESSURE(1'b0)
+    .NUM_RX(NUM_RX), .N_RANGE(N_SAMPLES), .DATA_W(DATA_W), .ADC_BACKPRESSURE(1'b0)
   ) u_pingpong (
     .clk, .rst,
-    .s_axis_tdata(s_axis_adc_tdata), .s_axis_tvalid(s_axis_adc_tvalid),
+    .s_axis_tdata(adc_tdata), .s_axis_tvalid(s_axis_adc_tvalid),
     .s_axis_tready(s_axis_adc_tready), .s_axis_tlast(s_axis_adc_tlast),
     .s_axis_tuser(s_axis_adc_tuser),
     .m_axis_tdata(pp_tdata), .m_axis_tvalid(pp_tvalid), .m_axis_tready(pp_tready),
@@ -265,13 +310,13 @@ module radar_pipeline #(
   assign chirps_in = pp_chirps_out;
 
   // ---- frame alignment (zero-fills frames that lost chirps) --------------------------------
-  localparam int FRAME_CHIRPS = NUM_TX * N_DOPPLER;
+  localparam int FRAME_CHIRPS = NUM_TX * N_LOOPS;
   logic [WORD_W-1:0] fa_tdata;
   logic              fa_tvalid, fa_tready, fa_tlast;
   logic              fa_frame_done, fa_frame_damaged;
 
   frame_align #(
-    .NUM_RX(NUM_RX), .DATA_W(DATA_W), .N_RANGE(N_RANGE), .FRAME_CHIRPS(FRAME_CHIRPS)
+    .NUM_RX(NUM_RX), .DATA_W(DATA_W), .N_RANGE(N_SAMPLES), .FRAME_CHIRPS(FRAME_CHIRPS)
   ) u_frame_align (
     .clk, .rst,
     .s_axis_tdata(pp_tdata), .s_axis_tvalid(pp_tvalid), .s_axis_tready(pp_tready),
@@ -290,8 +335,8 @@ module radar_pipeline #(
   logic                       rf_ev_unexp, rf_ev_miss, rf_ev_ovf;
 
   fft_axis #(
-    .N(N_RANGE), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0), .WINDOW(WINDOW),
-    .SCALE_SCH(RANGE_SCALE_SCH)
+    .N(N_RANGE), .N_IN(N_SAMPLES), .N_OUT(N_RBINS), .NUM_CH(NUM_RX), .DATA_W(DATA_W),
+    .INVERSE(1'b0), .WINDOW(WINDOW), .SCALE_SCH(RANGE_SCALE_SCH)
   ) u_range_fft (
     .clk, .rst,
     .s_axis_tdata(fa_tdata), .s_axis_tvalid(fa_tvalid), .s_axis_tready(fa_tready),
@@ -311,8 +356,8 @@ module radar_pipeline #(
 
   if (!FRAME_STORE) begin : g_ct_onchip
     corner_turn #(
-      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
-      .DATA_W(DATA_W), .READ_ORDER(OUTPUT_MODE)
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RBINS), .N_DOPPLER(N_DOPPLER),
+      .N_LOOPS(N_LOOPS), .DATA_W(DATA_W), .READ_ORDER(OUTPUT_MODE)
     ) u_corner_turn (
       .clk, .rst,
       .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
@@ -357,7 +402,7 @@ module radar_pipeline #(
     /* verilator lint_on UNUSEDSIGNAL */
   end else begin : g_ct_external
     frame_store_axi #(
-      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RBINS), .N_DOPPLER(N_DOPPLER),
       .READ_ORDER(OUTPUT_MODE), .DATA_W(DATA_W), .TILE_R(FS_TILE_R), .AXI_DATA_W(AXI_DATA_W),
       .AXI_ADDR_W(AXI_ADDR_W),
       .AXI_ID_W(AXI_ID_W), .MEM_BASE(MEM_BASE)
@@ -391,7 +436,7 @@ module radar_pipeline #(
 
   if (STATIC_REMOVAL) begin : g_static_removal
     static_removal #(
-      .NUM_RX(NUM_RX), .N_DOPPLER(N_DOPPLER), .N_LOOPS(N_DOPPLER), .DATA_W(DATA_W),
+      .NUM_RX(NUM_RX), .N_DOPPLER(N_LOOPS), .N_LOOPS(N_LOOPS), .DATA_W(DATA_W),
       .WINDOW(WINDOW)
     ) u_static_removal (
       .clk, .rst, .enable(cfg_clutter_removal),
@@ -422,8 +467,8 @@ module radar_pipeline #(
   logic                         df_ev_unexp, df_ev_miss, df_ev_ovf;
 
   fft_axis #(
-    .N(N_DOPPLER), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0), .WINDOW(WINDOW),
-    .SCALE_SCH(DOPPLER_SCALE_SCH)
+    .N(N_DOPPLER), .N_IN(N_LOOPS), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0),
+    .WINDOW(WINDOW), .SCALE_SCH(DOPPLER_SCALE_SCH)
   ) u_doppler_fft (
     .clk, .rst,
     .s_axis_tdata(sr_tdata), .s_axis_tvalid(sr_tvalid), .s_axis_tready(sr_tready),
@@ -443,7 +488,7 @@ module radar_pipeline #(
   if (OUTPUT_MODE == 1) begin : g_detect
     logic        det_framing;
     detect_chain #(
-      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER),
+      .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RBINS), .N_DOPPLER(N_DOPPLER),
       .GUARD_R(GUARD_R), .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D),
       .KIND(CFAR_KIND), .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI),
       .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
@@ -568,16 +613,16 @@ module radar_pipeline #(
   assign framing_error_count = (framing_sum[33:32] != 2'b00) ? '1 : framing_sum[31:0];
 
   // ---- control and status registers --------------------------------------------------------
-  // Frame boundary at static_removal's input (the corner turn's output, CUBE_WORDS words a
+  // Frame boundary at static_removal's input (the corner turn's output, TURN_WORDS words a
   // frame in either read order): ct_word_q counts the words of the current frame. The
   // active settings follow the pending ones while no word of a frame has been taken yet
   // (ct_word_q == 0 and no beat) and in the cycle of a frame's last word; so they are frozen
   // from a frame's first word, where static_removal samples the switch, to its last.
-  localparam int CWORD_W = $clog2(CUBE_WORDS);
+  localparam int CWORD_W = $clog2(TURN_WORDS);
   logic [CWORD_W-1:0] ct_word_q;
   logic               ct_beat, ct_frame_last, ctrl_frame_start;
   assign ct_beat          = ct_tvalid && ct_tready;
-  assign ct_frame_last    = ct_beat && (ct_word_q == CWORD_W'(CUBE_WORDS - 1));
+  assign ct_frame_last    = ct_beat && (ct_word_q == CWORD_W'(TURN_WORDS - 1));
   assign ctrl_frame_start = ct_beat ? ct_frame_last : (ct_word_q == '0);
   always_ff @(posedge clk) begin
     if (rst) ct_word_q <= '0;

@@ -21,9 +21,10 @@ class TB(AxisTB):
         self.num_rx = param("NUM_RX")
         self.n_range = param("N_RANGE")
         self.n_doppler = param("N_DOPPLER")
+        self.n_loops = param("N_LOOPS", self.n_doppler)    # chirps per TX in a frame
         assert param("DATA_W") == 16
         self.read_order = param("READ_ORDER", 0)
-        self.frame_words = self.num_tx * self.n_range * self.n_doppler
+        self.frame_words = self.num_tx * self.n_range * self.n_loops
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
@@ -41,7 +42,7 @@ class TB(AxisTB):
             vecs = []
             for v in range(self.num_tx * self.n_range):
                 w, sof = await self.recv_words_user(self.num_rx)
-                assert len(w) == self.n_doppler, f"vector of {len(w)} words"
+                assert len(w) == self.n_loops, f"vector of {len(w)} words"
                 assert sof == [int(v == 0 and i == 0) for i in range(len(w))], sof[:4]
                 vecs.append(w)
             frames.append(np.vstack(vecs))
@@ -53,7 +54,8 @@ class TB(AxisTB):
 
     def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
         for k, (g, f) in enumerate(zip(got, sent, strict=True)):
-            exp = ct.corner_turn(f, self.num_tx, self.n_range, self.n_doppler, self.read_order)
+            exp = ct.corner_turn(f, self.num_tx, self.n_range, self.n_doppler, self.read_order,
+                                 n_loops=self.n_loops)
             if not np.array_equal(g, exp):
                 bad = np.nonzero((g != exp).any(axis=1))[0]
                 raise AssertionError(f"frame {k}: {len(bad)} words differ, first at {bad[0]}")
@@ -219,6 +221,9 @@ PARAMS = [
     dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
     # on-chip detection order (r, t, d): bit-permutation addresses, period 7 frames
     dict(NUM_TX=4, NUM_RX=2, N_RANGE=4, N_DOPPLER=8, READ_ORDER=1),
+    # fewer loops than the Doppler FFT length: 15 of 16 (2 TX), 5 of 8 in the (r, t, d) order
+    dict(NUM_TX=2, NUM_RX=2, N_RANGE=4, N_DOPPLER=16, N_LOOPS=15),
+    dict(NUM_TX=4, NUM_RX=1, N_RANGE=4, N_DOPPLER=8, N_LOOPS=5, READ_ORDER=1),
 ]
 
 
@@ -231,14 +236,17 @@ def test_corner_turn(parameters: dict) -> None:
 
 
 @pytest.mark.parametrize("read_order", [0, 1])
-@pytest.mark.parametrize("shape", [(1, 4, 8), (4, 8, 16), (2, 4, 4), (4, 2, 2), (1, 64, 256)])
-def test_in_place_model(shape: tuple[int, int, int], read_order: int) -> None:
+@pytest.mark.parametrize("shape", [(1, 4, 8, 8), (4, 8, 16, 16), (2, 4, 4, 4), (4, 2, 2, 2),
+                                   (1, 64, 256, 256), (2, 4, 16, 15), (4, 2, 8, 5),
+                                   (1, 16, 256, 255)])
+def test_in_place_model(shape: tuple[int, int, int, int], read_order: int) -> None:
     """The in-place address scheme (one frame of memory) reproduces the transpose over more
-    than a full period of its address pattern, never overwriting an unread slot."""
-    nt, nr, nd = shape
+    than a full period of its address pattern, never overwriting an unread slot, also with
+    fewer loops than the memory's (the counters skipping the missing words)."""
+    nt, nr, nd, nl = shape
     rng = np.random.default_rng(0)
-    frames = [rng.integers(0, 1 << 32, (nt * nr * nd, 2), dtype=np.uint32)
+    frames = [rng.integers(0, 1 << 32, (nt * nr * nl, 2), dtype=np.uint32)
               for _ in range(ct.frame_period(nt, nr, nd, read_order) + 2)]
-    out = ct.in_place_stream(frames, nt, nr, nd, read_order)
+    out = ct.in_place_stream(frames, nt, nr, nd, read_order, n_loops=nl)
     for f, o in zip(frames, out, strict=True):
-        assert np.array_equal(o, ct.corner_turn(f, nt, nr, nd, read_order))
+        assert np.array_equal(o, ct.corner_turn(f, nt, nr, nd, read_order, n_loops=nl))

@@ -33,6 +33,8 @@ class TB(AxisTB):
     def __init__(self, dut) -> None:
         super().__init__(dut, log_level=logging.ERROR)  # the reset test flushes a frame
         self.n = param("N")
+        self.n_in = param("N_IN", self.n)      # input samples per vector (zero fill after)
+        self.n_out = param("N_OUT", self.n)    # bins out per vector (0..N_OUT-1)
         self.ch = param("NUM_CH")
         self.dw = param("DATA_W", 16)
         self.guard_w = param("GUARD_W", 4)
@@ -113,15 +115,18 @@ class TB(AxisTB):
         return re + 1j * im, list(tuser)[:: nbytes]
 
     def model(self, x: np.ndarray) -> ff.FftFixedResult:
-        return ff.fft_fixed(x, inverse=self.inverse, window=self.window,
-                            scale_sch=self.scale_sch, data_w=self.dw, guard_w=self.guard_w)
+        """The core's output of ``x`` (frames, N_IN, lanes): bins 0..N_OUT-1."""
+        r = ff.fft_fixed(x, inverse=self.inverse, window=self.window, scale_sch=self.scale_sch,
+                         data_w=self.dw, guard_w=self.guard_w, n_fft=self.n)
+        return ff.FftFixedResult(y=r.y[:, :self.n_out], overflow=r.overflow[:, :self.n_out])
 
     def float_ref(self, x: np.ndarray) -> np.ndarray:
         return ff.fft_float(x, inverse=self.inverse, window=self.window,
-                            scale_sch=self.scale_sch)
+                            scale_sch=self.scale_sch, n_fft=self.n)[:, :self.n_out]
 
     def stimulus(self, frames: int, kinds: list[str] | None = None) -> np.ndarray:
-        """complex (frames, N, lanes) integer test vectors, one kind per (frame, lane)."""
+        """complex (frames, N_IN, lanes) integer test vectors, one kind per (frame, lane):
+        the first N_IN samples of N-sample shapes."""
         n, rng = self.n, self.rng
         kinds = kinds or ["random", "tone", "tone_between", "impulse", "dc", "extreme",
                           "overflow", "random_small"]
@@ -161,12 +166,12 @@ class TB(AxisTB):
         if self.dw != 16:  # same shapes at the core's full scale
             x = np.floor(x.real * 2.0 ** (self.dw - 16)) + 1j * np.floor(
                 x.imag * 2.0 ** (self.dw - 16))
-        return x
+        return x[:, :self.n_in]
 
     async def run_frames(self, x: np.ndarray, timeout_us: float | None = None) -> np.ndarray:
-        """Send frames (frames, N, lanes) back to back, receive and check every output beat
-        bit-exact (data, tuser, tlast framing, overflow events). Returns the received
-        outputs complex (frames, N, lanes)."""
+        """Send frames (frames, N_IN, lanes) back to back, receive and check every output
+        beat bit-exact (data, tuser, tlast framing, overflow events). Returns the received
+        outputs complex (frames, N_OUT, lanes)."""
         frames = x.shape[0]
         exp = self.model(x)
         first_out = len(self.out_cycles)
@@ -177,8 +182,8 @@ class TB(AxisTB):
         for f in range(frames):
             frame = await with_timeout(self.sink.recv(), round(timeout_us * 1000), "ns")
             y, tuser = self.from_frame(frame)
-            assert y.shape[0] == self.n, f"frame {f}: {y.shape[0]} beats, expected {self.n}"
-            assert tuser == list(range(self.n)), f"frame {f}: tuser not 0..N-1"
+            assert y.shape[0] == self.n_out, f"frame {f}: {y.shape[0]} beats, not {self.n_out}"
+            assert tuser == list(range(self.n_out)), f"frame {f}: tuser not 0..N_OUT-1"
             bad = np.argwhere(y != exp.y[f])
             if bad.size:
                 k, c = bad[0]
@@ -188,8 +193,8 @@ class TB(AxisTB):
             got[f] = y
         await self.cycles(3)
         # overflow event = the cycle after the handshake of a flagged beat
-        beats = self.out_cycles[first_out:first_out + frames * self.n]
-        ov_got = np.array([(c + 1) in self.ev_ov for c in beats]).reshape(frames, self.n)
+        beats = self.out_cycles[first_out:first_out + frames * self.n_out]
+        ov_got = np.array([(c + 1) in self.ev_ov for c in beats]).reshape(frames, self.n_out)
         assert np.array_equal(ov_got, exp.overflow), (
             f"overflow events differ: got {int(ov_got.sum())} expected {int(exp.overflow.sum())}")
         return got
@@ -225,7 +230,8 @@ async def test_mixed_random_stalls(dut) -> None:
 @cocotb.test()
 async def test_input_gaps_never_throttled(dut) -> None:
     """Random TVALID gaps, sink always ready: s_axis_tready never drops (only output
-    backpressure may throttle the input)."""
+    backpressure may throttle the input) but for the N - N_IN clocks of each vector's zero
+    fill."""
     tb = TB(dut)
     await tb.start()
     tb.set_idle_generator(random_pause(0.4, seed=31))
@@ -238,9 +244,12 @@ async def test_input_gaps_never_throttled(dut) -> None:
             low += int(dut.s_axis_tready.value == 0)
 
     watcher = cocotb.start_soon(watch())
-    await tb.run_frames(tb.stimulus(max(3, min(12, 4096 // tb.n))))
+    frames = max(3, min(12, 4096 // tb.n))
+    await tb.run_frames(tb.stimulus(frames))
     watcher.cancel()
-    assert low == 0, f"s_axis_tready low for {low} cycles without output backpressure"
+    fill = frames * (tb.n - tb.n_in)
+    assert low == fill, (f"s_axis_tready low for {low} cycles without output backpressure, "
+                         f"the zero fill is {fill}")
 
 
 @cocotb.test()
@@ -272,25 +281,26 @@ async def test_sqnr_random_full_scale(dut) -> None:
 
 @cocotb.test()
 async def test_throughput_latency(dut) -> None:
-    """No stalls: input never throttled, successive frames' first outputs exactly N cycles
-    apart; measures latency (written to $FFT_BENCH_JSON for the benchmark script)."""
+    """No stalls: input never throttled (a vector every N clocks, its N_IN samples and the
+    zero fill), successive frames' first outputs exactly N cycles apart; measures latency
+    (written to $FFT_BENCH_JSON for the benchmark script)."""
     tb = TB(dut)
     await tb.start()
     frames = 4
     await tb.run_frames(tb.stimulus(frames, ["random"]))
-    n = tb.n
+    n, n_in, n_out = tb.n, tb.n_in, tb.n_out
     ins, outs = tb.in_cycles, tb.out_cycles
-    assert len(ins) == frames * n and len(outs) == frames * n
-    assert ins[-1] - ins[0] == frames * n - 1, "input throttled without backpressure"
-    firsts = [outs[f * n] for f in range(frames)]
+    assert len(ins) == frames * n_in and len(outs) == frames * n_out
+    assert ins[-1] - ins[0] == (frames - 1) * n + n_in - 1, "input throttled beyond the fill"
+    firsts = [outs[f * n_out] for f in range(frames)]
     periods = [b - a for a, b in zip(firsts, firsts[1:], strict=False)]
     assert all(p == n for p in periods), f"frame periods {periods}, expected {n}"
-    assert outs[-1] - outs[0] == frames * n - 1, "output not continuous"
+    assert outs[-1] - outs[0] == (frames - 1) * n + n_out - 1, "output not continuous"
     res = {
         "N": n, "NUM_CH": tb.ch, "INVERSE": int(tb.inverse), "WINDOW": int(tb.window),
         "period": periods[0],
         "latency_first": firsts[0] - ins[0],
-        "latency_last": outs[n - 1] - ins[n - 1],
+        "latency_last": outs[n_out - 1] - ins[n_in - 1],
         "multipliers_per_lane": ff.multipliers_per_lane(n),
     }
     tb.log.info("throughput/latency: %s", res)
@@ -316,7 +326,7 @@ async def test_tlast_events(dut) -> None:
     framing keeps counting N samples, so data stays bit-exact against the model."""
     tb = TB(dut)
     await tb.start()
-    n = tb.n
+    n = tb.n_in
     x = tb.stimulus(4, ["random", "tone"])
     beats = x.reshape(4 * n, tb.ch)
     # chunks: [N/2 (early tlast), N/2], [2N (missing at N-1, tlast at 2N-1)], [N]
@@ -363,7 +373,7 @@ async def test_reset_mid_frame(dut) -> None:
     tb.set_backpressure_generator(random_pause(0.2, seed=5))
     for _ in range(3):
         tb.source.send_nowait(tb.to_frame(tb.stimulus(1)[0]))
-    while len(tb.in_cycles) < n + n // 3:
+    while len(tb.in_cycles) < tb.n_in + n // 3:
         await tb.cycles(1)
     await reset_and_rerun(tb)
 
@@ -384,7 +394,7 @@ async def test_reset_mid_output(dut) -> None:
         tb.source.send_nowait(tb.to_frame(x[f]))
     y, _ = tb.from_frame(await with_timeout(tb.sink.recv(), 20 + 3 * n, "us"))
     assert np.array_equal(y, exp.y[0]), "frame 0 (before the reset) differs from the model"
-    while len(tb.out_cycles) < n + n // 2:
+    while len(tb.out_cycles) < tb.n_out + tb.n_out // 2:
         await tb.cycles(1)
     await reset_and_rerun(tb)
 
@@ -406,6 +416,10 @@ PARAMS = [
     dict(N=1024, NUM_CH=1, WINDOW=1),
     dict(N=16, NUM_CH=1, DATA_W=24, GUARD_W=2, INVERSE=1),
     dict(N=16, NUM_CH=1, SCALE_SCH=0b1110),
+    # zero fill: 15 of 16 samples with their own 15-point window, two lanes; 50 of 64, the
+    # positive half only (a real ADC's range FFT)
+    dict(N=16, NUM_CH=2, WINDOW=1, N_IN=15),
+    dict(N=64, NUM_CH=1, WINDOW=1, N_IN=50, N_OUT=32),
 ]
 if os.environ.get("FFT_AXIS_FULL", "0") not in ("", "0"):
     PARAMS += [dict(N=4096, NUM_CH=1, WINDOW=1), dict(N=32, NUM_CH=1, INVERSE=1)]

@@ -173,6 +173,9 @@ PARAMS = [
     dict(NUM_RX=1, N_DOPPLER=16, N_LOOPS=8, WINDOW=1),
     # plain mean of 13 loops of 16 (reciprocal multiply, zero fill passes unchanged), 1 lane
     dict(NUM_RX=1, N_DOPPLER=16, N_LOOPS=13, WINDOW=0),
+    # the pipeline's 15 loops (zero-filled to 16 by the Doppler FFT behind): 15-word vectors,
+    # weighted by the generated 15-point window (reciprocal multiply), 2 lanes
+    dict(NUM_RX=2, N_DOPPLER=15, N_LOOPS=15, WINDOW=1),
 ]
 
 
@@ -180,8 +183,8 @@ PARAMS = [
     f"{k}{v}" for k, v in p.items()))
 def test_static_removal(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("fft/fft_rom_pkg.sv", "fft/fft_hann_rom.sv", "common/*.sv",
-                            "buffers/buf_*.sv"),
+    sources = [*rtl_sources("fft/fft_rom_pkg.sv", "fft/fft_hann_rom.sv", "fft/fft_win_rom.sv",
+                            "common/*.sv", "buffers/buf_*.sv"),
                *rtl_sources("buffers/static_removal.sv")]
     run_cocotb("static_removal", sources, "test_static_removal", here,
                parameters={"DATA_W": 16, **parameters})

@@ -13,15 +13,17 @@ from model.radar_pipeline import ChainOutput, PipelineParams, chain_output, turn
 
 def run_chain_reference(adc: np.ndarray, cfg: RadarConfig,
                         params: PipelineParams | None = None) -> ChainOutput:
-    """``run_chain`` of adc, complex (num_tx * n_doppler, num_rx, n_range) int16 I/Q, through
-    the reference FFT (slow)."""
+    """``run_chain`` of adc, (num_tx * n_loops, num_rx, n_samples) int16 I/Q (complex, or
+    real for a real ADC), through the reference FFT (slow)."""
     params = params or PipelineParams()
     params.check_mode(cfg)
     cfg.check_adc(adc)
+    nr = cfg.n_range_bins
     rng = fft_fixed_reference(np.transpose(adc, (0, 2, 1)), window=params.window,
-                              scale_sch=params.range_scale_sch)
-    turned = turn(rng.y.reshape(-1, cfg.num_rx), cfg, params)     # chirp-major input order
-    dop = fft_fixed_reference(turned.reshape(-1, cfg.n_doppler, cfg.num_rx),
-                              window=params.window, scale_sch=params.doppler_scale_sch)
-    return chain_output(dop.y.reshape(-1, cfg.num_rx), int(rng.overflow.sum()),
+                              scale_sch=params.range_schedule(cfg), n_fft=cfg.n_range)
+    turned = turn(rng.y[:, :nr].reshape(-1, cfg.num_rx), cfg, params)   # chirp-major input
+    dop = fft_fixed_reference(turned.reshape(-1, cfg.n_loops, cfg.num_rx),
+                              window=params.window, scale_sch=params.doppler_scale_sch,
+                              n_fft=cfg.n_doppler)
+    return chain_output(dop.y.reshape(-1, cfg.num_rx), int(rng.overflow[:, :nr].sum()),
                         int(dop.overflow.sum()), cfg, params)
