@@ -64,7 +64,7 @@ def setup(dut) -> tuple[PipelineTB, str, RadarConfig, PipelineParams]:
     name = os.environ["RP_DETECT_SET"]
     cfg, chain = ALL_SETS[name]
     assert tb.output_mode == 1 and tb.frame_words == chain.frame_words(cfg)
-    tb.set_cfar_scale(chain.cfar_scale(cfg))
+    tb.cfar_scales = chain.cfar_scales(cfg)
     return tb, name, cfg, chain
 
 
