@@ -65,10 +65,10 @@ class TB(AxisTB):
                 n += 1
 
     async def change_limits(self, seed: int) -> None:
-        """cfg_max_detections to a random legal value every few hundred clocks."""
+        """cfg_max_detections to a random legal value every few to few tens of clocks."""
         rng = random.Random(seed)
         while True:
-            await self.cycles(rng.randint(20, 400))
+            await self.cycles(rng.randint(3, 60))
             await FallingEdge(self.dut.clk)
             self.dut.cfg_max_detections.value = rng.randint(1, self.max_det)
 
@@ -201,7 +201,8 @@ async def test_runtime_limit(dut):
     await tb.reset()
     tb.set_backpressure_generator(random_pause(0.3, 2))
     task = cocotb.start_soon(tb.change_limits(seed=5))
-    await tb.run(5, [3 * tb.max_det, 2 * tb.max_det, 1, 3 * tb.max_det, 2], seed=5)
+    await tb.run(8, [3 * tb.max_det, 2 * tb.max_det, 1, 3 * tb.max_det, 2, 4 * tb.max_det,
+                     tb.max_det, 3 * tb.max_det], seed=5)
     task.cancel()
     assert len(set(tb.limits)) > 1, f"the limit never changed between frames: {tb.limits}"
 
