@@ -15,6 +15,7 @@ import numpy as np
 from model.axis_packetizer import packets_per_frame
 from model.chirp_pingpong import adc_frame_to_stream
 from model.detect_records import frame_words as record_frame_words
+from model.radar_regs_map import REGISTERS
 from rtlsim.axis import AxisTB
 from rtlsim.toolchain import param
 
@@ -62,12 +63,11 @@ class PipelineTB(AxisTB):
         at its next frame start); attaches the AXI4-Lite master if needed."""
         if not self.cfar_scales:
             return
-        from host import regs
-
         if self.axil is None:
             self.attach_regs()
+        table = REGISTERS["CFAR_SCALE"]
         for e, value in enumerate(self.cfar_scales):
-            await self.write32(regs.address("CFAR_SCALE", e), value)
+            await self.write32(table.address + e * table.stride, value)
 
     def attach_regs(self, pauses: Callable[[], Iterator[bool]] | None = None) -> None:
         """Drive the register block's AXI4-Lite slave ``s_axil_*`` with cocotbext-axi's
