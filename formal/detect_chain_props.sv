@@ -30,7 +30,8 @@ module detect_chain_props (
   detect_chain #(.NUM_TX(1), .NUM_RX(2), .N_RANGE(4), .N_DOPPLER(4), .GUARD_R(0),
                  .GUARD_D(0), .TRAIN_R(1), .TRAIN_D(1), .KIND(0), .SCALE_W(4),
                  .SCALE_FRAC(1), .MAX_DETECTIONS(1)) dut (
-    .clk, .rst, .cfg_scale, .s_axis_tdata, .s_axis_tvalid, .s_axis_tready, .s_axis_tlast,
+    .clk, .rst, .cfg_scale, .cfg_max_detections(16'd1), .frame_start(),
+    .s_axis_tdata, .s_axis_tvalid, .s_axis_tready, .s_axis_tlast,
     .m_axis_tdata, .m_axis_tvalid, .m_axis_tready, .m_axis_tlast,
     .status_framing_error(framing), .status_truncated(trunc), .detection_count,
     .frame_count);

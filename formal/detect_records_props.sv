@@ -27,7 +27,7 @@ module detect_records_props (
 
   detect_records #(.NUM_TX(1), .NUM_RX(4), .N_RANGE(4), .N_DOPPLER(4), .POW_W(8),
                    .SUM_W(12), .CNT_W(4), .SNAP_ROWS(4), .MAX_DETECTIONS(1)) dut (
-    .clk, .rst, .snap_wr, .snap_data, .snap_room, .s_axis_tdata, .s_axis_tvalid,
+    .clk, .rst, .cfg_max_detections(16'd1), .snap_wr, .snap_data, .snap_room, .s_axis_tdata, .s_axis_tvalid,
     .s_axis_tready, .s_axis_tuser, .m_axis_tdata, .m_axis_tvalid, .m_axis_tready,
     .m_axis_tlast, .status_truncated(trunc), .frame_count);
 

@@ -24,7 +24,7 @@ module radar_pipeline_props (
   radar_pipeline #(.NUM_RX(1), .NUM_TX(1), .N_RANGE(16), .N_DOPPLER(16), .DATA_W(16),
                    .PACKET_WORDS(16), .WINDOW(1'b0), .OUT_BANKS(2)) dut (
     .clk, .rst, .s_axis_adc_tdata, .s_axis_adc_tvalid, .s_axis_adc_tready,
-    .s_axis_adc_tlast, .s_axis_adc_tuser, .cfg_cfar_scale('0),
+    .s_axis_adc_tlast, .s_axis_adc_tuser,
     .s_axil_awvalid(1'b0), .s_axil_awaddr('0), .s_axil_awprot('0), .s_axil_wvalid(1'b0),
     .s_axil_wdata('0), .s_axil_wstrb('0), .s_axil_bready(1'b1), .s_axil_arvalid(1'b0),
     .s_axil_araddr('0), .s_axil_arprot('0), .s_axil_rready(1'b1),

@@ -11,7 +11,7 @@ the cocotb testbench (tb/radar_ctrl) uses the same functions with ``cocotbext-ax
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from model.radar_regs_map import REGISTERS, Register
 
@@ -27,9 +27,13 @@ def register(name: str) -> Register:
         raise KeyError(f"no register {name!r}: one of {', '.join(REGISTERS)}") from None
 
 
-def address(name: str) -> int:
-    """Byte offset of register ``name`` from the block's base address."""
-    return register(name).address
+def address(name: str, index: int = 0) -> int:
+    """Byte offset of register ``name`` (entry ``index`` of a table, e.g. CFAR_SCALE) from
+    the block's base address. IndexError outside the table."""
+    reg = register(name)
+    if not 0 <= index < reg.count:
+        raise IndexError(f"{name}[{index}]: {name} has {reg.count} entries")
+    return reg.address + index * reg.stride
 
 
 def encode(name: str, **fields: int) -> int:
@@ -62,19 +66,26 @@ class RadarRegs:
         self._read32 = read32
         self._write32 = write32
 
-    def read(self, name: str) -> dict[str, int]:
-        """Fields of register ``name``."""
-        return decode(name, self._read32(address(name)))
+    def read(self, name: str, *, index: int = 0) -> dict[str, int]:
+        """Fields of register ``name`` (entry ``index`` of a table)."""
+        return decode(name, self._read32(address(name, index)))
 
-    def write(self, name: str, **fields: int) -> None:
-        """Write the whole register ``name`` (fields not named are written 0)."""
-        self._write32(address(name), encode(name, **fields))
+    def write(self, name: str, *, index: int = 0, **fields: int) -> None:
+        """Write the whole register ``name`` (entry ``index`` of a table; fields not named
+        are written 0)."""
+        self._write32(address(name, index), encode(name, **fields))
 
-    def update(self, name: str, **fields: int) -> None:
+    def update(self, name: str, *, index: int = 0, **fields: int) -> None:
         """Read-modify-write: change only the named fields of register ``name``."""
-        current = self.read(name)
+        current = self.read(name, index=index)
         current.update(fields)
-        self.write(name, **current)
+        self.write(name, index=index, **current)
+
+    def write_cfar_scales(self, scales: Sequence[int]) -> None:
+        """The CFAR threshold scale table, entry e = range edge index e
+        (``model.cfar_2d.scale_table``; CAPS2.cfar_scales entries)."""
+        for e, value in enumerate(scales):
+            self.write("CFAR_SCALE", index=e, value=int(value))
 
     def check_id(self) -> dict[str, int]:
         """Verify the ID register; returns VERSION's fields. Raises RuntimeError on a wrong

@@ -182,12 +182,15 @@ def packetize(frame: np.ndarray, packet_words: int, frame_id: int = 0, header: b
     return out
 
 
-def packetize_stream(frames: Iterable[np.ndarray], packet_words: int, header: bool = True,
-                     first_frame_id: int = 0) -> list[np.ndarray]:
-    """Packets of consecutive loss-free frames (frame ids counting from ``first_frame_id``)."""
+def packetize_stream(frames: Iterable[np.ndarray], packet_words: int | Sequence[int],
+                     header: bool = True, first_frame_id: int = 0) -> list[np.ndarray]:
+    """Packets of consecutive loss-free frames (frame ids counting from ``first_frame_id``).
+    ``packet_words``: one length for every frame, or frame k's length (the RTL's run-time
+    ``cfg_packet_words`` as it stood at the frame's first word)."""
     out: list[np.ndarray] = []
     for k, frame in enumerate(frames):
-        out.extend(packetize(frame, packet_words, first_frame_id + k, header))
+        pw = packet_words if isinstance(packet_words, int) else packet_words[k]
+        out.extend(packetize(frame, pw, first_frame_id + k, header))
     return out
 
 

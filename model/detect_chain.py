@@ -6,7 +6,7 @@ docs/design.md 3.4). The record stream then goes through ``axis_packetizer``
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,18 +97,23 @@ def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
 
 
 def detect_stream(frames: Iterable[np.ndarray], cfg: DetectConfig,
-                  scale: np.ndarray | None = None, first_frame_id: int = 0
-                  ) -> list[np.ndarray]:
+                  scale: np.ndarray | None = None, first_frame_id: int = 0,
+                  scales: Sequence[np.ndarray] | None = None,
+                  limits: Sequence[int] | None = None) -> list[np.ndarray]:
     """Record streams of consecutive frames after reset: list of uint32
     ``(frame_words, num_rx)``, one per frame (frame ids from ``first_frame_id``, sticky
-    truncation from the first frame on)."""
+    truncation from the first frame on). Run-time settings per frame k, as the registers
+    applied them at that frame's start (docs/regs.md): ``scales[k]`` (int64 ``(2PR+1,)``;
+    None: ``scale`` for every frame, by default ``cfg.scale()``) and ``limits[k]`` (records
+    at most, 1..cfg.max_detections; None: cfg.max_detections)."""
     sc = cfg.scale() if scale is None else scale
     out = []
     sticky = False
     for k, f in enumerate(frames):
-        recs, _ = detections(f, cfg, sc)
+        recs, _ = detections(f, cfg, sc if scales is None else scales[k])
+        limit = cfg.max_detections if limits is None else limits[k]
         out.append(detect_records.encode_frame(recs, len(recs), cfg.num_tx, cfg.num_rx,
                                                cfg.max_detections, frame_id=first_frame_id + k,
-                                               sticky=sticky))
-        sticky = sticky or len(recs) > cfg.max_detections
+                                               sticky=sticky, limit=limit))
+        sticky = sticky or len(recs) > limit
     return out

@@ -84,7 +84,8 @@ TRAILER_FIELDS: tuple[Field, ...] = (
     Field("records", 1, 0, 32),
     Field("detections", 2, 0, 32),          # found, saturating at MAX_COUNT
     Field("frame_id", 3, 0, 32),
-    Field("max_detections", 4, 0, 32),
+    Field("max_detections", 4, 0, 32),    # MAX_DETECTIONS: fixes the frame length
+    Field("limit", 5, 0, 32),             # this frame's run-time record limit
 )
 """The trailer's fields (besides :data:`TAG`), named as :class:`Trailer`'s."""
 HDR_LANES = max(f.end for f in (TAG, *RECORD_FIELDS, *TRAILER_FIELDS))
@@ -211,6 +212,8 @@ class Trailer:
     truncated_sticky: bool
     frame_id: int
     max_detections: int
+    limit: int
+    """Records per frame at most in this frame (the run-time setting, <= max_detections)."""
 
 
 @dataclass
@@ -223,14 +226,19 @@ class RecordFrame:
 
 
 def encode_frame(records: Sequence[Record], detections: int, num_tx: int, num_rx: int,
-                 max_detections: int, frame_id: int = 0, sticky: bool = False
-                 ) -> np.ndarray:
+                 max_detections: int, frame_id: int = 0, sticky: bool = False,
+                 limit: int | None = None) -> np.ndarray:
     """Record stream of one frame, uint32 ``(frame_words, num_rx)``, exactly as the RTL
-    sends it. ``records``: the first min(len, max_detections) are sent (each with its
-    position as ``index`` and ``frame_id``); ``detections``: detections found
-    (>= len(records)); ``sticky``: a frame since reset was truncated (this frame's own
-    truncation is included automatically)."""
-    sent = list(records)[:max_detections]
+    sends it. ``max_detections``: the RTL's MAX_DETECTIONS (the frame length); ``limit``:
+    the frame's run-time record limit, 1..max_detections (None: max_detections);
+    ``records``: the first min(len, limit) are sent (each with its position as ``index``
+    and ``frame_id``); ``detections``: detections found (>= len(records)); ``sticky``: a
+    frame since reset was truncated (this frame's own truncation is included
+    automatically)."""
+    limit = max_detections if limit is None else limit
+    if not 1 <= limit <= max_detections:
+        raise ValueError(f"limit {limit} not in 1..{max_detections}")
+    sent = list(records)[:limit]
     n, hw = len(sent), hdr_words(num_rx)
     values = {f.name: [getattr(r, f.name) for r in sent] for f in RECORD_FIELDS}
     values.update(index=range(n), frame_id=[frame_id] * n)
@@ -239,10 +247,10 @@ def encode_frame(records: Sequence[Record], detections: int, num_tx: int, num_rx
     if n:
         rec[:, hw * num_rx:] = np.stack([np.asarray(r.snapshot, dtype=np.uint32).reshape(-1)
                                          for r in sent])
-    truncated = detections > max_detections
+    truncated = detections > limit
     trailer = Trailer(records=n, detections=min(detections, MAX_COUNT), truncated=truncated,
                       truncated_sticky=sticky or truncated, frame_id=frame_id,
-                      max_detections=max_detections)
+                      max_detections=max_detections, limit=limit)
     out = np.zeros((frame_words(num_tx, num_rx, max_detections), num_rx), dtype=np.uint32)
     lanes = out.reshape(-1)                                          # a view of out
     lanes[:rec.size] = rec.reshape(-1)

@@ -41,7 +41,6 @@ from model.axis_packetizer import (
     packetize,
     unpack_iq,
 )
-from model.cfar_2d import pack_scale
 from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
@@ -168,11 +167,11 @@ class PipelineParams:
                               DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),
                               **store)
 
-    def cfar_scale(self, cfg: RadarConfig) -> int:
-        """Value of the top's quasi-static ``cfg_cfar_scale`` input in mode 1 (the threshold
-        scale table for the detector's Pfa, ``model.cfar_2d.pack_scale``)."""
-        d = self.detect_config(cfg)
-        return pack_scale(d.scale(), d.cfar)
+    def cfar_scales(self, cfg: RadarConfig) -> list[int]:
+        """The CFAR_SCALE register table in mode 1: the threshold scale of each range edge
+        index for the detector's Pfa (``model.cfar_2d.scale_table``; entry e = register
+        CFAR_SCALE entry e)."""
+        return [int(v) for v in self.detect_config(cfg).scale()]
 
     def check(self, cfg: RadarConfig) -> None:
         """ValueError for a radar or a combination the RTL refuses at elaboration."""
@@ -343,13 +342,29 @@ def record_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
 
 def dma_packets(adc_frames: list[np.ndarray], cfg: RadarConfig,
                 params: PipelineParams | None = None, first_frame_id: int = 0,
-                removal: Sequence[bool] | None = None) -> list[np.ndarray]:
+                removal: Sequence[bool] | None = None,
+                settings: FrameSettings | None = None) -> list[np.ndarray]:
     """DMA packets of consecutive frames exactly as ``radar_pipeline`` sends them: uint32
     arrays (words, num_rx), one per TLAST-closed packet, header word first. Mode 0: the
-    cube; mode 1: the record streams (:func:`record_frames`), same framing. ``removal``: as
-    :func:`dma_frames`."""
-    return [p for f in dma_frames(adc_frames, cfg, params, first_frame_id, removal)
+    cube; mode 1: the record streams (:func:`record_frames`), same framing. ``removal``,
+    ``settings``: as :func:`dma_frames`."""
+    return [p for f in dma_frames(adc_frames, cfg, params, first_frame_id, removal, settings)
             for p in f.packets]
+
+
+@dataclass(frozen=True)
+class FrameSettings:
+    """Run-time register settings per frame, entry k as frame k ran with them at each
+    consumer (the register's active values at that block's frame start, docs/regs.md);
+    None: the reset value (the HDL parameter) for every frame.
+
+    ``packet_words``: PACKET.words at the packetizer; ``max_detections``:
+    SETTINGS.max_detections at the detector (mode 1); ``scales``: the CFAR_SCALE table at
+    the detector (mode 1), int ``(2PR+1,)`` each."""
+
+    packet_words: Sequence[int] | None = None
+    max_detections: Sequence[int] | None = None
+    scales: Sequence[np.ndarray] | None = None
 
 
 @dataclass(frozen=True)
@@ -369,13 +384,18 @@ class FrameDma:
 
 def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
                params: PipelineParams | None = None, first_frame_id: int = 0,
-               removal: Sequence[bool] | None = None) -> list[FrameDma]:
+               removal: Sequence[bool] | None = None,
+               settings: FrameSettings | None = None) -> list[FrameDma]:
     """:func:`dma_packets` per frame, with each frame's FFT overflow beats (one model run
     gives both: what a soak compares the RTL's packets and status counters with).
     ``removal``: per frame, the register's static-clutter removal switch as that frame ran
     (ACTIVE_SETTINGS.clutter_removal; True needs ``params.static_removal``); None: every
-    frame as ``params.static_removal`` (the reset setting)."""
+    frame as ``params.static_removal`` (the reset setting). ``settings``: the other run-time
+    settings per frame (:class:`FrameSettings`)."""
     params = params or PipelineParams()
+    settings = settings or FrameSettings()
+    n = len(adc_frames)
+    lengths = settings.packet_words or [params.packet_words] * n
     params.check(cfg)
     if removal is None:
         removal = [params.static_removal] * len(adc_frames)
@@ -391,13 +411,14 @@ def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
                 overflow.append((rng_ov, dop_ov))
                 yield pack_iq(dop)
         payloads = detect_stream(words(), params.detect_config(cfg),
-                                 first_frame_id=first_frame_id)
+                                 first_frame_id=first_frame_id, scales=settings.scales,
+                                 limits=settings.max_detections)
     else:
         payloads = []
         for adc, fp in zip(adc_frames, per_frame, strict=True):
             out = run_chain(adc, cfg, fp)
             overflow.append((out.range_overflow, out.doppler_overflow))
             payloads.append(cube_to_payload(out.payload))
-    return [FrameDma(packetize(payload, params.packet_words, first_frame_id + k,
-                               header=params.header), *ov)
+    return [FrameDma(packetize(payload, lengths[k], first_frame_id + k, header=params.header),
+                     *ov)
             for k, (payload, ov) in enumerate(zip(payloads, overflow, strict=True))]

@@ -24,12 +24,14 @@ class Register(NamedTuple):
     """One 32-bit register."""
 
     name: str
-    address: int
+    address: int  # of entry 0
     fields: tuple[Field, ...]
+    count: int = 1  # entries of a memory (a table of 32-bit words)
+    stride: int = 4  # bytes from one entry to the next
 
 
 NAME = 'radar_regs'
-SIZE = 0x54
+SIZE = 0x2f4
 DATA_W = 32
 REGISTERS: dict[str, Register] = {
     'ID': Register(
@@ -38,7 +40,7 @@ REGISTERS: dict[str, Register] = {
         )),
     'VERSION': Register(
         'VERSION', 0x04, (
-            Field('minor', 0, 16, 'r', False, 0x0),
+            Field('minor', 0, 16, 'r', False, 0x1),
             Field('major', 16, 16, 'r', False, 0x1),
         )),
     'CAPS': Register(
@@ -46,15 +48,18 @@ REGISTERS: dict[str, Register] = {
             Field('max_detections', 0, 16, 'r', False, None),
             Field('packet_words', 16, 16, 'r', False, None),
         )),
+    'CAPS2': Register(
+        'CAPS2', 0x0c, (
+            Field('cfar_kinds', 0, 4, 'r', False, None),
+            Field('cfar_scales', 8, 8, 'r', False, None),
+            Field('packet_words_min', 16, 16, 'r', False, None),
+        )),
     'SETTINGS': Register(
         'SETTINGS', 0x10, (
             Field('cfar_kind', 0, 2, 'rw', False, None),
             Field('clutter_removal', 4, 1, 'rw', False, None),
+            Field('local_max', 5, 1, 'rw', False, None),
             Field('max_detections', 16, 16, 'rw', False, None),
-        )),
-    'CFAR_SCALE': Register(
-        'CFAR_SCALE', 0x14, (
-            Field('scale', 0, 32, 'rw', False, None),
         )),
     'PACKET': Register(
         'PACKET', 0x18, (
@@ -64,11 +69,8 @@ REGISTERS: dict[str, Register] = {
         'ACTIVE_SETTINGS', 0x20, (
             Field('cfar_kind', 0, 2, 'r', False, None),
             Field('clutter_removal', 4, 1, 'r', False, None),
+            Field('local_max', 5, 1, 'r', False, None),
             Field('max_detections', 16, 16, 'r', False, None),
-        )),
-    'ACTIVE_CFAR_SCALE': Register(
-        'ACTIVE_CFAR_SCALE', 0x24, (
-            Field('scale', 0, 32, 'r', False, None),
         )),
     'ACTIVE_PACKET': Register(
         'ACTIVE_PACKET', 0x28, (
@@ -108,4 +110,12 @@ REGISTERS: dict[str, Register] = {
         'CFG_ERRORS', 0x50, (
             Field('count', 0, 32, 'r', False, 0x0),
         )),
+    'CFAR_SCALE': Register(
+        'CFAR_SCALE', 0x100, (
+            Field('value', 0, 32, 'rw', False, None),
+        ), 61, 4),
+    'ACTIVE_CFAR_SCALE': Register(
+        'ACTIVE_CFAR_SCALE', 0x200, (
+            Field('value', 0, 32, 'r', False, None),
+        ), 61, 4),
 }

@@ -15,6 +15,7 @@ import numpy as np
 from model.axis_packetizer import packets_per_frame
 from model.chirp_pingpong import adc_frame_to_stream
 from model.detect_records import frame_words as record_frame_words
+from model.radar_regs_map import REGISTERS
 from rtlsim.axis import AxisTB
 from rtlsim.toolchain import param
 
@@ -44,17 +45,31 @@ class PipelineTB(AxisTB):
         self.frame_words = (record_frame_words(self.num_tx, self.num_rx, self.max_detections)
                             if self.output_mode == 1
                             else self.num_tx * self.n_range_bins * self.n_doppler)
-        self.dut.cfg_cfar_scale.value = 0
         # the register block idle until attach_regs (its reset settings hold: static-clutter
         # removal, when built in with STATIC_REMOVAL = 1, on for every frame)
         for name in ("awvalid", "wvalid", "arvalid"):
             getattr(self.dut, f"s_axil_{name}").value = 0
         self.axil = None
+        self.cfar_scales: list[int] = []
+        """CFAR_SCALE register table written after every reset (OUTPUT_MODE = 1), e.g.
+        ``PipelineParams.cfar_scales(cfg)``; empty: the reset scales (0)."""
         self.packets_per_frame = packets_per_frame(self.frame_words, self.packet_words)
 
     async def reset(self, cycles: int = 8) -> None:
-        """Synchronous active-high reset."""
+        """Synchronous active-high reset, then :attr:`cfar_scales` written."""
         await super().reset(cycles)
+        await self.write_cfar_scales()
+
+    async def write_cfar_scales(self) -> None:
+        """Write :attr:`cfar_scales` to the CFAR_SCALE registers (the detector applies them
+        at its next frame start); attaches the AXI4-Lite master if needed."""
+        if not self.cfar_scales:
+            return
+        if self.axil is None:
+            self.attach_regs()
+        table = REGISTERS["CFAR_SCALE"]
+        for e, value in enumerate(self.cfar_scales):
+            await self.write32(table.address + e * table.stride, value)
 
     def attach_regs(self, pauses: Callable[[], Iterator[bool]] | None = None) -> None:
         """Drive the register block's AXI4-Lite slave ``s_axil_*`` with cocotbext-axi's
@@ -78,11 +93,6 @@ class PipelineTB(AxisTB):
     async def write32(self, address: int, value: int) -> None:
         """One 32-bit register write at byte ``address`` (after :meth:`attach_regs`)."""
         await self.axil.write_dword(address, int(value))
-
-    def set_cfar_scale(self, value: int) -> None:
-        """Drive the quasi-static ``cfg_cfar_scale`` input (OUTPUT_MODE = 1), e.g.
-        ``PipelineParams.cfar_scale(cfg)``; call before the first frame."""
-        self.dut.cfg_cfar_scale.value = int(value)
 
     async def send_frame(self, adc: np.ndarray) -> None:
         """Queue one ADC frame, (n_chirps, num_rx, n_samples) of int16 I/Q (complex, or real:
@@ -115,6 +125,7 @@ class PipelineTB(AxisTB):
         await ClockCycles(self.dut.clk, 8)
         self.dut.rst.value = 0
         self.sink.clear()
+        await self.write_cfar_scales()
         try:
             return await self.recv_frames(n_frames, 2 * self.frame_timeout_cycles())
         except SimTimeoutError:

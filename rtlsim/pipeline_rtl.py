@@ -29,9 +29,9 @@ PIPELINE_SOURCES = ("common/*.sv", "fft/*.sv", "buffers/*.sv", "detect/*.sv", "r
 """Globs (under ``rtl/``) of the files the ``radar_pipeline`` top elaborates."""
 
 
-def _cfar_scale(cfg: RadarConfig, chain: PipelineParams) -> int:
-    """Value of the top's ``cfg_cfar_scale`` input: the detector's scale table in mode 1."""
-    return chain.cfar_scale(cfg) if chain.output_mode == 1 else 0
+def _cfar_scales(cfg: RadarConfig, chain: PipelineParams) -> str:
+    """The CFAR_SCALE register table, comma-separated hex (mode 1; empty in mode 0)."""
+    return ",".join(hex(v) for v in chain.cfar_scales(cfg)) if chain.output_mode == 1 else ""
 
 
 def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
@@ -49,7 +49,7 @@ def run_pipeline_rtl(adc_frames: list[np.ndarray], cfg: RadarConfig,
                        extra_env={"RADAR_RTL_ADC": str(d / "adc.npy"),
                                   "RADAR_RTL_DMA": str(d / "dma.npz"),
                                   "RADAR_RTL_STATUS": str(d / "status.json"),
-                                  "RADAR_RTL_CFAR_SCALE": hex(_cfar_scale(cfg, chain))},
+                                  "RADAR_RTL_CFAR_SCALES": _cfar_scales(cfg, chain)},
                        testcase="stream_frames")
         if not (d / "dma.npz").exists():
             raise RuntimeError("the RTL simulation produced no DMA stream (see its log)")

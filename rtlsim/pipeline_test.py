@@ -2,8 +2,8 @@
 (``RADAR_RTL_ADC``: .npy of shape (frames, n_chirps, num_rx, n_range)) through
 ``radar_pipeline`` back to back, write the DMA packets to ``RADAR_RTL_DMA`` (.npz: ``words``
 uint32 (total words, num_rx) and ``lengths``, words per packet) and the status to
-``RADAR_RTL_STATUS`` (JSON). ``RADAR_RTL_CFAR_SCALE``: value of ``cfg_cfar_scale``
-(OUTPUT_MODE = 1)."""
+``RADAR_RTL_STATUS`` (JSON). ``RADAR_RTL_CFAR_SCALES``: the CFAR_SCALE register table,
+comma-separated (OUTPUT_MODE = 1; empty: none written)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,8 @@ from rtlsim.pipeline import PipelineTB
 async def stream_frames(dut) -> None:
     tb = PipelineTB(dut)
     frames = np.load(os.environ["RADAR_RTL_ADC"])
-    tb.set_cfar_scale(int(os.environ.get("RADAR_RTL_CFAR_SCALE", "0"), 0))
+    tb.cfar_scales = [int(v, 0) for v in os.environ.get("RADAR_RTL_CFAR_SCALES", "").split(",")
+                      if v]
     await tb.reset()
     for adc in frames:
         await tb.send_frame(adc)

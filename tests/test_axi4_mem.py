@@ -24,8 +24,9 @@ struct Top {
   CData s_axis_adc_tuser;
   VlWide<4> m_axis_dma_tdata; CData m_axis_dma_tvalid, m_axis_dma_tready, m_axis_dma_tlast;
   CData status_adc_overflow; IData packets_out;
-  VlWide<9> cfg_cfar_scale;  // the detector's threshold scale input (every top has it)
   CData s_axil_awvalid, s_axil_wvalid, s_axil_arvalid, s_axil_bready, s_axil_rready;
+  SData s_axil_awaddr; CData s_axil_awprot, s_axil_wstrb, s_axil_awready, s_axil_wready;
+  IData s_axil_wdata; CData s_axil_bvalid;
   CData m_axi_mem_awid, m_axi_mem_arid, m_axi_mem_bid, m_axi_mem_rid;
   QData m_axi_mem_awaddr; CData m_axi_mem_awlen, m_axi_mem_awsize, m_axi_mem_awburst;
   CData m_axi_mem_awvalid, m_axi_mem_awready;

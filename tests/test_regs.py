@@ -53,8 +53,11 @@ def test_encode_decode() -> None:
     word = regs.encode("SETTINGS", cfar_kind=1, clutter_removal=1, max_detections=300)
     assert word == 1 | 1 << 4 | 300 << 16
     assert regs.decode("SETTINGS", word) == {"cfar_kind": 1, "clutter_removal": 1,
-                                             "max_detections": 300}
+                                             "local_max": 0, "max_detections": 300}
     assert regs.address("STATUS") == 0x30
+    assert regs.address("CFAR_SCALE", 2) == regs.address("CFAR_SCALE") + 8
+    with pytest.raises(IndexError):
+        regs.address("CFAR_SCALE", REGISTERS["CFAR_SCALE"].count)
     with pytest.raises(ValueError, match="no field"):
         regs.encode("SETTINGS", kind=1)
     with pytest.raises(ValueError, match="does not fit"):
@@ -70,13 +73,20 @@ def _bus(model: RadarCtrl) -> regs.RadarRegs:
 def test_access_layer_over_the_model() -> None:
     m = RadarCtrl(max_detections=64, packet_words=512)
     r = _bus(m)
-    assert r.check_id() == {"minor": 0, "major": 1}
+    assert r.check_id() == {"minor": 1, "major": 1}
     assert r.read("CAPS") == {"max_detections": 64, "packet_words": 512}
-    r.update("SETTINGS", cfar_kind=1)
+    assert r.read("CAPS2") == {"cfar_kinds": 0b0111, "cfar_scales": 13, "packet_words_min": 1}
+    r.update("SETTINGS", cfar_kind=1, clutter_removal=1)
+    r.write_cfar_scales([5, 6, 7])
     assert r.read("SETTINGS")["cfar_kind"] == 1
     assert r.read("ACTIVE_SETTINGS")["cfar_kind"] == 0       # not before the frame start
-    m.step(frame_start=True)
+    m.step(removal_start=True, packet_start=True)            # not the detector's
+    assert r.read("ACTIVE_SETTINGS")["cfar_kind"] == 0
+    assert r.read("ACTIVE_SETTINGS")["clutter_removal"] == 1
+    assert r.read("ACTIVE_CFAR_SCALE", index=2)["value"] == 0
+    m.step(detect_start=True)
     assert r.read("ACTIVE_SETTINGS") == r.read("SETTINGS")
+    assert [r.read("ACTIVE_CFAR_SCALE", index=e)["value"] for e in range(4)] == [5, 6, 7, 0]
     r.write("IRQ_ENABLE", error=1)
     m.step(error=True)
     m.step()
@@ -93,15 +103,23 @@ def test_out_of_range_write_is_refused_whole_and_counted() -> None:
     r = _bus(m)
     before = r.read("SETTINGS")
     r.write("SETTINGS", cfar_kind=1, max_detections=9)        # legal kind, bound exceeded
-    r.write("SETTINGS", cfar_kind=2, max_detections=4)        # reserved kind
+    r.write("SETTINGS", cfar_kind=3, max_detections=4)        # kind not built in (OS)
     r.write("PACKET", words=0)
     assert r.read("SETTINGS") == before and r.read("PACKET")["words"] == 16
     assert r.read("CFG_ERRORS")["count"] == 3 and r.read("STATUS")["cfg_error"] == 1
+    r.write("CFAR_SCALE", index=m.n_scales, value=1)          # an entry not built in
+    assert r.read("CFAR_SCALE", index=m.n_scales)["value"] == 0
+    assert r.read("CFG_ERRORS")["count"] == 4
     # byte strobes: the merged word is what is checked
     m.write(regs.address("SETTINGS") + 2, 8 << 16, strb=0b1100)
     assert r.read("SETTINGS")["max_detections"] == 8
     m.write(regs.address("SETTINGS"), 3, strb=0b0001)
-    assert r.read("CFG_ERRORS")["count"] == 4
+    assert r.read("CFG_ERRORS")["count"] == 5
+    narrow = RadarCtrl(scale_w=20, packet_words_min=4)
+    rn = _bus(narrow)
+    rn.write("CFAR_SCALE", index=1, value=1 << 20)            # wider than SCALE_W
+    rn.write("PACKET", words=3)                               # below CAPS2.packet_words_min
+    assert rn.read("CFG_ERRORS")["count"] == 2 and rn.read("CFAR_SCALE", index=1)["value"] == 0
 
 
 def test_counters_saturate_and_reset() -> None:

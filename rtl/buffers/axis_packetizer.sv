@@ -7,6 +7,12 @@
 // it); the CRC: model/packet_crc.py, which generates packet_crc32.sv.
 // Frame boundaries come from counting FRAME_WORDS input words after reset; s_axis_tlast is
 // only checked (every TLAST_PERIOD words) and a mismatch raises the framing error flag.
+// Packet length: cfg_packet_words (a run-time setting, PACKET_WORDS_MIN..PACKET_WORDS, see
+// below) taken with a frame's first word and held for the frame. The packets per frame the
+// header states come from a sequential divider (13 clocks) that follows the setting while
+// no word of a frame has been taken; only when the length changed fewer clocks than that
+// before a frame's first packet closes does the input wait for it (INPUT_BACKPRESSURE = 1;
+// with 0 the length must stay PACKET_WORDS).
 // Store and forward: a packet is sent only once it is complete in its bank, so its header
 // can state its exact length and whether words were dropped from it.
 `default_nettype none
@@ -16,7 +22,8 @@ module axis_packetizer #(
   parameter int NUM_RX = 4,
   // Bits of I and of Q; the DMA format is 32-bit {Q,I} lanes, so only 16 is legal.
   parameter int DATA_W = 16,
-  // Payload words per packet (the last packet of a frame may be shorter), 2..65535.
+  // Payload words per packet at most (the last packet of a frame may be shorter), 2..65535;
+  // the run-time length cfg_packet_words may be shorter.
   parameter int PACKET_WORDS = 256,
   // Payload words per frame, 1..2^30; at most 4096 packets per frame (12-bit sequence).
   parameter int FRAME_WORDS = 16384,
@@ -38,6 +45,10 @@ module axis_packetizer #(
 ) (
   input  wire logic                     clk,
   input  wire logic                     rst,
+  // Payload words per packet for the frames from the next one on, PACKET_WORDS_MIN ..
+  // PACKET_WORDS (PACKET_WORDS_MIN = max(2, ceil(FRAME_WORDS / 4096))), sampled with a
+  // frame's first word; tie to PACKET_WORDS for a fixed length
+  input  wire logic [15:0]              cfg_packet_words,
   // Input stream (Doppler FFT output, payload order)
   input  wire logic [NUM_RX*32-1:0]     s_axis_tdata,
   input  wire logic                     s_axis_tvalid,
@@ -65,13 +76,19 @@ module axis_packetizer #(
   // Derived sizes
   localparam int WORD_W    = NUM_RX * 32;
   localparam int NPKT      = (FRAME_WORDS + PACKET_WORDS - 1) / PACKET_WORDS;
+  /* verilator lint_off UNUSEDPARAM */ // (the formal properties' packet plan)
   localparam int LAST_LEN  = FRAME_WORDS - (NPKT - 1) * PACKET_WORDS;  // words, last packet
+  /* verilator lint_on UNUSEDPARAM */
   localparam int POS_W     = $clog2(PACKET_WORDS);
   localparam int BANK_W    = $clog2(NUM_BANKS);
   localparam int LEN_W     = $clog2(PACKET_WORDS + 1);
   localparam int SEQ_W     = 12;
   localparam int TLP       = (TLAST_PERIOD > 0) ? TLAST_PERIOD : 1;
   localparam int TLP_W     = $clog2(TLP + 1);
+  localparam int FWC_W     = $clog2(FRAME_WORDS + 1);
+  localparam int NP_W      = 13;                                       // packets per frame
+  localparam int PW_MIN    = ((FRAME_WORDS + 4095) / 4096 > 2)          // shortest packet
+                             ? (FRAME_WORDS + 4095) / 4096 : 2;
   localparam logic [7:0] MAGIC = 8'hA5;
 
   // Parameter checks: stop elaboration on illegal values.
@@ -120,6 +137,7 @@ module axis_packetizer #(
     logic [LEN_W-1:0] len;       // payload words stored
     logic [LEN_W-1:0] drops;     // payload words dropped
     logic [SEQ_W-1:0] seq;       // packet number within the frame
+    logic [NP_W-1:0]  npkt;      // packets of its frame
     logic [31:0]      frame;     // frame id (frames since reset)
     logic             last;      // packet ends its frame
     logic             ovf;       // status_overflow when the packet closed
@@ -128,7 +146,7 @@ module axis_packetizer #(
   } desc_t;
 
   // (plain vectors: Yosys mis-reads an unpacked array of packed structs, formal/README)
-  localparam int DESC_W = 2 * LEN_W + SEQ_W + 32 + 4;  // $bits(desc_t)
+  localparam int DESC_W = 2 * LEN_W + SEQ_W + NP_W + 32 + 4;  // $bits(desc_t)
   logic [DESC_W-1:0] desc_q [NUM_BANKS];
   logic [NUM_BANKS-1:0] full_q;            // bank holds a complete packet not yet fully read
 
@@ -140,20 +158,24 @@ module axis_packetizer #(
   logic [LEN_W-1:0] wr_drop_q;   // words dropped from the open packet
   logic             wr_dmg_q;    // a word of the open packet was marked damaged
   logic [SEQ_W-1:0] seq_q;
+  logic [FWC_W-1:0] fw_q;        // input word position within the frame
+  logic [LEN_W-1:0] pw_q, pw;    // the frame's packet length (pw: also for its first word)
   logic [31:0]      frame_q;
   logic [TLP_W-1:0] tl_pos_q;
   logic             ovf_q, framing_q;
   logic [31:0]      drop_cnt_q, framing_cnt_q, frame_cnt_q, packet_cnt_q;
 
-  logic             beat, space, store, frame_end, pkt_end, tlast_err;
+  logic             beat, space, store, frame_end, pkt_end, tlast_err, npkt_ok;
   logic [LEN_W-1:0] cnt_next, drop_next;
 
+  assign pw            = (fw_q == '0) ? LEN_W'(cfg_packet_words) : pw_q;
   assign space         = !full_q[wr_bank_q];
-  assign s_axis_tready = INPUT_BACKPRESSURE ? space : 1'b1;
+  // a packet closes only once its frame's packet count is known
+  assign s_axis_tready = INPUT_BACKPRESSURE ? space && (npkt_ok || !pkt_end) : 1'b1;
   assign beat          = s_axis_tvalid && s_axis_tready;
   assign store         = beat && space;
-  assign frame_end     = (seq_q == SEQ_W'(NPKT - 1)) && (pos_q == POS_W'(LAST_LEN - 1));
-  assign pkt_end       = (pos_q == POS_W'(PACKET_WORDS - 1)) || frame_end;
+  assign frame_end     = (fw_q == FWC_W'(FRAME_WORDS - 1));
+  assign pkt_end       = (LEN_W'(pos_q) == pw - 1'b1) || frame_end;
   assign cnt_next      = wr_cnt_q + LEN_W'(store);
   assign drop_next     = wr_drop_q + LEN_W'(beat && !space);
   assign tlast_err     = (TLAST_PERIOD > 0) && beat &&
@@ -161,6 +183,39 @@ module axis_packetizer #(
 
   assign ram_wr_en   = store;
   assign ram_wr_addr = {wr_bank_q, wr_cnt_q[POS_W-1:0]};
+
+  // Packets per frame, ceil(FRAME_WORDS / pw), by long division (quotient bits 12..0, one a
+  // clock), restarted whenever pw changes; at reset the count of PACKET_WORDS.
+  logic [LEN_W-1:0] dv_op_q;
+  logic [31:0]      dv_rem_q, dv_div_q;
+  logic [NP_W-1:0]  dv_np_q;
+  logic [3:0]       dv_i_q;
+  logic             dv_busy_q, dv_ge;
+  assign dv_ge   = (dv_rem_q >= dv_div_q);
+  assign npkt_ok = !dv_busy_q && (dv_op_q == pw);
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      dv_op_q   <= LEN_W'(PACKET_WORDS);
+      dv_np_q   <= NP_W'(NPKT);
+      dv_busy_q <= 1'b0;
+      dv_rem_q  <= '0;
+      dv_div_q  <= '0;
+      dv_i_q    <= '0;
+    end else if (dv_op_q != pw) begin
+      dv_op_q   <= pw;
+      dv_rem_q  <= 32'(FRAME_WORDS) + 32'(pw) - 32'd1;
+      dv_div_q  <= 32'(pw) << (NP_W - 1);
+      dv_np_q   <= '0;
+      dv_i_q    <= 4'(NP_W - 1);
+      dv_busy_q <= 1'b1;
+    end else if (dv_busy_q) begin
+      if (dv_ge) dv_rem_q <= dv_rem_q - dv_div_q;
+      dv_np_q   <= {dv_np_q[NP_W-2:0], dv_ge};
+      dv_div_q  <= dv_div_q >> 1;
+      dv_i_q    <= dv_i_q - 1'b1;
+      dv_busy_q <= (dv_i_q != '0);
+    end
+  end
 
   // ---------------------------------------------------------------------------------------
   // Output side: header (if any), the payload of bank rd_bank_q, then (with the header) the
@@ -203,7 +258,7 @@ module axis_packetizer #(
                        rd_desc.framing, rd_desc.ovf, (rd_desc.drops != '0), rd_desc.last};
     hdr_full[63:32] = {16'(rd_desc.drops), 16'(rd_desc.len)};
     hdr_full[95:64] = rd_desc.frame;
-    hdr_full[127:96] = {rd_desc.damaged, 15'(NPKT), 16'(rd_desc.seq)};
+    hdr_full[127:96] = {rd_desc.damaged, 15'(rd_desc.npkt), 16'(rd_desc.seq)};
   end
   assign hdr_word = hdr_full[WORD_W-1:0];
 
@@ -238,6 +293,7 @@ module axis_packetizer #(
     new_desc.len     = cnt_next;
     new_desc.drops   = drop_next;
     new_desc.seq     = seq_q;
+    new_desc.npkt    = dv_np_q;
     new_desc.frame   = frame_q;
     new_desc.last    = frame_end;
     new_desc.ovf     = ovf_q || (beat && !space);
@@ -271,6 +327,8 @@ module axis_packetizer #(
       wr_drop_q     <= '0;
       wr_dmg_q      <= 1'b0;
       seq_q         <= '0;
+      fw_q          <= '0;
+      pw_q          <= LEN_W'(PACKET_WORDS);
       frame_q       <= '0;
       tl_pos_q      <= '0;
       ovf_q         <= 1'b0;
@@ -287,6 +345,8 @@ module axis_packetizer #(
       // input side
       if (beat) begin
         tl_pos_q <= (tl_pos_q == TLP_W'(TLP - 1) || frame_end) ? '0 : tl_pos_q + 1'b1;
+        fw_q     <= frame_end ? '0 : fw_q + 1'b1;
+        if (fw_q == '0) pw_q <= pw;
         if (!space) begin
           ovf_q <= 1'b1;
           if (drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 1'b1;
@@ -334,6 +394,19 @@ module axis_packetizer #(
     end
   end
 
+`ifndef SYNTHESIS
+`ifndef FORMAL  // (formal/axis_packetizer.sby fixes the length instead)
+  // the run-time length is legal where it is taken (a frame's first word)
+  always_ff @(posedge clk) begin
+    if (!rst && beat && fw_q == '0)
+      assert (32'(cfg_packet_words) >= 32'(PW_MIN) && 32'(cfg_packet_words) <= PACKET_WORDS
+              && (INPUT_BACKPRESSURE || 32'(cfg_packet_words) == PACKET_WORDS))
+        else $error("%m: cfg_packet_words=%0d not in %0d..%0d", cfg_packet_words, PW_MIN,
+                    PACKET_WORDS);
+  end
+`endif
+`endif
+
   assign status_overflow      = ovf_q;
   assign status_framing_error = framing_q;
   assign drop_count           = drop_cnt_q;
@@ -378,6 +451,11 @@ module axis_packetizer #(
     f_dn = '0;
     if (f_past && !rst) begin
       assume (frame_q != '1);
+      // the packet plan below is the one of PACKET_WORDS (the run-time length fixed there)
+      assume (cfg_packet_words == 16'(PACKET_WORDS));
+      assert (pw_q == LEN_W'(PACKET_WORDS) && dv_op_q == LEN_W'(PACKET_WORDS));
+      assert (!dv_busy_q && dv_np_q == NP_W'(NPKT));
+      assert (32'(fw_q) == 32'(seq_q) * PACKET_WORDS + 32'(pos_q));
       assert (seq_q <= SEQ_W'(NPKT - 1));
       assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
       if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));

@@ -3,6 +3,13 @@
 // records out. nci (|x|^2 over NUM_TX x NUM_RX) -> cfar_2d -> detect_records, whose
 // snapshot ring is written from the same input stream. The record stream has a fixed
 // FRAME_WORDS per frame, ready for axis_packetizer (header, sequence numbers, loss flags).
+// Run-time settings (cfg_scale, cfg_max_detections) change only in the cycle after a
+// frame_start pulse: the CFAR takes the first word of a frame's range row 1. By then the
+// CFAR has tested every row of the previous frame (it tests a frame's last rows before it
+// takes the next frame's input, and its pipeline reads the scale 6 clocks after a step,
+// fewer than the N_DOPPLER >= 8 words of row 0; the top has >= 16), and it tests no row of
+// the new frame before it takes row GUARD_R+TRAIN_R+1; detect_records takes the record
+// limit with a frame's first cell, which comes after that pulse too.
 // Formats and the pass schedule: docs/detect.md; model: model/detect_chain.py.
 `default_nettype none
 
@@ -39,8 +46,11 @@ module detect_chain #(
 ) (
   input  wire logic                     clk,
   input  wire logic                     rst,
-  // Threshold scale per CFAR edge index (model/cfar_2d.py scale_table), quasi-static
+  // Threshold scale per CFAR edge index (model/cfar_2d.py scale_table); records per frame
+  // at most, 1..MAX_DETECTIONS. Change them only in the cycle after frame_start.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_scale,
+  input  wire logic [15:0]              cfg_max_detections,
+  output logic                          frame_start,   // the settings may change after it
   // Doppler-FFT output in (r, t, d) order, TLAST on Doppler bin N_DOPPLER-1 (checked)
   input  wire logic [NUM_RX*32-1:0]     s_axis_tdata,
   input  wire logic                     s_axis_tvalid,
@@ -112,10 +122,18 @@ module detect_chain #(
     .detection_count(detection_count)
   );
 
+  // frame start: the CFAR takes word N_DOPPLER of a frame (the first of range row 1)
+  logic [BR+BD-1:0] cin_q;             // CFAR input words of this frame
+  always_ff @(posedge clk) begin
+    if (rst) cin_q <= '0;
+    else if (nci_tvalid && nci_tready) cin_q <= cin_q + 1'b1;
+  end
+  assign frame_start = nci_tvalid && nci_tready && (cin_q == (BR+BD)'(N_DOPPLER));
+
   detect_records #(.NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RANGE),
                    .N_DOPPLER(N_DOPPLER), .POW_W(POW_W), .SUM_W(SUM_W), .CNT_W(CNT_W),
                    .SNAP_ROWS(SNAP_ROWS), .MAX_DETECTIONS(MAX_DETECTIONS)) u_rec (
-    .clk(clk), .rst(rst),
+    .clk(clk), .rst(rst), .cfg_max_detections(cfg_max_detections),
     .snap_wr(s_axis_tvalid && s_axis_tready), .snap_data(s_axis_tdata), .snap_room(snap_room),
     .s_axis_tdata(cf_tdata), .s_axis_tvalid(cf_tvalid), .s_axis_tready(cf_tready),
     .s_axis_tuser(cf_tuser),

@@ -4,6 +4,9 @@
 // the NUM_TX words of NUM_RX complex values of that cell), then a per-frame trailer with the
 // record count and the truncated flag, then zero padding to a fixed FRAME_WORDS so the
 // stream can go through axis_packetizer (header/sequence framing, loss detection).
+// Records per frame: at most cfg_max_detections (1..MAX_DETECTIONS, a run-time setting
+// taken with the frame's first cell and held for the frame); the frame length stays the one
+// MAX_DETECTIONS fixes, which the trailer reports beside the frame's limit.
 //
 // Record and trailer layout: docs/detect.md and model/detect_records.py (the host decoder
 // uses that model). Header vector: 16 lanes of 32 bits sent as HDR_WORDS = ceil(16/NUM_RX)
@@ -40,6 +43,8 @@ module detect_records #(
 ) (
   input  wire logic                        clk,
   input  wire logic                        rst,
+  // Records per frame at most, 1..MAX_DETECTIONS, sampled with a frame's first cell
+  input  wire logic [15:0]                 cfg_max_detections,
   // Snapshot write port: Doppler-FFT words in (r, t, d) order, written when snap_wr
   input  wire logic                        snap_wr,
   input  wire logic [NUM_RX*32-1:0]        snap_data,
@@ -57,7 +62,7 @@ module detect_records #(
   output logic                             m_axis_tlast,
   // Status (cleared only by rst)
   output logic                             status_truncated,  // sticky: a frame had more
-                                                              // than MAX_DETECTIONS
+                                                              // than its limit
   output logic      [31:0]                 frame_count        // frames of records sent
 );
 
@@ -152,6 +157,8 @@ module detect_records #(
   logic [TS_W-1:0]  st_q;              // snapshot word index (TX)
   logic             in_hdr_q;
   logic [RC_W-1:0]  n_rec_q, n_det_q;  // records sent / detections found, this frame
+  logic [15:0]      lim_q;             // this frame's record limit (from its first cell)
+  logic [RC_W-1:0]  limit;
   logic [BR+BD-1:0] cell_q;            // cells of this frame consumed
   logic [FW_W-1:0]  out_q;             // words of this frame issued
   logic [31:0]      frame_q;
@@ -169,6 +176,8 @@ module detect_records #(
   assign cell_beat     = s_axis_tvalid && s_axis_tready;
   assign issue         = can_issue && (state_q != S_CELL);
   assign last_word     = (out_q == FW_W'(FRAME_WORDS - 1));
+  // the limit: cfg_max_detections with the frame's first cell, then held
+  assign limit         = RC_W'((cell_q == '0) ? cfg_max_detections : lim_q);
 
   // Header vectors (docs/detect.md)
   logic [HV_W-1:0] rec_hdr, trl_hdr, hdr_vec;
@@ -187,6 +196,7 @@ module detect_records #(
     trl_hdr[95:64]   = 32'(n_det_q);
     trl_hdr[127:96]  = frame_q;
     trl_hdr[159:128] = 32'(MAX_DETECTIONS);
+    trl_hdr[191:160] = 32'(lim_q);
     hdr_vec = (state_q == S_TRAILER) ? trl_hdr : rec_hdr;
   end
 
@@ -245,6 +255,7 @@ module detect_records #(
       hw_q        <= '0;
       st_q        <= '0;
       in_hdr_q    <= 1'b1;
+      lim_q       <= 16'(MAX_DETECTIONS);
       n_rec_q     <= '0;
       n_det_q     <= '0;
       cell_q      <= '0;
@@ -266,14 +277,15 @@ module detect_records #(
         S_CELL: if (cell_beat) begin
           cell_q      <= cell_q + 1'b1;
           frame_end_q <= (cell_q == '1);
+          if (cell_q == '0) lim_q <= cfg_max_detections;
           if (det) begin
             if (n_det_q != '1) n_det_q <= n_det_q + 1'b1;
-            if (n_rec_q == RC_W'(MAX_DETECTIONS)) begin
+            if (n_rec_q == limit) begin
               trunc_q  <= 1'b1;
               sticky_q <= 1'b1;
             end
           end
-          if (det && n_rec_q != RC_W'(MAX_DETECTIONS)) begin
+          if (det && n_rec_q != limit) begin
             state_q  <= S_REC;
             hw_q     <= '0;
             st_q     <= '0;
@@ -331,6 +343,10 @@ module detect_records #(
   // block invariant: the snapshot ring is never written without room
   always_ff @(posedge clk) begin
     if (!rst && snap_wr) assert (snap_room) else $error("%m: snapshot written without room");
+    if (!rst && cell_beat && cell_q == '0)
+      assert (cfg_max_detections != '0 && 32'(cfg_max_detections) <= 32'(MAX_DETECTIONS))
+        else $error("%m: cfg_max_detections=%0d not in 1..%0d", cfg_max_detections,
+                    MAX_DETECTIONS);
   end
 `endif
 

@@ -11,7 +11,7 @@ module radar_regs (
 
         output logic s_axil_awready,
         input wire s_axil_awvalid,
-        input wire [6:0] s_axil_awaddr,
+        input wire [9:0] s_axil_awaddr,
         input wire [2:0] s_axil_awprot,
         output logic s_axil_wready,
         input wire s_axil_wvalid,
@@ -22,7 +22,7 @@ module radar_regs (
         output logic [1:0] s_axil_bresp,
         output logic s_axil_arready,
         input wire s_axil_arvalid,
-        input wire [6:0] s_axil_araddr,
+        input wire [9:0] s_axil_araddr,
         input wire [2:0] s_axil_arprot,
         input wire s_axil_rready,
         output logic s_axil_rvalid,
@@ -38,7 +38,7 @@ module radar_regs (
     //--------------------------------------------------------------------------
     logic cpuif_req;
     logic cpuif_req_is_wr;
-    logic [6:0] cpuif_addr;
+    logic [9:0] cpuif_addr;
     logic [31:0] cpuif_wr_data;
     logic [31:0] cpuif_wr_biten;
     logic cpuif_req_stall_wr;
@@ -55,10 +55,10 @@ module radar_regs (
     logic [1:0] axil_n_in_flight;
     logic axil_prev_was_rd;
     logic axil_arvalid;
-    logic [6:0] axil_araddr;
+    logic [9:0] axil_araddr;
     logic axil_ar_accept;
     logic axil_awvalid;
-    logic [6:0] axil_awaddr;
+    logic [9:0] axil_awaddr;
     logic axil_wvalid;
     logic [31:0] axil_wdata;
     logic [3:0] axil_wstrb;
@@ -136,17 +136,17 @@ module radar_regs (
             if(axil_arvalid && !axil_prev_was_rd) begin
                 cpuif_req = '1;
                 cpuif_req_is_wr = '0;
-                cpuif_addr = {axil_araddr[6:2], 2'b0};
+                cpuif_addr = {axil_araddr[9:2], 2'b0};
                 if(!cpuif_req_stall_rd) axil_ar_accept = '1;
             end else if(axil_awvalid && axil_wvalid) begin
                 cpuif_req = '1;
                 cpuif_req_is_wr = '1;
-                cpuif_addr = {axil_awaddr[6:2], 2'b0};
+                cpuif_addr = {axil_awaddr[9:2], 2'b0};
                 if(!cpuif_req_stall_wr) axil_aw_accept = '1;
             end else if(axil_arvalid) begin
                 cpuif_req = '1;
                 cpuif_req_is_wr = '0;
-                cpuif_addr = {axil_araddr[6:2], 2'b0};
+                cpuif_addr = {axil_araddr[9:2], 2'b0};
                 if(!cpuif_req_stall_rd) axil_ar_accept = '1;
             end
         end
@@ -234,11 +234,10 @@ module radar_regs (
         logic ID;
         logic VERSION;
         logic CAPS;
+        logic CAPS2;
         logic SETTINGS;
-        logic CFAR_SCALE;
         logic PACKET;
         logic ACTIVE_SETTINGS;
-        logic ACTIVE_CFAR_SCALE;
         logic ACTIVE_PACKET;
         logic STATUS;
         logic IRQ_ENABLE;
@@ -247,12 +246,14 @@ module radar_regs (
         logic DROPS;
         logic ERRORS;
         logic CFG_ERRORS;
+        logic CFAR_SCALE;
+        logic ACTIVE_CFAR_SCALE;
     } decoded_reg_strb_t;
     decoded_reg_strb_t decoded_reg_strb;
     logic decoded_err;
     logic decoded_req_is_external;
 
-    logic [6:0] decoded_addr;
+    logic [9:0] decoded_addr;
     logic decoded_req;
     logic decoded_req_is_wr;
     logic [31:0] decoded_wr_data;
@@ -265,25 +266,27 @@ module radar_regs (
         is_external = '0;
         is_valid_addr = '1; // No valid address check
         is_valid_rw = '1; // No valid RW check
-        decoded_reg_strb.ID = cpuif_req_masked & (cpuif_addr == 7'h0) & !cpuif_req_is_wr;
-        decoded_reg_strb.VERSION = cpuif_req_masked & (cpuif_addr == 7'h4) & !cpuif_req_is_wr;
-        decoded_reg_strb.CAPS = cpuif_req_masked & (cpuif_addr == 7'h8) & !cpuif_req_is_wr;
-        decoded_reg_strb.SETTINGS = cpuif_req_masked & (cpuif_addr == 7'h10);
-        is_external |= cpuif_req_masked & (cpuif_addr == 7'h10);
-        decoded_reg_strb.CFAR_SCALE = cpuif_req_masked & (cpuif_addr == 7'h14);
-        is_external |= cpuif_req_masked & (cpuif_addr == 7'h14);
-        decoded_reg_strb.PACKET = cpuif_req_masked & (cpuif_addr == 7'h18);
-        is_external |= cpuif_req_masked & (cpuif_addr == 7'h18);
-        decoded_reg_strb.ACTIVE_SETTINGS = cpuif_req_masked & (cpuif_addr == 7'h20) & !cpuif_req_is_wr;
-        decoded_reg_strb.ACTIVE_CFAR_SCALE = cpuif_req_masked & (cpuif_addr == 7'h24) & !cpuif_req_is_wr;
-        decoded_reg_strb.ACTIVE_PACKET = cpuif_req_masked & (cpuif_addr == 7'h28) & !cpuif_req_is_wr;
-        decoded_reg_strb.STATUS = cpuif_req_masked & (cpuif_addr == 7'h30);
-        decoded_reg_strb.IRQ_ENABLE = cpuif_req_masked & (cpuif_addr == 7'h34);
-        decoded_reg_strb.FRAMES = cpuif_req_masked & (cpuif_addr == 7'h40) & !cpuif_req_is_wr;
-        decoded_reg_strb.PACKETS = cpuif_req_masked & (cpuif_addr == 7'h44) & !cpuif_req_is_wr;
-        decoded_reg_strb.DROPS = cpuif_req_masked & (cpuif_addr == 7'h48) & !cpuif_req_is_wr;
-        decoded_reg_strb.ERRORS = cpuif_req_masked & (cpuif_addr == 7'h4c) & !cpuif_req_is_wr;
-        decoded_reg_strb.CFG_ERRORS = cpuif_req_masked & (cpuif_addr == 7'h50) & !cpuif_req_is_wr;
+        decoded_reg_strb.ID = cpuif_req_masked & (cpuif_addr == 10'h0) & !cpuif_req_is_wr;
+        decoded_reg_strb.VERSION = cpuif_req_masked & (cpuif_addr == 10'h4) & !cpuif_req_is_wr;
+        decoded_reg_strb.CAPS = cpuif_req_masked & (cpuif_addr == 10'h8) & !cpuif_req_is_wr;
+        decoded_reg_strb.CAPS2 = cpuif_req_masked & (cpuif_addr == 10'hc) & !cpuif_req_is_wr;
+        decoded_reg_strb.SETTINGS = cpuif_req_masked & (cpuif_addr == 10'h10);
+        is_external |= cpuif_req_masked & (cpuif_addr == 10'h10);
+        decoded_reg_strb.PACKET = cpuif_req_masked & (cpuif_addr == 10'h18);
+        is_external |= cpuif_req_masked & (cpuif_addr == 10'h18);
+        decoded_reg_strb.ACTIVE_SETTINGS = cpuif_req_masked & (cpuif_addr == 10'h20) & !cpuif_req_is_wr;
+        decoded_reg_strb.ACTIVE_PACKET = cpuif_req_masked & (cpuif_addr == 10'h28) & !cpuif_req_is_wr;
+        decoded_reg_strb.STATUS = cpuif_req_masked & (cpuif_addr == 10'h30);
+        decoded_reg_strb.IRQ_ENABLE = cpuif_req_masked & (cpuif_addr == 10'h34);
+        decoded_reg_strb.FRAMES = cpuif_req_masked & (cpuif_addr == 10'h40) & !cpuif_req_is_wr;
+        decoded_reg_strb.PACKETS = cpuif_req_masked & (cpuif_addr == 10'h44) & !cpuif_req_is_wr;
+        decoded_reg_strb.DROPS = cpuif_req_masked & (cpuif_addr == 10'h48) & !cpuif_req_is_wr;
+        decoded_reg_strb.ERRORS = cpuif_req_masked & (cpuif_addr == 10'h4c) & !cpuif_req_is_wr;
+        decoded_reg_strb.CFG_ERRORS = cpuif_req_masked & (cpuif_addr == 10'h50) & !cpuif_req_is_wr;
+        decoded_reg_strb.CFAR_SCALE = cpuif_req_masked & (cpuif_addr >= 10'h100) & (cpuif_addr <= 10'h100 + 10'hf3);
+        is_external |= cpuif_req_masked & (cpuif_addr >= 10'h100) & (cpuif_addr <= 10'h100 + 10'hf3);
+        decoded_reg_strb.ACTIVE_CFAR_SCALE = cpuif_req_masked & (cpuif_addr >= 10'h200) & (cpuif_addr <= 10'h200 + 10'hf3) & !cpuif_req_is_wr;
+        is_external |= cpuif_req_masked & (cpuif_addr >= 10'h200) & (cpuif_addr <= 10'h200 + 10'hf3) & !cpuif_req_is_wr;
         decoded_err = '0;
         decoded_req_is_external = is_external;
     end
@@ -456,11 +459,6 @@ module radar_regs (
     assign hwif_out.SETTINGS.req_is_wr = decoded_req_is_wr;
     assign hwif_out.SETTINGS.wr_data = decoded_wr_data;
     assign hwif_out.SETTINGS.wr_biten = decoded_wr_biten;
-    // External register: radar_regs.CFAR_SCALE
-    assign hwif_out.CFAR_SCALE.req = decoded_reg_strb.CFAR_SCALE;
-    assign hwif_out.CFAR_SCALE.req_is_wr = decoded_req_is_wr;
-    assign hwif_out.CFAR_SCALE.wr_data = decoded_wr_data;
-    assign hwif_out.CFAR_SCALE.wr_biten = decoded_wr_biten;
     // External register: radar_regs.PACKET
     assign hwif_out.PACKET.req = decoded_reg_strb.PACKET;
     assign hwif_out.PACKET.req_is_wr = decoded_req_is_wr;
@@ -807,6 +805,18 @@ module radar_regs (
             end
         end
     end
+    // External region: radar_regs.CFAR_SCALE
+    assign hwif_out.CFAR_SCALE.req = decoded_reg_strb.CFAR_SCALE;
+    assign hwif_out.CFAR_SCALE.addr = decoded_addr[7:0];
+    assign hwif_out.CFAR_SCALE.req_is_wr = decoded_req_is_wr;
+    assign hwif_out.CFAR_SCALE.wr_data = decoded_wr_data;
+    assign hwif_out.CFAR_SCALE.wr_biten = decoded_wr_biten;
+    // External region: radar_regs.ACTIVE_CFAR_SCALE
+    assign hwif_out.ACTIVE_CFAR_SCALE.req = decoded_reg_strb.ACTIVE_CFAR_SCALE;
+    assign hwif_out.ACTIVE_CFAR_SCALE.addr = decoded_addr[7:0];
+    assign hwif_out.ACTIVE_CFAR_SCALE.req_is_wr = decoded_req_is_wr;
+    assign hwif_out.ACTIVE_CFAR_SCALE.wr_data = decoded_wr_data;
+    assign hwif_out.ACTIVE_CFAR_SCALE.wr_biten = decoded_wr_biten;
 
     //--------------------------------------------------------------------------
     // Write response
@@ -815,8 +825,9 @@ module radar_regs (
         automatic logic wr_ack;
         wr_ack = '0;
         wr_ack |= hwif_in.SETTINGS.wr_ack;
-        wr_ack |= hwif_in.CFAR_SCALE.wr_ack;
         wr_ack |= hwif_in.PACKET.wr_ack;
+        wr_ack |= hwif_in.CFAR_SCALE.wr_ack;
+        wr_ack |= hwif_in.ACTIVE_CFAR_SCALE.wr_ack;
         external_wr_ack = wr_ack;
     end
     assign cpuif_wr_ack = external_wr_ack | (decoded_req & decoded_req_is_wr & ~decoded_req_is_external);
@@ -831,8 +842,9 @@ module radar_regs (
         automatic logic rd_ack;
         rd_ack = '0;
         rd_ack |= hwif_in.SETTINGS.rd_ack;
-        rd_ack |= hwif_in.CFAR_SCALE.rd_ack;
         rd_ack |= hwif_in.PACKET.rd_ack;
+        rd_ack |= hwif_in.CFAR_SCALE.rd_ack;
+        rd_ack |= hwif_in.ACTIVE_CFAR_SCALE.rd_ack;
         readback_external_rd_ack_c = rd_ack;
     end
 
@@ -840,8 +852,8 @@ module radar_regs (
 
     assign readback_external_rd_ack = readback_external_rd_ack_c;
 
-    logic [6:0] rd_mux_addr;
-    logic [6:0] pending_rd_addr;
+    logic [9:0] rd_mux_addr;
+    logic [9:0] pending_rd_addr;
     // Hold read mux address to guarantee it is stable throughout any external accesses
     always_ff @(posedge clk) begin
         if(rst) begin
@@ -858,63 +870,69 @@ module radar_regs (
     always_comb begin
         automatic logic [31:0] readback_data_var;
         readback_data_var = '0;
-        if(rd_mux_addr == 7'h0) begin
+        if(rd_mux_addr == 10'h0) begin
             readback_data_var[31:0] = 32'h52414452;
         end
-        if(rd_mux_addr == 7'h4) begin
-            readback_data_var[15:0] = 16'h0;
+        if(rd_mux_addr == 10'h4) begin
+            readback_data_var[15:0] = 16'h1;
             readback_data_var[31:16] = 16'h1;
         end
-        if(rd_mux_addr == 7'h8) begin
+        if(rd_mux_addr == 10'h8) begin
             readback_data_var[15:0] = hwif_in.CAPS.max_detections.next;
             readback_data_var[31:16] = hwif_in.CAPS.packet_words.next;
         end
-        if(rd_mux_addr == 7'h10) begin
+        if(rd_mux_addr == 10'hc) begin
+            readback_data_var[3:0] = hwif_in.CAPS2.cfar_kinds.next;
+            readback_data_var[15:8] = hwif_in.CAPS2.cfar_scales.next;
+            readback_data_var[31:16] = hwif_in.CAPS2.packet_words_min.next;
+        end
+        if(rd_mux_addr == 10'h10) begin
             readback_data_var = hwif_in.SETTINGS.rd_data;
         end
-        if(rd_mux_addr == 7'h14) begin
-            readback_data_var = hwif_in.CFAR_SCALE.rd_data;
-        end
-        if(rd_mux_addr == 7'h18) begin
+        if(rd_mux_addr == 10'h18) begin
             readback_data_var = hwif_in.PACKET.rd_data;
         end
-        if(rd_mux_addr == 7'h20) begin
+        if(rd_mux_addr == 10'h20) begin
             readback_data_var[1:0] = hwif_in.ACTIVE_SETTINGS.cfar_kind.next;
             readback_data_var[4] = hwif_in.ACTIVE_SETTINGS.clutter_removal.next;
+            readback_data_var[5] = hwif_in.ACTIVE_SETTINGS.local_max.next;
             readback_data_var[31:16] = hwif_in.ACTIVE_SETTINGS.max_detections.next;
         end
-        if(rd_mux_addr == 7'h24) begin
-            readback_data_var[31:0] = hwif_in.ACTIVE_CFAR_SCALE.scale.next;
-        end
-        if(rd_mux_addr == 7'h28) begin
+        if(rd_mux_addr == 10'h28) begin
             readback_data_var[15:0] = hwif_in.ACTIVE_PACKET.words.next;
         end
-        if(rd_mux_addr == 7'h30) begin
+        if(rd_mux_addr == 10'h30) begin
             readback_data_var[0] = field_storage.STATUS.frame_done.value;
             readback_data_var[1] = field_storage.STATUS.drop.value;
             readback_data_var[2] = field_storage.STATUS.error.value;
             readback_data_var[3] = field_storage.STATUS.cfg_error.value;
         end
-        if(rd_mux_addr == 7'h34) begin
+        if(rd_mux_addr == 10'h34) begin
             readback_data_var[0] = field_storage.IRQ_ENABLE.frame_done.value;
             readback_data_var[1] = field_storage.IRQ_ENABLE.drop.value;
             readback_data_var[2] = field_storage.IRQ_ENABLE.error.value;
             readback_data_var[3] = field_storage.IRQ_ENABLE.cfg_error.value;
         end
-        if(rd_mux_addr == 7'h40) begin
+        if(rd_mux_addr == 10'h40) begin
             readback_data_var[31:0] = field_storage.FRAMES.count.value;
         end
-        if(rd_mux_addr == 7'h44) begin
+        if(rd_mux_addr == 10'h44) begin
             readback_data_var[31:0] = field_storage.PACKETS.count.value;
         end
-        if(rd_mux_addr == 7'h48) begin
+        if(rd_mux_addr == 10'h48) begin
             readback_data_var[31:0] = field_storage.DROPS.count.value;
         end
-        if(rd_mux_addr == 7'h4c) begin
+        if(rd_mux_addr == 10'h4c) begin
             readback_data_var[31:0] = field_storage.ERRORS.count.value;
         end
-        if(rd_mux_addr == 7'h50) begin
+        if(rd_mux_addr == 10'h50) begin
             readback_data_var[31:0] = field_storage.CFG_ERRORS.count.value;
+        end
+        if((rd_mux_addr >= 10'h100) && (rd_mux_addr <= 10'h100 + 10'hf3)) begin
+            readback_data_var = hwif_in.CFAR_SCALE.rd_data;
+        end
+        if((rd_mux_addr >= 10'h200) && (rd_mux_addr <= 10'h200 + 10'hf3)) begin
+            readback_data_var = hwif_in.ACTIVE_CFAR_SCALE.rd_data;
         end
         readback_data = readback_data_var;
         readback_done = decoded_req & ~decoded_req_is_wr & ~decoded_req_is_external;

@@ -8,8 +8,8 @@
 package radar_regs_pkg;
 
     localparam RADAR_REGS_DATA_WIDTH = 32;
-    localparam RADAR_REGS_MIN_ADDR_WIDTH = 7;
-    localparam RADAR_REGS_SIZE = 'h54;
+    localparam RADAR_REGS_MIN_ADDR_WIDTH = 10;
+    localparam RADAR_REGS_SIZE = 'h2f4;
 
     typedef struct packed {
         logic [15:0] next;
@@ -25,8 +25,27 @@ package radar_regs_pkg;
     } radar_regs__CAPS__in_t;
 
     typedef struct packed {
+        logic [3:0] next;
+    } radar_regs__CAPS2__cfar_kinds__in_t;
+
+    typedef struct packed {
+        logic [7:0] next;
+    } radar_regs__CAPS2__cfar_scales__in_t;
+
+    typedef struct packed {
+        logic [15:0] next;
+    } radar_regs__CAPS2__packet_words_min__in_t;
+
+    typedef struct packed {
+        radar_regs__CAPS2__cfar_kinds__in_t cfar_kinds;
+        radar_regs__CAPS2__cfar_scales__in_t cfar_scales;
+        radar_regs__CAPS2__packet_words_min__in_t packet_words_min;
+    } radar_regs__CAPS2__in_t;
+
+    typedef struct packed {
         logic [15:0] max_detections;
-        logic [10:0] _reserved_15_5;
+        logic [9:0] _reserved_15_6;
+        logic local_max;
         logic clutter_removal;
         logic [1:0] _reserved_3_2;
         logic [1:0] cfar_kind;
@@ -37,16 +56,6 @@ package radar_regs_pkg;
         radar_regs__SETTINGS__fields__in_t rd_data;
         logic wr_ack;
     } radar_regs__SETTINGS__in_t;
-
-    typedef struct packed {
-        logic [31:0] scale;
-    } radar_regs__CFAR_SCALE__fields__in_t;
-
-    typedef struct packed {
-        logic rd_ack;
-        radar_regs__CFAR_SCALE__fields__in_t rd_data;
-        logic wr_ack;
-    } radar_regs__CFAR_SCALE__in_t;
 
     typedef struct packed {
         logic [15:0] _reserved_31_16;
@@ -68,22 +77,19 @@ package radar_regs_pkg;
     } radar_regs__ACTIVE_SETTINGS__clutter_removal__in_t;
 
     typedef struct packed {
+        logic next;
+    } radar_regs__ACTIVE_SETTINGS__local_max__in_t;
+
+    typedef struct packed {
         logic [15:0] next;
     } radar_regs__ACTIVE_SETTINGS__max_detections__in_t;
 
     typedef struct packed {
         radar_regs__ACTIVE_SETTINGS__cfar_kind__in_t cfar_kind;
         radar_regs__ACTIVE_SETTINGS__clutter_removal__in_t clutter_removal;
+        radar_regs__ACTIVE_SETTINGS__local_max__in_t local_max;
         radar_regs__ACTIVE_SETTINGS__max_detections__in_t max_detections;
     } radar_regs__ACTIVE_SETTINGS__in_t;
-
-    typedef struct packed {
-        logic [31:0] next;
-    } radar_regs__ACTIVE_CFAR_SCALE__scale__in_t;
-
-    typedef struct packed {
-        radar_regs__ACTIVE_CFAR_SCALE__scale__in_t scale;
-    } radar_regs__ACTIVE_CFAR_SCALE__in_t;
 
     typedef struct packed {
         logic [15:0] next;
@@ -157,12 +163,23 @@ package radar_regs_pkg;
     } radar_regs__CFG_ERRORS__in_t;
 
     typedef struct packed {
+        logic rd_ack;
+        logic [31:0] rd_data;
+        logic wr_ack;
+    } radar_regs__CFAR_SCALE__in_t;
+
+    typedef struct packed {
+        logic rd_ack;
+        logic [31:0] rd_data;
+        logic wr_ack;
+    } radar_regs__ACTIVE_CFAR_SCALE__in_t;
+
+    typedef struct packed {
         radar_regs__CAPS__in_t CAPS;
+        radar_regs__CAPS2__in_t CAPS2;
         radar_regs__SETTINGS__in_t SETTINGS;
-        radar_regs__CFAR_SCALE__in_t CFAR_SCALE;
         radar_regs__PACKET__in_t PACKET;
         radar_regs__ACTIVE_SETTINGS__in_t ACTIVE_SETTINGS;
-        radar_regs__ACTIVE_CFAR_SCALE__in_t ACTIVE_CFAR_SCALE;
         radar_regs__ACTIVE_PACKET__in_t ACTIVE_PACKET;
         radar_regs__STATUS__in_t STATUS;
         radar_regs__FRAMES__in_t FRAMES;
@@ -170,11 +187,14 @@ package radar_regs_pkg;
         radar_regs__DROPS__in_t DROPS;
         radar_regs__ERRORS__in_t ERRORS;
         radar_regs__CFG_ERRORS__in_t CFG_ERRORS;
+        radar_regs__CFAR_SCALE__in_t CFAR_SCALE;
+        radar_regs__ACTIVE_CFAR_SCALE__in_t ACTIVE_CFAR_SCALE;
     } radar_regs__in_t;
 
     typedef struct packed {
         logic [15:0] max_detections;
-        logic [10:0] _reserved_15_5;
+        logic [9:0] _reserved_15_6;
+        logic local_max;
         logic clutter_removal;
         logic [1:0] _reserved_3_2;
         logic [1:0] cfar_kind;
@@ -186,17 +206,6 @@ package radar_regs_pkg;
         radar_regs__SETTINGS__fields__out_t wr_data;
         radar_regs__SETTINGS__fields__out_t wr_biten;
     } radar_regs__SETTINGS__out_t;
-
-    typedef struct packed {
-        logic [31:0] scale;
-    } radar_regs__CFAR_SCALE__fields__out_t;
-
-    typedef struct packed {
-        logic req;
-        logic req_is_wr;
-        radar_regs__CFAR_SCALE__fields__out_t wr_data;
-        radar_regs__CFAR_SCALE__fields__out_t wr_biten;
-    } radar_regs__CFAR_SCALE__out_t;
 
     typedef struct packed {
         logic [15:0] _reserved_31_16;
@@ -257,11 +266,28 @@ package radar_regs_pkg;
     } radar_regs__IRQ_ENABLE__out_t;
 
     typedef struct packed {
+        logic req;
+        logic [7:0] addr;
+        logic req_is_wr;
+        logic [31:0] wr_data;
+        logic [31:0] wr_biten;
+    } radar_regs__CFAR_SCALE__out_t;
+
+    typedef struct packed {
+        logic req;
+        logic [7:0] addr;
+        logic req_is_wr;
+        logic [31:0] wr_data;
+        logic [31:0] wr_biten;
+    } radar_regs__ACTIVE_CFAR_SCALE__out_t;
+
+    typedef struct packed {
         radar_regs__SETTINGS__out_t SETTINGS;
-        radar_regs__CFAR_SCALE__out_t CFAR_SCALE;
         radar_regs__PACKET__out_t PACKET;
         radar_regs__STATUS__out_t STATUS;
         radar_regs__IRQ_ENABLE__out_t IRQ_ENABLE;
+        radar_regs__CFAR_SCALE__out_t CFAR_SCALE;
+        radar_regs__ACTIVE_CFAR_SCALE__out_t ACTIVE_CFAR_SCALE;
     } radar_regs__out_t;
 endpackage
 /* verilator lint_on UNUSEDSIGNAL */

@@ -36,14 +36,17 @@
 // WINDOW (docs/buffers.md).
 //
 // Control plane (docs/regs.md): radar_ctrl on the AXI4-Lite slave s_axil_* with the level
-// interrupt irq. Its frame_start is the frame boundary at static_removal's input (the corner
-// turn's output): the active settings follow the pending ones in every cycle that ends with
-// that input between two frames, and are frozen from the cycle of a frame's first word to
-// the cycle of its last word, so static_removal, which samples the switch with a frame's
-// first word, always runs a frame with the ACTIVE_SETTINGS of that frame. The event counters
-// and sticky flags count what the status ports below count (frames and packets out of the
-// packetizer, dropped ADC chirps and DMA words, framing errors, FFT saturation, memory
-// errors); the status ports stay until rtlsim reads the registers instead.
+// interrupt irq. Each run-time setting takes effect at the frame start of the block that
+// uses it, one frame boundary per consumer: static-clutter removal at static_removal's input
+// (the corner turn's output: the active switch follows the pending one in every cycle that
+// ends with that input between two frames and is frozen from the cycle of a frame's first
+// word to the cycle of its last word; static_removal samples it with a frame's first word);
+// the CFAR scales and the record limit at detect_chain's frame_start (the CFAR takes the
+// first word of a frame's range row 1); the packet length at the packetizer's input
+// boundary, as the removal's. The event counters and sticky flags count what the status
+// ports below count (frames and packets out of the packetizer, dropped ADC chirps and DMA
+// words, framing errors, FFT saturation, memory errors); the status ports stay until rtlsim
+// reads the registers instead.
 `default_nettype none
 
 module radar_pipeline #(
@@ -125,10 +128,6 @@ module radar_pipeline #(
   output logic                            s_axis_adc_tready,
   input  wire logic                       s_axis_adc_tlast,
   input  wire logic [0:0]                 s_axis_adc_tuser,
-  // CFAR threshold scale per range-edge index e = 0..2*(GUARD_R+TRAIN_R), SCALE_W bits each,
-  // entry e at bits e*SCALE_W (model.cfar_2d.scale_table / pack_scale). A quasi-static
-  // configuration register: change it only between frames. Unused in OUTPUT_MODE = 0.
-  input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_cfar_scale,
   // Control and status registers (radar_ctrl, docs/regs.md): AXI4-Lite slave, 32-bit data,
   // byte addresses; tie the VALIDs low when unused.
   input  wire logic                       s_axil_awvalid,
@@ -276,6 +275,9 @@ module radar_pipeline #(
   end
   if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 2)) begin : g_bad_cfar_kind
     $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", CFAR_KIND);
+  end
+  if (OUTPUT_MODE == 1 && SCALE_W > 32) begin : g_bad_scale_w
+    $fatal(1, "%m: SCALE_W=%0d above 32, the width of a CFAR_SCALE register", SCALE_W);
   end
   // guard/training/BLANK_TOP/SCALE_* ranges are checked by cfar_2d (g_bad_* there)
 
@@ -484,6 +486,12 @@ module radar_pipeline #(
   logic              pk_tvalid, pk_tready, pk_tlast, pk_frame_end;
   logic              det_framing_error;   // sticky, detector input TLAST misplaced
   logic              df_frame_end;        // last Doppler word of a frame (below)
+  // detector settings (radar_ctrl) and the detector's frame start, where they change
+  localparam int     N_SCALES = 2 * (GUARD_R + TRAIN_R) + 1;
+  localparam int     CTRL_SCALE_W = (OUTPUT_MODE == 1) ? SCALE_W : 32;
+  logic [N_SCALES*CTRL_SCALE_W-1:0] cfg_cfar_scale;
+  logic [15:0]       cfg_max_detections;
+  logic              det_frame_start;
 
   if (OUTPUT_MODE == 1) begin : g_detect
     logic        det_framing;
@@ -494,7 +502,8 @@ module radar_pipeline #(
       .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
       .MAX_DETECTIONS(MAX_DETECTIONS)
     ) u_detect (
-      .clk, .rst, .cfg_scale(cfg_cfar_scale),
+      .clk, .rst, .cfg_scale(cfg_cfar_scale), .cfg_max_detections,
+      .frame_start(det_frame_start),
       .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
       .s_axis_tlast(df_tlast),
       .m_axis_tdata(pk_tdata), .m_axis_tvalid(pk_tvalid), .m_axis_tready(pk_tready),
@@ -515,9 +524,10 @@ module radar_pipeline #(
     assign status_truncated  = 1'b0;
     assign detections        = '0;
     assign record_frames     = '0;
+    assign det_frame_start   = 1'b0;   // no detector: its settings are stored, not applied
     /* verilator lint_off UNUSEDSIGNAL */
-    logic unused_scale;
-    assign unused_scale = ^cfg_cfar_scale;
+    logic unused_det;
+    assign unused_det = ^{cfg_cfar_scale, cfg_max_detections};
     /* verilator lint_on UNUSEDSIGNAL */
   end
 
@@ -567,7 +577,7 @@ module radar_pipeline #(
     .NUM_BANKS(OUT_BANKS), .HEADER(HEADER), .INPUT_BACKPRESSURE(1'b1),
     .TLAST_PERIOD((OUTPUT_MODE == 1) ? REC_WORDS : N_DOPPLER)
   ) u_packetizer (
-    .clk, .rst,
+    .clk, .rst, .cfg_packet_words,
     .s_axis_tdata(pk_tdata), .s_axis_tvalid(pk_tvalid), .s_axis_tready(pk_tready),
     .s_axis_tlast(pk_tlast), .s_axis_tuser(df_damaged),
     .m_axis_tdata(m_axis_dma_tdata), .m_axis_tvalid(m_axis_dma_tvalid),
@@ -576,6 +586,16 @@ module radar_pipeline #(
     .drop_count(dma_words_dropped), .framing_error_count(pk_framing_count),
     .frame_count(frames_out), .packet_count(packets_out)
   );
+
+  // Frame boundary at the packetizer's input, as the corner turn's below: high while no word
+  // of a frame has been taken and in the cycle of a frame's last word (the packetizer takes
+  // the length with a frame's first word)
+  logic pk_mid_q, pk_frame_start;
+  always_ff @(posedge clk) begin
+    if (rst) pk_mid_q <= 1'b0;
+    else if (pk_tvalid && pk_tready) pk_mid_q <= !pk_frame_end;
+  end
+  assign pk_frame_start = (pk_tvalid && pk_tready) ? pk_frame_end : !pk_mid_q;
 
   // ---- pipeline status --------------------------------------------------------------------
   // Events of the two FFTs: saturation and misplaced/missing TLAST (1-cycle pulses).
@@ -649,12 +669,22 @@ module radar_pipeline #(
   assign ctrl_drop        = ev[7] | ev[6];
   assign ctrl_error       = (|ev[5:0]) | rf_ev_ovf | df_ev_ovf | fft_tlast_event;
 
+  // CFAR kind and local maximum: stored and read back; the detector takes its kind from
+  // the HDL parameter CFAR_KIND (the one kind built in, CAPS2.cfar_kinds) until cfar_2d has
+  // run-time inputs for them
   logic [1:0]  cfg_cfar_kind;
-  logic [15:0] cfg_max_detections, cfg_packet_words;
-  logic [31:0] cfg_scale;
+  logic        cfg_local_max;
+  logic [15:0] cfg_packet_words;
+  // shortest packet: at most 4096 packets a frame (axis_packetizer's PW_MIN)
+  localparam int PACKET_WORDS_MIN = ((FRAME_WORDS + 4095) / 4096 > 2)
+                                    ? (FRAME_WORDS + 4095) / 4096 : 2;
   radar_ctrl #(
     .MAX_DETECTIONS((OUTPUT_MODE == 1) ? MAX_DETECTIONS : 256), .PACKET_WORDS(PACKET_WORDS),
-    .CFAR_KIND(0), .CFAR_SCALE(0), .CLUTTER_REMOVAL(STATIC_REMOVAL)
+    .PACKET_WORDS_MIN(PACKET_WORDS_MIN),
+    .CFAR_KINDS(4'(1 << ((OUTPUT_MODE == 1) ? CFAR_KIND : 0))),
+    .CFAR_KIND((OUTPUT_MODE == 1) ? CFAR_KIND : 0), .N_SCALES(N_SCALES),
+    .SCALE_W(CTRL_SCALE_W), .CFAR_SCALE(0), .LOCAL_MAX(1'b0),
+    .CLUTTER_REMOVAL(STATIC_REMOVAL)
   ) u_ctrl (
     .clk, .rst,
     .s_axil_awvalid, .s_axil_awready, .s_axil_awaddr, .s_axil_awprot,
@@ -662,25 +692,24 @@ module radar_pipeline #(
     .s_axil_bvalid, .s_axil_bready, .s_axil_bresp,
     .s_axil_arvalid, .s_axil_arready, .s_axil_araddr, .s_axil_arprot,
     .s_axil_rvalid, .s_axil_rready, .s_axil_rdata, .s_axil_rresp,
-    .frame_start(ctrl_frame_start), .frame_done(ctrl_frame_done),
+    .removal_start(ctrl_frame_start), .detect_start(det_frame_start),
+    .packet_start(pk_frame_start), .frame_done(ctrl_frame_done),
     .packet_done(ctrl_packet_done), .drop(ctrl_drop), .error(ctrl_error),
-    .cfg_cfar_kind, .cfg_clutter_removal, .cfg_max_detections, .cfg_cfar_scale(cfg_scale),
-    .cfg_packet_words, .irq
+    .cfg_cfar_kind, .cfg_local_max, .cfg_clutter_removal, .cfg_max_detections,
+    .cfg_cfar_scale, .cfg_packet_words, .irq
   );
 
   // Signals the chain does not need: bin indices (the order is implied), the ping-pong's
   // frame-start / discontinuity marks (its counters report drops), the corner turn's
   // frame-start mark (after static removal) and output frame count, the ping-pong's
   // dropped-sample count (chirps dropped are reported instead), and the static removal's
-  // saturation flag (the model reports it; no status port yet). Waiver: reduced into a
-  // deliberately unused bit. The settings the datapath cannot take at run time yet (CFAR kind
-  // and scale, detections per frame, packet length: HDL parameters of the detector and the
-  // packetizer, docs/regs.md) stay in the register map, unused here.
+  // saturation flag (the model reports it; no status port yet), the CFAR kind and local
+  // maximum settings (above). Waiver: reduced into a deliberately unused bit.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
   assign unused_ok = ^{rf_tuser, df_tuser, sr_tuser, ct_frames_out, pp_drop_samples,
                        dmg_count, dmg_overflow, dmg_underflow, sr_saturated,
-                       cfg_cfar_kind, cfg_max_detections, cfg_packet_words, cfg_scale};
+                       cfg_cfar_kind, cfg_local_max};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

@@ -6,7 +6,7 @@ read-out, resets between segments), Python only writes the ADC beats and reads t
 
 With ``chain=PipelineParams(output_mode=1, ...)`` the top is built with OUTPUT_MODE = 1 and
 the packets are the detection-record stream (``model.radar_pipeline.dma_packets`` gives the
-same bytes); the harness drives ``cfg_cfar_scale`` with ``chain.cfar_scale(cfg)``.
+same bytes); the harness writes ``chain.cfar_scales(cfg)`` to the CFAR_SCALE registers.
 
 The executable is built once per HDL parameter set by Verilator (``--cc --exe --build``)
 under ``sim_build/radar_pipeline_native/<tag>/``, with the project's toolchain environment
@@ -194,7 +194,7 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
                              f"{adc.shape}")
     exe = build_harness(cfg, chain, frame_store)
     ppf = packets_per_frame(chain.frame_words(cfg), chain.packet_words)
-    scale = chain.cfar_scale(cfg) if chain.output_mode == 1 else 0
+    scales = chain.cfar_scales(cfg) if chain.output_mode == 1 else []
     if timeout is None:
         timeout = default_timeout(cfg, adc_gap, chirp_gap)
     with tempfile.TemporaryDirectory(prefix="radar_harness_") as tmp:
@@ -206,8 +206,9 @@ def run_harness(adc_frames: Sequence[np.ndarray], cfg: RadarConfig,
                "--packets-per-frame", str(ppf), "--seed", str(seed),
                "--adc-gap", repr(float(adc_gap)), "--dma-stall", repr(float(dma_stall)),
                "--chirp-gap", str(chirp_gap), "--timeout", str(timeout), "--quiet", str(quiet),
-               "--mem-latency", str(mem_latency), "--mem-stall", repr(float(mem_stall)),
-               "--cfar-scale", hex(scale)]
+               "--mem-latency", str(mem_latency), "--mem-stall", repr(float(mem_stall))]
+        if scales:
+            cmd += ["--cfar-scales", ",".join(hex(v) for v in scales)]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
             msg = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]

@@ -18,8 +18,10 @@
 // segment). Random ADC gaps (TVALID low with probability --adc-gap per cycle, plus
 // --chirp-gap idle cycles after each chirp), DMA backpressure (TREADY low with probability
 // --dma-stall) and memory stalls come from one seed (--seed): the same arguments give the
-// same cycles. --cfar-scale HEX drives the quasi-static cfg_cfar_scale input (OUTPUT_MODE = 1:
-// the CFAR threshold scale table, model.radar_pipeline.PipelineParams.cfar_scale). --quiet N: a segment also ends once its input is sent and no DMA word came
+// same cycles. --cfar-scales HEX,HEX,... are written to the register table CFAR_SCALE over
+// AXI4-Lite after every reset (OUTPUT_MODE = 1: the CFAR threshold scale of each range edge,
+// model.radar_pipeline.PipelineParams.cfar_scales); the other registers keep their reset
+// values. --quiet N: a segment also ends once its input is sent and no DMA word came
 // for N cycles (for runs that lose frames on purpose; 0: every packet must arrive). Exit status: 0 ok, 2 bad arguments or files, 3 timeout (no DMA word for
 // --timeout cycles while packets are missing).
 #include <verilated.h>
@@ -59,23 +61,28 @@ struct Args {
   uint64_t quiet = 0;
   int mem_latency = 20;
   double mem_stall = 0.0;
-  std::vector<uint32_t> cfar_scale;  // 32-bit words, word 0 = bits 31:0
+  std::vector<uint32_t> cfar_scales;  // CFAR_SCALE entries 0, 1, ...
 };
 
-// Hex string (optional 0x) -> 32-bit words, least significant first.
-std::vector<uint32_t> parse_hex_words(const std::string& v) {
-  std::string h = (v.rfind("0x", 0) == 0 || v.rfind("0X", 0) == 0) ? v.substr(2) : v;
+// Comma-separated hex numbers (optional 0x), each below 2^32 -> their values; empty on error.
+std::vector<uint32_t> parse_hex_list(const std::string& v) {
   std::vector<uint32_t> out;
-  for (size_t end = h.size(); end > 0;) {
-    size_t begin = end >= 8 ? end - 8 : 0;
-    std::string chunk = h.substr(begin, end - begin);
-    if (chunk.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+  size_t at = 0;
+  while (at <= v.size()) {
+    size_t end = v.find(',', at);
+    if (end == std::string::npos) end = v.size();
+    std::string h = v.substr(at, end - at);
+    if (h.rfind("0x", 0) == 0 || h.rfind("0X", 0) == 0) h = h.substr(2);
+    if (h.empty() || h.size() > 8 ||
+        h.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
       return {};
-    out.push_back(static_cast<uint32_t>(std::strtoul(chunk.c_str(), nullptr, 16)));
-    end = begin;
+    out.push_back(static_cast<uint32_t>(std::strtoul(h.c_str(), nullptr, 16)));
+    at = end + 1;
   }
   return out;
 }
+
+constexpr uint32_t CFAR_SCALE_ADDR = 0x100;  // model.radar_regs_map: CFAR_SCALE, 4 bytes apart
 
 [[noreturn]] void fail(int code, const std::string& msg) {
   std::fprintf(stderr, "radar_harness: %s\n", msg.c_str());
@@ -104,9 +111,9 @@ Args parse(int argc, char** argv) {
     else if (k == "--quiet") a.quiet = std::strtoull(v.c_str(), nullptr, 0);
     else if (k == "--mem-latency") a.mem_latency = std::atoi(v.c_str());
     else if (k == "--mem-stall") a.mem_stall = std::atof(v.c_str());
-    else if (k == "--cfar-scale") {
-      a.cfar_scale = parse_hex_words(v);
-      if (a.cfar_scale.empty()) fail(2, "--cfar-scale must be a hex number");
+    else if (k == "--cfar-scales") {
+      a.cfar_scales = parse_hex_list(v);
+      if (a.cfar_scales.empty()) fail(2, "--cfar-scales must be comma-separated hex numbers");
     }
     else fail(2, "unknown option " + k);
   }
@@ -134,15 +141,9 @@ class Harness {
         static_cast<int>(sizeof(std::declval<Top>().m_axi_mem_wdata))));
 #endif
     load_adc();
-    const size_t scale_words = (sizeof(top_->cfg_cfar_scale) + 3) / 4;
-    std::vector<uint32_t> scale(scale_words, 0u);
-    for (size_t i = 0; i < a.cfar_scale.size(); ++i) {
-      if (i < scale_words) scale[i] = a.cfar_scale[i];
-      else if (a.cfar_scale[i]) fail(2, "--cfar-scale wider than cfg_cfar_scale");
-    }
-    harness::put_words(top_->cfg_cfar_scale, scale.data(), static_cast<int>(scale_words));
-    // the register block stays idle: its reset settings (static-clutter removal on when
-    // built in, STATIC_REMOVAL = 1) hold for every frame
+    // the register block: after each reset the scale table is written (reset()), the other
+    // settings keep their reset values (static-clutter removal on when built in,
+    // STATIC_REMOVAL = 1)
     top_->s_axil_awvalid = 0;
     top_->s_axil_wvalid = 0;
     top_->s_axil_arvalid = 0;
@@ -218,6 +219,28 @@ class Harness {
     ++cycles_;
   }
 
+  // One AXI4-Lite write (whole word), the handshakes sampled as tick() samples the streams'.
+  void axil_write(uint32_t addr, uint32_t data) {
+    top_->s_axil_awaddr = addr;
+    top_->s_axil_awprot = 0;
+    top_->s_axil_wdata = data;
+    top_->s_axil_wstrb = 0xF;
+    top_->s_axil_awvalid = 1;
+    top_->s_axil_wvalid = 1;
+    for (int i = 0; i < 64; ++i) {
+      top_->clk = 0;
+      top_->eval();
+      bool aw = top_->s_axil_awvalid && top_->s_axil_awready;
+      bool w = top_->s_axil_wvalid && top_->s_axil_wready;
+      bool b = top_->s_axil_bvalid && top_->s_axil_bready;
+      tick();
+      if (aw) top_->s_axil_awvalid = 0;
+      if (w) top_->s_axil_wvalid = 0;
+      if (b) return;
+    }
+    fail(3, "AXI4-Lite write not answered");
+  }
+
   void flush_packet() {
     uint32_t words = static_cast<uint32_t>(packet_.size() / a_.num_rx);
     std::fwrite(&words, 4, 1, dma_);
@@ -234,6 +257,8 @@ class Harness {
     for (int i = 0; i < 8; ++i) tick();
     top_->rst = 0;
     for (int i = 0; i < 2; ++i) tick();
+    for (size_t e = 0; e < a_.cfar_scales.size(); ++e)
+      axil_write(CFAR_SCALE_ADDR + 4 * static_cast<uint32_t>(e), a_.cfar_scales[e]);
     packet_.clear();  // a packet cut by the reset is not a packet
 #ifdef HARNESS_FRAME_STORE
     mem_->reset_channels();

@@ -20,7 +20,7 @@ extern "C" {
 #define RADAR_REGS__VERSION__MINOR_bm 0xffff
 #define RADAR_REGS__VERSION__MINOR_bp 0
 #define RADAR_REGS__VERSION__MINOR_bw 16
-#define RADAR_REGS__VERSION__MINOR_reset 0x0
+#define RADAR_REGS__VERSION__MINOR_reset 0x1
 #define RADAR_REGS__VERSION__MAJOR_bm 0xffff0000
 #define RADAR_REGS__VERSION__MAJOR_bp 16
 #define RADAR_REGS__VERSION__MAJOR_bw 16
@@ -34,6 +34,17 @@ extern "C" {
 #define RADAR_REGS__CAPS__PACKET_WORDS_bp 16
 #define RADAR_REGS__CAPS__PACKET_WORDS_bw 16
 
+// reg - radar_regs.CAPS2
+#define RADAR_REGS__CAPS2__CFAR_KINDS_bm 0xf
+#define RADAR_REGS__CAPS2__CFAR_KINDS_bp 0
+#define RADAR_REGS__CAPS2__CFAR_KINDS_bw 4
+#define RADAR_REGS__CAPS2__CFAR_SCALES_bm 0xff00
+#define RADAR_REGS__CAPS2__CFAR_SCALES_bp 8
+#define RADAR_REGS__CAPS2__CFAR_SCALES_bw 8
+#define RADAR_REGS__CAPS2__PACKET_WORDS_MIN_bm 0xffff0000
+#define RADAR_REGS__CAPS2__PACKET_WORDS_MIN_bp 16
+#define RADAR_REGS__CAPS2__PACKET_WORDS_MIN_bw 16
+
 // reg - radar_regs.SETTINGS
 #define RADAR_REGS__SETTINGS__CFAR_KIND_bm 0x3
 #define RADAR_REGS__SETTINGS__CFAR_KIND_bp 0
@@ -41,14 +52,12 @@ extern "C" {
 #define RADAR_REGS__SETTINGS__CLUTTER_REMOVAL_bm 0x10
 #define RADAR_REGS__SETTINGS__CLUTTER_REMOVAL_bp 4
 #define RADAR_REGS__SETTINGS__CLUTTER_REMOVAL_bw 1
+#define RADAR_REGS__SETTINGS__LOCAL_MAX_bm 0x20
+#define RADAR_REGS__SETTINGS__LOCAL_MAX_bp 5
+#define RADAR_REGS__SETTINGS__LOCAL_MAX_bw 1
 #define RADAR_REGS__SETTINGS__MAX_DETECTIONS_bm 0xffff0000
 #define RADAR_REGS__SETTINGS__MAX_DETECTIONS_bp 16
 #define RADAR_REGS__SETTINGS__MAX_DETECTIONS_bw 16
-
-// reg - radar_regs.CFAR_SCALE
-#define RADAR_REGS__CFAR_SCALE__SCALE_bm 0xffffffff
-#define RADAR_REGS__CFAR_SCALE__SCALE_bp 0
-#define RADAR_REGS__CFAR_SCALE__SCALE_bw 32
 
 // reg - radar_regs.PACKET
 #define RADAR_REGS__PACKET__WORDS_bm 0xffff
@@ -62,14 +71,12 @@ extern "C" {
 #define RADAR_REGS__ACTIVE_SETTINGS__CLUTTER_REMOVAL_bm 0x10
 #define RADAR_REGS__ACTIVE_SETTINGS__CLUTTER_REMOVAL_bp 4
 #define RADAR_REGS__ACTIVE_SETTINGS__CLUTTER_REMOVAL_bw 1
+#define RADAR_REGS__ACTIVE_SETTINGS__LOCAL_MAX_bm 0x20
+#define RADAR_REGS__ACTIVE_SETTINGS__LOCAL_MAX_bp 5
+#define RADAR_REGS__ACTIVE_SETTINGS__LOCAL_MAX_bw 1
 #define RADAR_REGS__ACTIVE_SETTINGS__MAX_DETECTIONS_bm 0xffff0000
 #define RADAR_REGS__ACTIVE_SETTINGS__MAX_DETECTIONS_bp 16
 #define RADAR_REGS__ACTIVE_SETTINGS__MAX_DETECTIONS_bw 16
-
-// reg - radar_regs.ACTIVE_CFAR_SCALE
-#define RADAR_REGS__ACTIVE_CFAR_SCALE__SCALE_bm 0xffffffff
-#define RADAR_REGS__ACTIVE_CFAR_SCALE__SCALE_bp 0
-#define RADAR_REGS__ACTIVE_CFAR_SCALE__SCALE_bw 32
 
 // reg - radar_regs.ACTIVE_PACKET
 #define RADAR_REGS__ACTIVE_PACKET__WORDS_bm 0xffff
@@ -142,18 +149,28 @@ extern "C" {
 #define RADAR_REGS__CFG_ERRORS__COUNT_bw 32
 #define RADAR_REGS__CFG_ERRORS__COUNT_reset 0x0
 
+// mem - radar_regs.CFAR_SCALE
+typedef struct __attribute__ ((__packed__)) {
+    uint32_t mem[61];
+} radar_regs__CFAR_SCALE_t;
+
+// mem - radar_regs.ACTIVE_CFAR_SCALE
+typedef struct __attribute__ ((__packed__)) {
+    uint32_t mem[61];
+} radar_regs__ACTIVE_CFAR_SCALE_t;
+
 // addrmap - radar_regs
 typedef struct __attribute__ ((__packed__)) {
     uint32_t ID;
     uint32_t VERSION;
     uint32_t CAPS;
-    uint8_t RESERVED_c_f[0x4];
+    uint32_t CAPS2;
     uint32_t SETTINGS;
-    uint32_t CFAR_SCALE;
+    uint8_t RESERVED_14_17[0x4];
     uint32_t PACKET;
     uint8_t RESERVED_1c_1f[0x4];
     uint32_t ACTIVE_SETTINGS;
-    uint32_t ACTIVE_CFAR_SCALE;
+    uint8_t RESERVED_24_27[0x4];
     uint32_t ACTIVE_PACKET;
     uint8_t RESERVED_2c_2f[0x4];
     uint32_t STATUS;
@@ -164,10 +181,14 @@ typedef struct __attribute__ ((__packed__)) {
     uint32_t DROPS;
     uint32_t ERRORS;
     uint32_t CFG_ERRORS;
+    uint8_t RESERVED_54_ff[0xac];
+    radar_regs__CFAR_SCALE_t CFAR_SCALE;
+    uint8_t RESERVED_1f4_1ff[0xc];
+    radar_regs__ACTIVE_CFAR_SCALE_t ACTIVE_CFAR_SCALE;
 } radar_regs_t;
 
 
-static_assert(sizeof(radar_regs_t) == 0x54, "Packing error");
+static_assert(sizeof(radar_regs_t) == 0x2f4, "Packing error");
 
 #ifdef __cplusplus
 }

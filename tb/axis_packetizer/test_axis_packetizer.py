@@ -1,4 +1,10 @@
-"""cocotb testbench of ``rtl/buffers/axis_packetizer.sv`` against ``model/axis_packetizer.py``."""
+"""cocotb testbench of ``rtl/buffers/axis_packetizer.sv`` against ``model/axis_packetizer.py``.
+
+``cfg_packet_words`` is PACKET_WORDS, or (``test_runtime_length``, with input backpressure)
+changed at random clocks, in mid-frame too, to any legal length (the shortest ones make the
+input wait for the packet count): each frame must be cut with the length it had at its
+first word.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +14,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
+from cocotb.triggers import FallingEdge, RisingEdge
 
 from model import axis_packetizer as pk
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
@@ -25,6 +32,31 @@ class TB(AxisTB):
         self.backpressure = bool(param("INPUT_BACKPRESSURE"))
         self.tlast_period = param("TLAST_PERIOD")
         self.n_packets = pk.packets_per_frame(self.frame_words, self.packet_words)
+        self.lengths: list[int] = []      # cfg_packet_words at each frame's first word
+        dut.cfg_packet_words.value = self.packet_words
+        cocotb.start_soon(self._watch_lengths())
+
+    async def _watch_lengths(self) -> None:
+        """Record cfg_packet_words at every frame's first input word."""
+        d, n = self.dut, 0
+        while True:
+            await RisingEdge(d.clk)
+            if d.rst.value == 1:
+                n = 0
+                self.lengths = []
+            elif d.s_axis_tvalid.value == 1 and d.s_axis_tready.value == 1:
+                if n % self.frame_words == 0:
+                    self.lengths.append(int(d.cfg_packet_words.value))
+                n += 1
+
+    async def change_lengths(self, seed: int) -> None:
+        """cfg_packet_words to a random legal length every few to few hundred clocks."""
+        rng = np.random.default_rng(seed)
+        lo = max(2, -(-self.frame_words // pk.MAX_PACKETS_PER_FRAME))
+        while True:
+            await self.cycles(int(rng.integers(3, 300)))
+            await FallingEdge(self.dut.clk)
+            self.dut.cfg_packet_words.value = int(rng.integers(lo, self.packet_words + 1))
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
@@ -272,6 +304,28 @@ async def test_reset_recovery(dut):
     got = await tb.drain()
     tb.compare(got, tb.expected(frames))
     assert tb.status()["drop_count"] == 0
+
+
+@cocotb.test()
+async def test_runtime_length(dut):
+    """cfg_packet_words changed at random clocks with random stalls: every frame cut with
+    the length it had at its first word, header packet counts included."""
+    tb = TB(dut)
+    if not tb.backpressure:
+        tb.log.info("run-time length needs INPUT_BACKPRESSURE=1: skipped")
+        return
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.2, 31))
+    tb.set_backpressure_generator(random_pause(0.3, 32))
+    task = cocotb.start_soon(tb.change_lengths(seed=33))
+    frames = [tb.random_frame() for _ in range(2 if tb.frame_words > 4096 else 8)]
+    for f in frames:
+        await tb.send_frame(f)
+    got = await tb.drain(quiet=8 * tb.packet_words + 64)
+    task.cancel()
+    exp = pk.packetize_stream(frames, tb.lengths, tb.header)
+    tb.compare(got, exp)
+    assert len(set(tb.lengths)) > 1, f"the length never changed between frames: {tb.lengths}"
 
 
 @cocotb.test()

@@ -34,6 +34,7 @@ class TB(AxisTB):
             pfa=float(os.environ["DETECT_PFA"]))
         self.scale = self.cfg.scale()
         dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg.cfar)
+        dut.cfg_max_detections.value = self.cfg.max_detections
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
 
     def random_frame(self, n_targets: int) -> np.ndarray:

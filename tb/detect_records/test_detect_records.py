@@ -3,6 +3,9 @@
 The snapshot port is driven word by word while ``snap_room`` allows it; the CFAR cells come
 from ``model/cfar_2d.py`` on a random map, sent only after their snapshot row was written
 (as in the chain). A slow cell source lets the writer run into the ``snap_room`` interlock.
+The run-time record limit ``cfg_max_detections`` is MAX_DETECTIONS, or (``test_runtime_limit``)
+changed at random clocks, in mid-frame too: each frame must use the value it had at the
+frame's first cell.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import FallingEdge, with_timeout
+from cocotb.triggers import FallingEdge, RisingEdge, with_timeout
 from cocotbext.axi import AxiStreamFrame
 
 from model import cfar_2d as cm
@@ -42,8 +45,32 @@ class TB(AxisTB):
         self.rows_written = 0
         self.writer_gap = 0.0
         self.tasks: list = []
+        self.limits: list[int] = []       # the limit at each frame's first cell
         dut.snap_wr.value = 0
         dut.snap_data.value = 0
+        dut.cfg_max_detections.value = self.max_det
+        cocotb.start_soon(self._watch_limits())
+
+    async def _watch_limits(self) -> None:
+        """Record cfg_max_detections at every frame's first cell beat."""
+        d, cells, n = self.dut, self.n_range * self.n_doppler, 0
+        while True:
+            await RisingEdge(d.clk)
+            if d.rst.value == 1:
+                n = 0
+                self.limits = []
+            elif d.s_axis_tvalid.value == 1 and d.s_axis_tready.value == 1:
+                if n % cells == 0:
+                    self.limits.append(int(d.cfg_max_detections.value))
+                n += 1
+
+    async def change_limits(self, seed: int) -> None:
+        """cfg_max_detections to a random legal value every few to few tens of clocks."""
+        rng = random.Random(seed)
+        while True:
+            await self.cycles(rng.randint(3, 60))
+            await FallingEdge(self.dut.clk)
+            self.dut.cfg_max_detections.value = rng.randint(1, self.max_det)
 
     def random_frame(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:
         """(snapshot words uint32 (r, t, d, rx) flattened, power map int64 (r, d))."""
@@ -99,9 +126,10 @@ class TB(AxisTB):
             sv = s.reshape(c.n_range, self.num_tx, c.n_doppler, self.num_rx)
             recs = [dr.Record.of_cell(res, r, d, sv[r, :, d, :])
                     for r, d in cm.output_order(c) if res.detect[r, d]]
+            limit = self.limits[k]
             out.append(dr.encode_frame(recs, len(recs), self.num_tx, self.num_rx,
-                                       self.max_det, frame_id=k, sticky=sticky))
-            sticky = sticky or len(recs) > self.max_det
+                                       self.max_det, frame_id=k, sticky=sticky, limit=limit))
+            sticky = sticky or len(recs) > limit
         return out
 
     async def run(self, n_frames: int, targets: list[int], seed: int) -> None:
@@ -111,11 +139,11 @@ class TB(AxisTB):
         self.rows_written = 0
         self.tasks = [cocotb.start_soon(self.write_snapshots(snaps, seed)),
                       cocotb.start_soon(self.send_cells(maps, scale))]
-        exp = self.expected(snaps, maps, scale)
         # a hang (deadlock) fails after 20x the stall-free frame time
         limit = 20 * 10 * (self.num_tx * self.n_range * self.n_doppler + self.frame_words)
-        for k, e in enumerate(exp):
-            f = await with_timeout(self.sink.recv(), limit, "ns")
+        got = [await with_timeout(self.sink.recv(), limit, "ns") for _ in range(n_frames)]
+        exp = self.expected(snaps, maps, scale)
+        for k, (f, e) in enumerate(zip(got, exp, strict=True)):
             g = np.frombuffer(bytes(f.tdata), dtype="<u4").reshape(-1, self.num_rx)
             assert len(g) == self.frame_words, f"frame {k}: {len(g)} words"
             if not np.array_equal(g, e):
@@ -163,6 +191,20 @@ async def test_reset_recovery(dut):
     tb.set_backpressure_generator(no_pause())
     tb.set_idle_generator(random_pause(0.2, 4))
     await tb.run(2, [2, 1], seed=4)
+
+
+@cocotb.test()
+async def test_runtime_limit(dut):
+    """cfg_max_detections changed at random clocks (mid-frame too), output stalls: each
+    frame keeps the limit it had at its first cell; the frame length stays fixed."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.set_backpressure_generator(random_pause(0.3, 2))
+    task = cocotb.start_soon(tb.change_limits(seed=5))
+    await tb.run(8, [3 * tb.max_det, 2 * tb.max_det, 1, 3 * tb.max_det, 2, 4 * tb.max_det,
+                     tb.max_det, 3 * tb.max_det], seed=5)
+    task.cancel()
+    assert len(set(tb.limits)) > 1, f"the limit never changed between frames: {tb.limits}"
 
 
 # ------------------------------------------------------------------------------------------

@@ -13,6 +13,7 @@ Scene of ``test_radar_pipeline`` gives 19 detections per frame, the crowded fram
 from __future__ import annotations
 
 import os
+import random
 from pathlib import Path
 
 import cocotb
@@ -64,7 +65,7 @@ def setup(dut) -> tuple[PipelineTB, str, RadarConfig, PipelineParams]:
     name = os.environ["RP_DETECT_SET"]
     cfg, chain = ALL_SETS[name]
     assert tb.output_mode == 1 and tb.frame_words == chain.frame_words(cfg)
-    tb.set_cfar_scale(chain.cfar_scale(cfg))
+    tb.cfar_scales = chain.cfar_scales(cfg)
     return tb, name, cfg, chain
 
 
@@ -136,6 +137,57 @@ async def reset_mid_stream(dut) -> None:
     assert_packets_equal(got, dma_packets(frames[1:], cfg, chain), "mode 1 after reset")
     status = tb.status()
     assert status["record_frames"] == 2 and status["status_truncated"] == 0, status
+
+
+@cocotb.test()
+async def settings_written_mid_frame(dut) -> None:
+    """SETTINGS.max_detections and the CFAR_SCALE table written while the CFAR works on
+    frame 0 (after its frame start, the CFAR's row 1): ACTIVE_* keep the old values, frame 0
+    runs with them, frames 1 and 2 with the new ones (the model with ``FrameSettings``);
+    random AXI4-Lite stalls."""
+    from dataclasses import replace
+
+    from host import regs
+    from model.radar_pipeline import FrameSettings
+
+    tb, name, cfg, chain = setup(dut)
+    if name == "paper-fpga":
+        return
+    rng = random.Random(seed())
+    tb.attach_regs(lambda: random_pause(0.4, rng.randrange(1 << 30)))
+    frames = [crowded_frame(cfg, k) for k in range(3)]
+    tb.set_idle_generator(random_pause(0.2, 21))
+    tb.set_backpressure_generator(random_pause(0.2, 22))
+    await tb.reset()
+    dcfg = chain.detect_config(cfg)
+    old_scale = dcfg.scale()
+    new_scale = replace(dcfg, pfa=1e-2).scale()
+    assert not np.array_equal(new_scale, old_scale)
+    limit = 5
+    for adc in frames:
+        await tb.send_frame(adc)
+    det = tb.dut.g_detect.u_detect
+    row = cfg.n_doppler
+    while not (row + 8 < int(det.cin_q.value) < cfg.n_range * row // 2):
+        await tb.cycles(1)
+    before = int(det.cin_q.value)
+    await tb.write32(regs.address("SETTINGS"),
+                     regs.encode("SETTINGS", max_detections=limit, clutter_removal=0))
+    for e, v in enumerate(new_scale):
+        await tb.write32(regs.address("CFAR_SCALE", e), int(v))
+    assert before < int(det.cin_q.value), "the writes did not end inside frame 0"
+    act = regs.decode("ACTIVE_SETTINGS", await tb.read32(regs.address("ACTIVE_SETTINGS")))
+    assert act["max_detections"] == dcfg.max_detections, "applied mid-frame"
+    assert await tb.read32(regs.address("ACTIVE_CFAR_SCALE", 0)) == old_scale[0]
+    got = await tb.recv_frames(len(frames), 2 * tb.frame_timeout_cycles())
+    assert (await tb.read32(regs.address("CFG_ERRORS"))) == 0
+    settings = FrameSettings(max_detections=[dcfg.max_detections, limit, limit],
+                             scales=[old_scale, new_scale, new_scale])
+    assert_packets_equal(got, dma_packets(frames, cfg, chain, settings=settings),
+                         "detector settings written mid-frame")
+    tr = trailers(cfg, chain, got)
+    assert [t.limit for t in tr] == [dcfg.max_detections, limit, limit], tr
+    assert tr[1].records == limit < tr[1].detections, tr
 
 
 @cocotb.test()

@@ -3,11 +3,18 @@ with ``STATIC_REMOVAL = 1``: every access through the AXI4-Lite slave ``s_axil_*
 (cocotbext-axi ``AxiLiteMaster``, random stalls on all five channels) with the register names
 of ``host.regs``.
 
-ID and version read; static-clutter removal switched off, two frames, switched on between
-frames, two more: the DMA packets equal the model's with the removal off for the first two
-and on from the next frame (``dma_packets(removal=...)``), ACTIVE_SETTINGS follows; the
-FRAMES / PACKETS counters equal what the DMA delivered (and the status ports), no drops or
-errors; irq rises on frame done when enabled and falls when STATUS.frame_done is written 1.
+ID and version read; every register (every entry of the CFAR_SCALE tables) written with a
+random word and read back against ``model.radar_ctrl`` (refused writes counted as there),
+then out-of-range writes (packet words 0, below CAPS2 and above CAPS, a CFAR kind not built
+in, max_detections 0, a scale entry not built in) refused whole and counted; static-clutter
+removal switched off, two frames, switched on between frames, two more: the DMA packets equal
+the model's with the removal off for the first two and on from the next frame
+(``dma_packets(removal=...)``), ACTIVE_SETTINGS follows; PACKET.words written while frame 4
+streams into the packetizer: ACTIVE_PACKET keeps the old length until that frame's last
+word, frame 4 is cut with the old length and frames 5 and 6 with the new one (the model
+with ``FrameSettings(packet_words=...)``); the FRAMES / PACKETS counters equal what the DMA
+delivered (and the status ports), no drops or errors; irq rises on frame done when enabled
+and falls when STATUS.frame_done is written 1.
 """
 
 from __future__ import annotations
@@ -20,7 +27,10 @@ import numpy as np
 from test_radar_pipeline import SMALL4, adc_frames, assert_packets_equal, chirp_bursts
 
 from host import regs
-from model.radar_pipeline import PipelineParams, dma_packets
+from model.axis_packetizer import packets_per_frame
+from model.radar_ctrl import RadarCtrl
+from model.radar_pipeline import FrameSettings, PipelineParams, dma_packets
+from model.radar_regs_map import REGISTERS
 from rtlsim.axis import random_pause
 from rtlsim.pipeline import PipelineTB
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
@@ -44,10 +54,58 @@ async def set_removal(tb: PipelineTB, on: bool) -> None:
     corner turn's output is between frames: the active set follows at once)."""
     fields = await read(tb, "SETTINGS")
     fields["clutter_removal"] = int(on)
+    refused = (await read(tb, "CFG_ERRORS"))["count"]
     await write(tb, "SETTINGS", **fields)
     await tb.cycles(4)
     assert (await read(tb, "ACTIVE_SETTINGS"))["clutter_removal"] == int(on)
-    assert (await read(tb, "CFG_ERRORS"))["count"] == 0
+    assert (await read(tb, "CFG_ERRORS"))["count"] == refused
+
+
+def ctrl_model() -> RadarCtrl:
+    """``radar_ctrl`` as the top builds it for CHAIN on SMALL4 (mode 0: no detector)."""
+    return RadarCtrl(max_detections=256, packet_words=CHAIN.packet_words, cfar_kind=0,
+                     clutter_removal=True, packet_words_min=2, cfar_kinds=0b0001,
+                     n_scales=2 * (2 + 4) + 1)
+
+
+async def every_register(tb: PipelineTB, rng: random.Random) -> None:
+    """Every register and table entry written with a random word and read back, against the
+    model (the pipeline idle: the removal and packet settings follow at once, the detector's
+    never, as in the top without a detector); then out-of-range writes refused and counted;
+    the settings restored to their reset values at the end."""
+    m = ctrl_model()
+    at = [(name, i) for name, reg in REGISTERS.items() for i in range(reg.count)]
+    for name, i in at:
+        word = rng.getrandbits(32)
+        if name == "SETTINGS" and rng.random() < 0.5:   # some legal ones too
+            word = regs.encode(name, clutter_removal=rng.randint(0, 1),
+                               max_detections=rng.randint(1, 256))
+        await tb.write32(regs.address(name, i), word)
+        m.write(regs.address(name, i), word)
+        await tb.cycles(2)
+        m.step(removal_start=True, packet_start=True)
+        for rname, ri in (rng.sample(at, 3) + [(name, i), ("CFG_ERRORS", 0)]):
+            got = await tb.read32(regs.address(rname, ri))
+            assert got == m.read(regs.address(rname, ri)), f"{rname}[{ri}] after {name}[{i}]"
+    for name, i in at:
+        assert await tb.read32(regs.address(name, i)) == m.read(regs.address(name, i)), name
+    refused = m.counts["CFG_ERRORS"]
+    bad = [("PACKET", 0, regs.encode("PACKET", words=0)),
+           ("PACKET", 0, regs.encode("PACKET", words=1)),                  # below CAPS2
+           ("PACKET", 0, regs.encode("PACKET", words=CHAIN.packet_words + 1)),
+           ("SETTINGS", 0, regs.encode("SETTINGS", cfar_kind=1, max_detections=1)),
+           ("SETTINGS", 0, regs.encode("SETTINGS", max_detections=0)),
+           ("CFAR_SCALE", m.n_scales, 5)]
+    for name, i, word in bad:
+        before = await tb.read32(regs.address(name, i))
+        await tb.write32(regs.address(name, i), word)
+        assert await tb.read32(regs.address(name, i)) == before, f"{name} half applied"
+    assert (await read(tb, "CFG_ERRORS"))["count"] == refused + len(bad)
+    await write(tb, "SETTINGS", clutter_removal=1, max_detections=256)
+    await write(tb, "PACKET", words=CHAIN.packet_words)
+    await write(tb, "IRQ_ENABLE")
+    await write(tb, "STATUS", frame_done=1, drop=1, error=1, cfg_error=1)
+    assert (await read(tb, "STATUS"))["cfg_error"] == 0
 
 
 @cocotb.test()
@@ -61,7 +119,9 @@ async def registers_through_axi_lite(dut) -> None:
     await tb.reset()
 
     assert await tb.read32(regs.address("ID")) == regs.ID_VALUE
-    assert (await read(tb, "VERSION"))["major"] == 1
+    assert await read(tb, "VERSION") == {"minor": 1, "major": 1}
+    await every_register(tb, rng)
+    refused = (await read(tb, "CFG_ERRORS"))["count"]
     # reset: removal on (STATIC_REMOVAL = 1), nothing counted, no flag, irq low
     assert (await read(tb, "ACTIVE_SETTINGS"))["clutter_removal"] == 1
     await write(tb, "IRQ_ENABLE", frame_done=1)
@@ -88,13 +148,37 @@ async def registers_through_axi_lite(dut) -> None:
     plain = dma_packets(frames[2:], SMALL4, CHAIN, first_frame_id=2, removal=[False] * 2)
     assert any(not np.array_equal(g, p) for g, p in zip(got[-len(plain):], plain, strict=True))
 
+    # packet length written while frame 4 streams into the packetizer: from frame 5 on
+    more = adc_frames("small4", SMALL4, 7)[4:]
+    new_words = 96
+    for adc in more:
+        await tb.send_frame(adc)
+    fw = SMALL4.num_tx * SMALL4.n_range * SMALL4.n_doppler
+    while not (int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1):
+        await tb.cycles(1)
+    await tb.cycles(fw // 4)
+    assert int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1
+    await write(tb, "PACKET", words=new_words)
+    assert int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1, "not mid-frame"
+    assert (await read(tb, "ACTIVE_PACKET"))["words"] == CHAIN.packet_words, "applied mid-frame"
+    n_pk = (packets_per_frame(fw, CHAIN.packet_words)
+            + 2 * packets_per_frame(fw, new_words))
+    late = [await tb.recv_packet(2 * tb.frame_timeout_cycles()) for _ in range(n_pk)]
+    assert (await read(tb, "ACTIVE_PACKET"))["words"] == new_words
+    lengths = [CHAIN.packet_words] * 5 + [new_words] * 2
+    want = dma_packets([*frames, *more], SMALL4, CHAIN, removal=removal + [True] * 3,
+                       settings=FrameSettings(packet_words=lengths))
+    assert_packets_equal(late, want[len(got):], "packet length written in mid-frame")
+    got += late
+    assert (await read(tb, "CFG_ERRORS"))["count"] == refused
+
     st = tb.status()
-    assert (await read(tb, "FRAMES"))["count"] == 4 == st["frames_out"]
+    assert (await read(tb, "FRAMES"))["count"] == 7 == st["frames_out"]
     assert (await read(tb, "PACKETS"))["count"] == len(got) == st["packets_out"]
     assert (await read(tb, "DROPS"))["count"] == 0
     assert (await read(tb, "ERRORS"))["count"] == 0
-    assert (await read(tb, "STATUS")) == dict.fromkeys(("frame_done", "drop", "error",
-                                                        "cfg_error"), 0)
+    assert (await read(tb, "STATUS")) == {"frame_done": 1, "drop": 0, "error": 0,
+                                          "cfg_error": 0}
 
 
 def test_radar_pipeline_regs() -> None:

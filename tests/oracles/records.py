@@ -42,7 +42,8 @@ def decode_frame_reference(words: np.ndarray, num_tx: int) -> RecordFrame:
         if tag == TAG_TRAILER:
             tr = Trailer(records=int(lanes[1]), detections=int(lanes[2]),
                          truncated=bool(lanes[0] & 1), truncated_sticky=bool(lanes[0] & 2),
-                         frame_id=int(lanes[3]), max_detections=int(lanes[4]))
+                         frame_id=int(lanes[3]), max_detections=int(lanes[4]),
+                         limit=int(lanes[5]))
             if tr.records != len(recs):
                 errors.append(f"trailer counts {tr.records} records, found {len(recs)}")
             return RecordFrame(recs, tr, errors)
