@@ -81,7 +81,7 @@ module radar_pipeline #(
   // SETTINGS.clutter_removal, on after reset); 0: none, the setting has no effect.
   parameter bit STATIC_REMOVAL = 1'b0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
-  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,
+  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO, 3 OS), top range bins blanked,
   // threshold-scale fixed point, records per frame at most.
   parameter int GUARD_R = 2,
   parameter int GUARD_D = 2,
@@ -237,8 +237,8 @@ module radar_pipeline #(
   begin : g_bad_max_detections
     $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535", MAX_DETECTIONS);
   end
-  if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 2)) begin : g_bad_cfar_kind
-    $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", CFAR_KIND);
+  if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 3)) begin : g_bad_cfar_kind
+    $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO), 2 (SO) or 3 (OS)", CFAR_KIND);
   end
   // guard/training/BLANK_TOP/SCALE_* ranges are checked by cfar_2d (g_bad_* there)
 
@@ -449,7 +449,7 @@ module radar_pipeline #(
       .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
       .MAX_DETECTIONS(MAX_DETECTIONS)
     ) u_detect (
-      .clk, .rst, .cfg_scale(cfg_cfar_scale),
+      .clk, .rst, .cfg_scale(cfg_cfar_scale), .cfg_kind(2'(CFAR_KIND)), .cfg_local_max(1'b0),
       .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
       .s_axis_tlast(df_tlast),
       .m_axis_tdata(pk_tdata), .m_axis_tvalid(pk_tvalid), .m_axis_tready(pk_tready),
