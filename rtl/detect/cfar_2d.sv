@@ -1,28 +1,24 @@
 // SPDX-License-Identifier: Apache-2.0
-// 2-D CFAR on the integrated power map: cell averaging (CA), greatest-of (GO),
-// smallest-of (SO) or, when built, ordered statistic (OS), chosen at run time (cfg_kind),
-// with an optional 3x3 local-maximum test (cfg_local_max), circular in Doppler, training window cut at the range ends with a
-// per-edge-row threshold scale, the top BLANK_TOP range bins blanked (never tested, never
-// used for training). Streams the map in (for r, for d) and sends every cell out with its
-// training sum, training cell count, the detection flag and the powers of its four
-// neighbours (range -1/+1, Doppler -1/+1: what the host's peak interpolation needs).
+// 2-D CFAR on the integrated power map, circular in Doppler: cell averaging (CA),
+// greatest-of (GO), smallest-of (SO) or, when built, ordered statistic (OS), chosen at run
+// time (cfg_kind), with an optional 3x3 local-maximum test (cfg_local_max). Training window
+// cut at the range ends with a per-edge-row threshold scale, the top BLANK_TOP range bins
+// blanked (never tested, never used for training). Streams the map in (for r, for d) and
+// sends every cell out with its training sum and cell count, the detection flag and the
+// powers of its four neighbours (what the host's peak interpolation needs).
 //
 // Architecture (docs/detect.md): a column store of N_DOPPLER words, each holding the cells
 // of the last ROWS = 2*PR+2 range rows of that Doppler column. Pass p writes input row p
 // (read-modify-write, one cell per clock) and tests row q = p-PR-1, whose window rows
-// q-PR..q+PR are complete: the vertical sums of every column stream through a shift
-// register of 2*PD+1 columns; the circular wrap is closed by replaying columns 0..2*PD-1
-// after column N_DOPPLER-1 (2*PD extra clocks per tested row). After the last input row,
-// PR+1 passes without input test the remaining rows. Output order per row:
-// d = PD..N_DOPPLER-1, 0..PD-1 (every cell carries its {r, d} in tuser).
-// Detection: CUT * 2^SCALE_FRAC > S * cfg_scale[e] (exact integers), S the training sum
-// of the chosen kind, e the edge index of the row (0..PR-1: PR-e rows cut below,
-// PR: interior, PR+1..2*PR: e-PR rows cut above). The scales come from model/cfar_2d.py
-// (alpha(Pfa, cells) / cells, the host CFAR's statistics). OS (cfar_os.sv): at least k(e)
-// training cells X_i with X_i * 2^SCALE_FRAC < CUT * cfg_scale[e] (the inverse scale).
-// Local maximum: a detection stays only if none of its 8 neighbours has a greater power
-// (Doppler circular; a range neighbour outside 0..N_RANGE-1 does not exist).
-// Window sums and the threshold product: cfar_sums.sv.
+// q-PR..q+PR are complete: the vertical sums of every column (cfar_vsum.sv) stream through
+// a shift register of 2*PD+1 columns; the circular wrap is closed by replaying columns
+// 0..2*PD-1 after column N_DOPPLER-1. After the last input row, PR+1 passes without input
+// test the remaining rows. Output order per row: d = PD..N_DOPPLER-1, 0..PD-1 ({r, d} in
+// tuser). Detection: CUT * 2^SCALE_FRAC > S * cfg_scale[e] (exact integers; cfar_sums.sv),
+// S the training sum of the kind, e the edge index of the row (0..PR-1: PR-e rows cut
+// below, PR: interior, PR+1..2*PR: e-PR rows cut above); OS (cfar_os.sv): at least k(e)
+// training cells X with X * 2^SCALE_FRAC < CUT * cfg_scale[e] (the inverse scale); the
+// scales from model/cfar_2d.py. Local maximum (cfar_peak.sv): no 8-neighbour greater.
 `default_nettype none
 
 module cfar_2d #(
@@ -175,23 +171,13 @@ module cfar_2d #(
   // ---------------------------------------------------------------------------------------
   // Pipeline: one column step per clock, no stall inside (a step is taken only when the
   // output FIFOs have room for every cell in flight). Stage k = k clocks after the step:
-  //    1  column store read data (the RAM's own read register); the step's row geometry
-  //    2  read data registered again (block RAM output before any logic); written back
-  //       with the input cell (read-modify-write); slot masks of the window rows
-  //    3  vertical sums, first two adder levels over the masked slots; the CUT-row and
-  //       range-neighbour cells picked from the word
-  //    4  vertical sums done (vo: window rows, vi: guard rows): the column arrives, shifts
-  //       into the column shift registers and updates the running window sums
-  //    5  window sums (the GO/SO halves and the CUT's column); the cell, its neighbours,
-  //       count, {r, d} and TLAST -> early output FIFO; OS comparator bits
-  //    6  training sum S of the kind, the row's threshold scale: multiplier inputs; the
-  //       local-maximum test
-  //    7  partial products S_i * scale_j (17 x 17 bits: one DSP48E2 / MULT18 each)
-  //    8  partial products summed per scale chunk
-  //    9  product S * scale; OS count >= k
-  //   10  CUT * 2^SCALE_FRAC > S * scale; the decision of the kind (and the local maximum)
-  //       -> late output FIFO with S
-  // (stages 4..10 of the sums and the product: cfar_sums.sv; the OS test: cfar_os.sv)
+  //  1 column store read (the RAM's own register), the row geometry; 2 read data registered
+  //  again, written back with the input cell, slot masks; 3-4 vertical sums (cfar_vsum.sv):
+  //  the column arrives, shifts into the column shift register; 5 window sums; the cell,
+  //  its neighbours, count, {r, d}, TLAST -> early output FIFO; 6 training sum of the kind,
+  //  local maximum (cfar_peak.sv); 7-9 S * scale (17 x 17-bit partial products, one
+  //  DSP48E2 each; cfar_sums.sv); OS (cfar_os.sv) comparators 5, popcount 6-8, count >= k 9;
+  //  10 the decision of the kind -> late output FIFO with S
   localparam int LAT_E = 5;     // step -> early FIFO entry
   localparam int LAT_L = 10;    // step -> late FIFO entry (the output's valid)
 
@@ -226,8 +212,9 @@ module cfar_2d #(
 
   // ---------------------------------------------------------------------------------------
   // Row geometry of pass p (tested row q = p - PR - 1): which window rows exist, the edge
-  // index, whether the row may detect and has range neighbours. It changes only between passes, so the next pass's geometry is computed ahead in three
-  // register stages (a pass lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
+  // index, whether the row may detect and has range neighbours. It changes only between
+  // passes, so the next pass's geometry is computed ahead in three register stages (a pass
+  // lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
   localparam int E_W   = $clog2(NE);
   localparam int NR_W  = $clog2(NE + 1);
   localparam int GEO_W = 3 + BR + E_W + NE;   // {cut_ok, rm_ok, rp_ok, r, e, rowv}

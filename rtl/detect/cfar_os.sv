@@ -161,29 +161,32 @@ module cfar_os #(
         hit5_q[j * ROWS + s] <= train && !none_q[PD-1] && (big_q[PD-1] || x <= thr_q[PD-1]);
       end
 
-  // Stages 6-8: popcount (groups of 8 bits, then groups of 8 counts, then the total)
-  logic [3:0]       c6_q [G1];
-  logic [6:0]       c7_q [G2];
-  logic [CNT_W:0]   c8_q;
+  // Stages 6-8: popcount as balanced adder trees: groups of 8 bits, groups of 8 counts
+  // (3 levels each), the total of the group counts (3 levels up to 512 comparators)
+  localparam int G2P = (G2 < 2) ? 2 : (1 << $clog2(G2));   // stage-8 tree width
+  logic [3:0]     c6_q [G1];
+  logic [6:0]     c7_q [G2];
+  logic [CNT_W:0] c8_q;
   always_ff @(posedge clk) begin
-    logic [3:0]     t6;
-    logic [6:0]     t7;
-    logic [CNT_W:0] t8;
+    logic [3:0]     t6 [8];
+    logic [6:0]     t7 [8];
+    logic [CNT_W:0] t8 [G2P];
     for (int g = 0; g < G1; g++) begin
-      t6 = '0;
-      for (int b = 0; b < 8; b++)
-        if (g * 8 + b < NC) t6 = t6 + 4'(hit5_q[(g * 8 + b) % NC]);
-      c6_q[g] <= t6;
+      for (int b = 0; b < 8; b++) t6[b] = (g * 8 + b < NC) ? 4'(hit5_q[(g * 8 + b) % NC]) : '0;
+      for (int w = 4; w >= 1; w = w / 2)
+        for (int b = 0; b < w; b++) t6[b] = t6[2 * b] + t6[2 * b + 1];
+      c6_q[g] <= t6[0];
     end
     for (int g = 0; g < G2; g++) begin
-      t7 = '0;
-      for (int b = 0; b < 8; b++)
-        if (g * 8 + b < G1) t7 = t7 + 7'(c6_q[(g * 8 + b) % G1]);
-      c7_q[g] <= t7;
+      for (int b = 0; b < 8; b++) t7[b] = (g * 8 + b < G1) ? 7'(c6_q[(g * 8 + b) % G1]) : '0;
+      for (int w = 4; w >= 1; w = w / 2)
+        for (int b = 0; b < w; b++) t7[b] = t7[2 * b] + t7[2 * b + 1];
+      c7_q[g] <= t7[0];
     end
-    t8 = '0;
-    for (int g = 0; g < G2; g++) t8 = t8 + (CNT_W + 1)'(c7_q[g]);
-    c8_q <= t8;
+    for (int b = 0; b < G2P; b++) t8[b] = (b < G2) ? (CNT_W + 1)'(c7_q[b % G2]) : '0;
+    for (int w = G2P / 2; w >= 1; w = w / 2)
+      for (int b = 0; b < w; b++) t8[b] = t8[2 * b] + t8[2 * b + 1];
+    c8_q <= t8[0];
   end
 
   // Stage 9: at least k cells
