@@ -59,11 +59,12 @@ class TB(AxisTB):
         return p
 
     def tie_map(self) -> np.ndarray:
-        """Background B with, every fourth row r, the cells (r, d), (r, d+1), (r+1, d-1) and
-        (r+1, d+2) at C(r), the smallest CUT whose OS threshold floor((C * inv - 1) / 2^frac)
-        is exactly B (inv the row's OS scale, or the kind's scale when OS is not built):
-        every background training cell sits on the OS comparison's boundary, and the four
-        equal cells are ties for the local maximum along Doppler and both diagonals."""
+        """Background B with, every fourth row r, the cells (r, d), (r, d+1), (r+1, d-1),
+        (r+1, d) and (r+1, d+2) at C(r), the smallest CUT whose OS threshold
+        floor((C * inv - 1) / 2^frac) is exactly B (inv the row's OS scale, or the kind's scale
+        when OS is not built): every background training cell sits on the OS comparison's
+        boundary, and the equal cells are ties for the local maximum along both axes and
+        both diagonals."""
         c = self.cfg
         inv = cm.scale_table(c, PFA, N_CHANNELS, kind="os") if c.os_built else self.scale
         b, nd = 5000, c.n_doppler
@@ -72,7 +73,8 @@ class TB(AxisTB):
             s = int(inv[cm.edge_index(r, c)])
             d = int(self.rng.integers(0, nd))
             cut = ((b << c.scale_frac) + s) // s
-            p[r, d] = p[r, (d + 1) % nd] = p[r + 1, (d - 1) % nd] = p[r + 1, (d + 2) % nd] = cut
+            for dr, dd in ((0, 0), (0, 1), (1, -1), (1, 0), (1, 2)):
+                p[r + dr, (d + dd) % nd] = cut
         return p
 
     async def send_map(self, power: np.ndarray) -> None:
