@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Formal harness of cfar_2d (formal/cfar_2d.sby): 4 range x 4 Doppler cells, POW_W 8,
-// guard 0, training 1 cell each way (PR = PD = 1), cell averaging, 4-bit scales (the scales
-// are any constant the solver picks). Both ports under the shared f_axis_port set, and:
+// guard 0, training 1 cell each way (PR = PD = 1), default kind CA, the run-time kind and
+// local-maximum setting and the 4-bit scales any constants the solver picks. Both ports
+// under the shared f_axis_port set, and:
 //   - every cell leaves exactly once, in order: output beat k carries tuser = {r, d} with
 //     r = (k / 4) mod 4 and d = (k + PD) mod 4 (each row starts at d = PD, wraps to 0..PD-1),
 //     TLAST on the last cell of every row; no cell before its input (out <= in);
@@ -24,6 +25,8 @@ module cfar_2d_props (
   localparam int NR = 4, ND = 4, PD = 1;
   localparam int POW_W = 8, CNT_W = 4, SUM_W = 12, OUT_W = 64;
   (* anyconst *) logic [3*4-1:0] cfg_scale;
+  (* anyconst *) logic [1:0] cfg_kind;       // any kind (OS not built: KIND)
+  (* anyconst *) logic       cfg_local_max;
 
   logic             s_axis_tready, m_axis_tvalid, m_axis_tlast, framing;
   logic [OUT_W-1:0] m_axis_tdata;
@@ -32,7 +35,8 @@ module cfar_2d_props (
 
   cfar_2d #(.N_RANGE(NR), .N_DOPPLER(ND), .POW_W(POW_W), .GUARD_R(0), .GUARD_D(0),
             .TRAIN_R(1), .TRAIN_D(1), .KIND(0), .SCALE_W(4), .SCALE_FRAC(1)) dut (
-    .clk, .rst, .cfg_scale, .s_axis_tdata, .s_axis_tvalid, .s_axis_tready, .s_axis_tlast,
+    .clk, .rst, .cfg_scale, .cfg_kind, .cfg_local_max,
+    .s_axis_tdata, .s_axis_tvalid, .s_axis_tready, .s_axis_tlast,
     .m_axis_tdata, .m_axis_tvalid, .m_axis_tready, .m_axis_tlast, .m_axis_tuser,
     .status_framing_error(framing), .frame_count, .detection_count);
 

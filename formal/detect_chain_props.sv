@@ -23,6 +23,8 @@ module detect_chain_props (
 );
   localparam int FW = 17;  // MAX_DETECTIONS * (HDR 8 + TX 1) + HDR 8
   (* anyconst *) logic [11:0] cfg_scale;
+  (* anyconst *) logic [1:0] cfg_kind;       // any kind (OS not built: KIND)
+  (* anyconst *) logic       cfg_local_max;
   logic        s_axis_tready, m_axis_tvalid, m_axis_tlast, framing, trunc;
   logic [63:0] m_axis_tdata;
   logic [31:0] detection_count, frame_count;
@@ -30,7 +32,8 @@ module detect_chain_props (
   detect_chain #(.NUM_TX(1), .NUM_RX(2), .N_RANGE(4), .N_DOPPLER(4), .GUARD_R(0),
                  .GUARD_D(0), .TRAIN_R(1), .TRAIN_D(1), .KIND(0), .SCALE_W(4),
                  .SCALE_FRAC(1), .MAX_DETECTIONS(1)) dut (
-    .clk, .rst, .cfg_scale, .cfg_max_detections(16'd1), .frame_start(),
+    .clk, .rst, .cfg_scale, .cfg_kind, .cfg_local_max, .cfg_max_detections(16'd1),
+    .frame_start(),
     .s_axis_tdata, .s_axis_tvalid, .s_axis_tready, .s_axis_tlast,
     .m_axis_tdata, .m_axis_tvalid, .m_axis_tready, .m_axis_tlast,
     .status_framing_error(framing), .status_truncated(trunc), .detection_count,

@@ -28,6 +28,7 @@ import numpy as np
 from host.cfar import CfarParams
 from host.stream import PacketDecoder
 from model.axis_packetizer import unpack_iq
+from model.cfar_2d import OS_RANK
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.detect_records import (
@@ -50,15 +51,19 @@ def fpga_detect_config(cfg: RadarConfig, cfar: CfarParams, kind: str = "ca",
                        windowed: tuple[bool, bool] = (True, True)) -> DetectConfig:
     """The on-chip detector's settings for ``cfg`` from the host CFAR options: same guard
     and training cells, same Pfa (the scale table is derived from it with the host CFAR's
-    statistics), CFAR ``kind`` ca/go/so; only ``RadarConfig.detection_bins`` may report
+    statistics), CFAR ``kind`` ca/go/so/os (OS: the host's ``os_rank``, which must be whole
+    per mille); only ``RadarConfig.detection_bins`` may report
     (``report``: REPORT_LO/REPORT_HI, the host's rule; the other rows stay training cells,
     as in the host CFAR, and as ``PipelineParams.detect_config``'s default). ValueError on
     settings the detector refuses."""
+    rank = round(cfar.os_rank * 1000)
+    if kind == "os" and abs(rank - cfar.os_rank * 1000) > 1e-9:
+        raise ValueError(f"os_rank {cfar.os_rank}: the on-chip OS rank is in whole per mille")
     return DetectConfig(num_tx=cfg.num_tx, num_rx=cfg.num_rx, n_range=cfg.n_range_bins,
                         n_doppler=cfg.n_doppler, guard=tuple(cfar.guard),
                         train=tuple(cfar.train), kind=kind,
                         max_detections=max_detections, pfa=cfar.pfa, windowed=windowed,
-                        report=cfg.detection_bins)
+                        report=cfg.detection_bins, os_rank=rank if kind == "os" else OS_RANK)
 
 
 @dataclass(frozen=True)

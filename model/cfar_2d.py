@@ -1,6 +1,6 @@
-"""Bit-exact model of ``rtl/detect/cfar_2d.sv`` (2-D CA/GO/SO-CFAR on the integrated power
-map) and the threshold scales it needs, derived from a requested Pfa with the host CFAR's
-statistics (``model/cfar_stats.py``).
+"""Bit-exact model of ``rtl/detect/cfar_2d.sv`` (2-D CA/GO/SO/OS-CFAR on the integrated power
+map, with the optional 3x3 local-maximum test) and the threshold scales it needs, derived
+from a requested Pfa with the host CFAR's statistics (``model/cfar_stats.py``).
 
 Maps are int64 ``(n_range, n_doppler)`` powers (``model/nci.py``), Doppler in natural FFT
 order and circular. Window per cell under test (CUT) at (q, d): rows q-PR..q+PR, columns
@@ -16,9 +16,19 @@ The top ``blank_top`` range bins are the negative beat frequencies of a complex-
 rows lo <= r < hi may detect (``RadarConfig.detection_bins``, the host's reporting rule);
 the others still train.
 
-Kinds: ``ca`` sums all training cells; ``go``/``so`` take the greater/smaller of the two
-Doppler halves (column offsets < 0 and > 0; the CUT's own column is in neither half).
-Decision (exact integers): ``power * 2^scale_frac > S * scale[e]``, S the kind's training sum.
+Kinds (run-time ``cfg_kind`` codes 0..3, :data:`KINDS`): ``ca`` sums all training cells;
+``go``/``so`` take the greater/smaller of the two Doppler halves (column offsets < 0 and > 0;
+the CUT's own column is in neither half); ``os`` (built when ``kind`` is ``os`` or ``os``
+is set) takes the k-th smallest training cell of the CA window, k = :func:`os_rank_k`.
+Decision (exact integers): ``power * 2^scale_frac > S * scale[e]``, S the kind's training sum;
+OS: at least k(e) training cells X with ``X * 2^scale_frac < power * scale[e]``, ``scale``
+then the inverse factor 2^scale_frac / alpha (one product per cell on chip, not one per
+training cell), which is ``power > alpha' * X_(k)`` with alpha' = 2^scale_frac / scale[e].
+OS sends the CA training sum and count (the noise estimate S / count). Local maximum
+(``local_max``): a detection stays only if none of its 8 neighbours has a greater power
+(``host.cfar.local_peaks``'s rule; Doppler circular, a range neighbour outside the map does
+not exist: the host's circular range axis differs only on rows 0 and n_range-1, which
+``RadarConfig.detection_bins`` never reports).
 
 Output word of the RTL (one per cell, LSB first): power ``pow_w`` bits, training sum S
 ``sum_w`` bits, training cell count ``cnt_w`` bits, detect 1 bit, then the powers of the
@@ -35,9 +45,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from model.cfar_stats import ca_factor, effective_cells_mask, go_so_factor
+from model.cfar_stats import ca_factor, effective_cells_mask, go_so_factor, os_factor
 
-KINDS = ("ca", "go", "so")
+KINDS = ("ca", "go", "so", "os")
+"""CFAR kinds by their code (``KIND`` parameter, ``cfg_kind`` input, the register map)."""
+OS_RANK = 750
+"""Default OS rank, per mille of the training cells (the host's ``CfarParams.os_rank``)."""
 NEIGHBOURS = ((-1, 0), (1, 0), (0, -1), (0, 1))
 """(range, Doppler) offsets of the four neighbour powers of an output cell, in field order."""
 
@@ -60,6 +73,8 @@ class Cfar2dConfig:
     scale_w: int = 32
     scale_frac: int = 20
     report: tuple[int, int] | None = None
+    os: bool = False
+    os_rank: int = OS_RANK
 
     def __post_init__(self) -> None:
         if self.report is not None and not 0 <= self.report[0] < self.report[1] <= \
@@ -75,6 +90,10 @@ class Cfar2dConfig:
             raise ValueError("guard must be in 0..15 and train in 1..15 cells per side")
         if self.kind not in KINDS:
             raise ValueError(f"kind: must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        if self.os_built and self.pd < 2:
+            raise ValueError("OS needs guard + train >= 2 Doppler cells per side")
+        if not 1 <= self.os_rank <= 999:
+            raise ValueError(f"os_rank={self.os_rank} not in 1..999 (per mille)")
         if 2 * self.pd + 1 > self.n_doppler:
             raise ValueError(f"Doppler window {2 * self.pd + 1} wider than n_doppler")
         if self.blank_top < 0 or self.rows < 2 * self.pr + 1:
@@ -92,6 +111,19 @@ class Cfar2dConfig:
     @property
     def pd(self) -> int:
         return self.guard[1] + self.train[1]
+
+    @property
+    def os_built(self) -> bool:
+        """The OS test is built (``OS_BUILD``)."""
+        return self.os or self.kind == "os"
+
+    def run_kind(self, kind: str | None) -> str:
+        """The kind the RTL runs for ``cfg_kind`` = ``kind`` (None: ``self.kind``): a kind
+        that is not built (OS) selects ``self.kind``."""
+        k = self.kind if kind is None else kind
+        if k not in KINDS:
+            raise ValueError(f"kind: must be one of {', '.join(KINDS)}, got {k!r}")
+        return self.kind if k == "os" and not self.os_built else k
 
     @property
     def rows(self) -> int:
@@ -120,6 +152,10 @@ class Cfar2dConfig:
         """HDL parameters of ``cfar_2d`` for this configuration."""
         rep = ({} if self.report is None
                else dict(REPORT_LO=self.report[0], REPORT_HI=self.report[1]))
+        if self.os and self.kind != "os":
+            rep["OS_BUILD"] = 1
+        if self.os_rank != OS_RANK:
+            rep["OS_RANK"] = self.os_rank
         return dict(N_RANGE=self.n_range, N_DOPPLER=self.n_doppler, POW_W=self.pow_w,
                     GUARD_R=self.guard[0], GUARD_D=self.guard[1], TRAIN_R=self.train[0],
                     TRAIN_D=self.train[1], KIND=KINDS.index(self.kind),
@@ -172,37 +208,55 @@ def training_mask(cfg: Cfar2dConfig, e: int, half: bool) -> np.ndarray:
     return k
 
 
+def os_rank_k(n: int, os_rank: int = OS_RANK) -> int:
+    """OS rank k of ``n`` training cells: ``os_rank`` per mille, rounded half to even (the
+    host's ``round(os_rank * n)``), clipped to 1..n (the RTL's k table, exact integers)."""
+    q, r = divmod(os_rank * n, 1000)
+    q += r > 500 or (r == 500 and q % 2 == 1)
+    return max(1, min(n, q))
+
+
 def threshold_factors(cfg: Cfar2dConfig, pfa: float, n_channels: int,
-                      windowed: tuple[bool, bool] = (True, True)
+                      windowed: tuple[bool, bool] = (True, True), kind: str | None = None
                       ) -> tuple[np.ndarray, np.ndarray]:
     """Per edge index: (alpha float ``(2PR+1,)``, training cells int ``(2PR+1,)``) such
-    that ``CUT > alpha * S / cells`` has false-alarm probability ``pfa`` under noise.
+    that ``CUT > alpha * S / cells`` (OS: ``CUT > alpha * X_(k)``) has false-alarm
+    probability ``pfa`` under noise, for ``kind`` (None: ``cfg.kind``).
 
     Effective cells scale with the cells that remain at range edges (host rule:
-    N_eff = cells * N_eff(full window) / cells(full window)).
+    N_eff = cells * N_eff(full window) / cells(full window)); OS takes the cells as
+    independent (the host's ``os_factor`` rule).
     """
-    half = cfg.kind != "ca"
+    kind = cfg.run_kind(kind)
+    half = kind in ("go", "so")
     full = training_mask(cfg, cfg.pr, half)
     eff_per_cell = effective_cells_mask(full, windowed) / full.sum()
     alphas, cells = [], []
     for e in range(cfg.n_edge):
         c = int(training_mask(cfg, e, half).sum())
         n_eff = c * eff_per_cell
-        a = (float(ca_factor(pfa, n_channels, n_eff)) if not half
-             else go_so_factor(pfa, n_channels, n_eff, cfg.kind))
+        if kind == "os":
+            a = os_factor(pfa, n_channels, c, os_rank_k(c, cfg.os_rank))
+        elif half:
+            a = go_so_factor(pfa, n_channels, n_eff, kind)
+        else:
+            a = float(ca_factor(pfa, n_channels, n_eff))
         alphas.append(a)
         cells.append(c)
     return np.array(alphas), np.array(cells, dtype=np.int64)
 
 
 def scale_table(cfg: Cfar2dConfig, pfa: float, n_channels: int,
-                windowed: tuple[bool, bool] = (True, True)) -> np.ndarray:
-    """Fixed-point threshold scales int64 ``(2PR+1,)``: round(alpha / cells * 2^frac)
-    (the RTL's ``cfg_scale`` input, entry e at bits ``e*scale_w``)."""
-    alpha, cells = threshold_factors(cfg, pfa, n_channels, windowed)
-    s = np.rint(alpha / cells * (1 << cfg.scale_frac)).astype(np.int64)
+                windowed: tuple[bool, bool] = (True, True), kind: str | None = None
+                ) -> np.ndarray:
+    """Fixed-point threshold scales int64 ``(2PR+1,)`` for ``kind`` (None: ``cfg.kind``):
+    round(alpha / cells * 2^frac), OS round(2^frac / alpha) (the RTL's ``cfg_scale`` input,
+    entry e at bits ``e*scale_w``)."""
+    alpha, cells = threshold_factors(cfg, pfa, n_channels, windowed, kind)
+    value = 1.0 / alpha if cfg.run_kind(kind) == "os" else alpha / cells
+    s = np.rint(value * (1 << cfg.scale_frac)).astype(np.int64)
     if (s >= 1 << cfg.scale_w).any() or (s < 1).any():
-        raise ValueError(f"threshold scale {alpha / cells} does not fit {cfg.scale_w} bits "
+        raise ValueError(f"threshold scale {value} does not fit {cfg.scale_w} bits "
                          f"with {cfg.scale_frac} fraction bits")
     return s
 
@@ -226,9 +280,53 @@ def neighbours(power: np.ndarray) -> np.ndarray:
     return out
 
 
-def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCells:
+def local_maxima(power: np.ndarray) -> np.ndarray:
+    """bool ``(n_range, n_doppler)``: no 8-neighbour of the cell has a greater power (int
+    map; Doppler circular, a range neighbour outside the map does not exist)."""
+    p = np.asarray(power)
+    pad = np.pad(p, ((1, 1), (0, 0)), constant_values=np.iinfo(np.int64).min)
+    keep = np.ones(p.shape, dtype=bool)
+    for dr in (-1, 0, 1):
+        rows = pad[1 + dr:1 + dr + p.shape[0]]
+        for dd in (-1, 0, 1):
+            if dr or dd:
+                keep &= np.roll(rows, -dd, axis=1) <= p
+    return keep
+
+
+def os_detect(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> np.ndarray:
+    """OS decisions of every cell (bool ``(n_range, n_doppler)``, before the reporting
+    rule): at least k(e) training cells X with ``X * 2^scale_frac < CUT * scale[e]``.
+    power: int64 ``(n_range, n_doppler)``; scale: the inverse scales (:func:`scale_table`)."""
+    p = np.asarray(power, dtype=np.int64)
+    nr, nd = p.shape
+    (pr, pd), big = (cfg.pr, cfg.pd), 1 << 62
+    sc = np.array([int(scale[edge_index(q, cfg)]) for q in range(nr)], dtype=np.int64)
+    # X * 2^frac < CUT * scale  <=>  X <= floor((CUT * scale - 1) / 2^frac) (-1: none);
+    # exact in int64 while the product fits, else in Python integers
+    if int(p.max()) * int(sc.max()) < big:
+        t = (p * sc[:, None] - 1) >> cfg.scale_frac
+    else:
+        t = np.array([[min((int(c) * int(s) - 1) >> cfg.scale_frac, big) for c in row]
+                      for row, s in zip(p, sc, strict=True)], dtype=np.int64)
+    # rows that do not exist (cut, blanked) never count: padded above any threshold
+    padded = np.full((nr + 2 * pr, nd + 2 * pd), big + 1, dtype=np.int64)
+    padded[pr:pr + cfg.rows] = np.pad(p[:cfg.rows], ((0, 0), (pd, pd)), mode="wrap")
+    count = np.zeros(p.shape, dtype=np.int64)
+    for kr, kd in zip(*np.nonzero(training_mask(cfg, pr, False)), strict=True):
+        count += padded[kr:kr + nr, kd:kd + nd] <= t
+    k = [os_rank_k(int(training_mask(cfg, edge_index(q, cfg), False).sum()), cfg.os_rank)
+         for q in range(nr)]
+    return count >= np.array(k)[:, None]
+
+
+def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray, kind: str | None = None,
+            local_max: bool = False) -> CfarCells:
     """Run the CFAR on one map. power: int ``(n_range, n_doppler)``; scale: int
-    ``(2PR+1,)`` from :func:`scale_table`."""
+    ``(2PR+1,)`` from :func:`scale_table` for the kind run; ``kind``: the RTL's
+    ``cfg_kind`` (None: ``cfg.kind``; :meth:`Cfar2dConfig.run_kind`); ``local_max``: its
+    ``cfg_local_max`` (keep only the detections that are 3x3 local maxima)."""
+    kind = cfg.run_kind(kind)
     p = np.asarray(power, dtype=np.int64)
     if p.shape != (cfg.n_range, cfg.n_doppler):
         raise ValueError(f"power: expected {(cfg.n_range, cfg.n_doppler)}, got {p.shape}")
@@ -238,6 +336,7 @@ def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCell
     detect = np.zeros(p.shape, dtype=bool)
     frac = 1 << cfg.scale_frac
     lo, hi = cfg.report or (0, cfg.n_range)
+    os_det = os_detect(p, cfg, scale) if kind == "os" else None
     for q in range(cfg.n_range):
         rowv = window_rows(q, cfg)
         rows = q - pr + np.nonzero(rowv)[0]
@@ -251,16 +350,22 @@ def cfar_2d(power: np.ndarray, cfg: Cfar2dConfig, scale: np.ndarray) -> CfarCell
 
         left = win(vo, range(-pd, 0)) - win(vi, range(-gd, 0))
         right = win(vo, range(1, pd + 1)) - win(vi, range(1, gd + 1))
-        if cfg.kind == "ca":
+        if kind in ("ca", "os"):
             s = left + right + vo - vi
             count[q] = n_out * (2 * pd + 1) - n_in * (2 * gd + 1)
         else:
-            s = np.maximum(left, right) if cfg.kind == "go" else np.minimum(left, right)
+            s = np.maximum(left, right) if kind == "go" else np.minimum(left, right)
             count[q] = n_out * pd - n_in * gd
         train_sum[q] = s
         if q < cfg.rows and lo <= q < hi:
             sc = int(scale[edge_index(q, cfg)])
-            detect[q] = [int(c) * frac > int(t) * sc for c, t in zip(p[q], s, strict=True)]
+            if os_det is not None:
+                detect[q] = os_det[q]
+            else:
+                detect[q] = [int(c) * frac > int(t) * sc
+                             for c, t in zip(p[q], s, strict=True)]
+    if local_max:
+        detect &= local_maxima(p)
     return CfarCells(p, train_sum, count, detect, neighbours(p))
 
 

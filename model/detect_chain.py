@@ -22,7 +22,10 @@ class DetectConfig:
     is derived from). guard/train: cells per side along (range, Doppler); ``windowed``:
     Hann windows before the (range, Doppler) FFTs (cell correlation in the Pfa arithmetic);
     ``blank_top``: top range bins blanked (negative beat frequencies); ``report``: (lo, hi),
-    only range bins lo <= r < hi may detect (``RadarConfig.detection_bins``; None: all)."""
+    only range bins lo <= r < hi may detect (``RadarConfig.detection_bins``; None: all).
+    ``kind``: KIND (the default kind; ``os`` builds the OS test), ``os``: OS_BUILD with
+    another default kind, ``os_rank``: OS_RANK (per mille); the run-time inputs:
+    ``run_kind`` (``cfg_kind``; None: ``kind``) and ``local_max`` (``cfg_local_max``)."""
 
     num_tx: int
     num_rx: int
@@ -38,6 +41,10 @@ class DetectConfig:
     scale_w: int = 32
     scale_frac: int = 20
     report: tuple[int, int] | None = None
+    os: bool = False
+    os_rank: int = cfar_2d.OS_RANK
+    run_kind: str | None = None
+    local_max: bool = False
 
     def __post_init__(self) -> None:
         if self.num_tx < 1 or self.num_tx > 16 or self.num_tx & (self.num_tx - 1):
@@ -46,7 +53,7 @@ class DetectConfig:
             raise ValueError(f"num_rx={self.num_rx} not in 1..64")
         if not 1 <= self.max_detections <= 65535:
             raise ValueError(f"max_detections={self.max_detections} not in 1..65535")
-        _ = self.cfar  # validates the CFAR geometry
+        self.cfar.run_kind(self.run_kind)  # validates the CFAR geometry and the kind
 
     @property
     def pow_w(self) -> int:
@@ -57,20 +64,22 @@ class DetectConfig:
         return cfar_2d.Cfar2dConfig(
             n_range=self.n_range, n_doppler=self.n_doppler, pow_w=self.pow_w, guard=self.guard,
             train=self.train, kind=self.kind, blank_top=self.blank_top, scale_w=self.scale_w,
-            scale_frac=self.scale_frac, report=self.report)
+            scale_frac=self.scale_frac, report=self.report, os=self.os, os_rank=self.os_rank)
 
     @property
     def frame_words(self) -> int:
         return detect_records.frame_words(self.num_tx, self.num_rx, self.max_detections)
 
     def scale(self) -> np.ndarray:
-        """Threshold scale table int64 ``(2PR+1,)`` for the configured Pfa."""
+        """Threshold scale table int64 ``(2PR+1,)`` for the configured Pfa and the kind run."""
         return cfar_2d.scale_table(self.cfar, self.pfa, self.num_tx * self.num_rx,
-                                   self.windowed)
+                                   self.windowed, self.run_kind)
 
     def hdl_parameters(self) -> dict[str, int]:
-        """HDL parameters of ``detect_chain``."""
-        return dict(NUM_TX=self.num_tx, NUM_RX=self.num_rx, N_RANGE=self.n_range,
+        """HDL parameters of ``detect_chain`` (OS_BUILD and OS_RANK when not the default)."""
+        extra = {k: v for k, v in self.cfar.hdl_parameters().items()
+                 if k in ("OS_BUILD", "OS_RANK")}
+        return dict(**extra, NUM_TX=self.num_tx, NUM_RX=self.num_rx, N_RANGE=self.n_range,
                     N_DOPPLER=self.n_doppler, GUARD_R=self.guard[0], GUARD_D=self.guard[1],
                     TRAIN_R=self.train[0], TRAIN_D=self.train[1], KIND=KIND_CODES[self.kind],
                     BLANK_TOP=self.blank_top, SCALE_W=self.scale_w, SCALE_FRAC=self.scale_frac,
@@ -87,7 +96,7 @@ def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
     """
     w = np.asarray(words, dtype=np.uint32)
     power = nci.nci(w, cfg.num_tx, cfg.n_range, cfg.n_doppler)
-    cells = cfar_2d.cfar_2d(power, cfg.cfar, scale)
+    cells = cfar_2d.cfar_2d(power, cfg.cfar, scale, cfg.run_kind, cfg.local_max)
     snap = w.reshape(cfg.n_range, cfg.num_tx, cfg.n_doppler, cfg.num_rx)
     recs = []
     for r, d in cfar_2d.output_order(cfg.cfar):

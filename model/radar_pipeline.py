@@ -41,6 +41,7 @@ from model.axis_packetizer import (
     packetize,
     unpack_iq,
 )
+from model.cfar_2d import OS_RANK
 from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
@@ -155,7 +156,13 @@ class PipelineParams:
         if self.static_removal:
             store["STATIC_REMOVAL"] = 1
         if self.output_mode == 1:
-            d = self.detect_config(cfg).hdl_parameters()
+            dc = self.detect_config(cfg)
+            if dc.os or dc.os_rank != OS_RANK or dc.run_kind not in (None, dc.kind) \
+                    or dc.local_max:
+                raise ValueError("detect: the top builds its detector from CFAR_KIND alone and "
+                                 "ties cfg_kind to it and the local-maximum test off (no "
+                                 "OS_BUILD, OS_RANK, run-time kind or local maximum)")
+            d = dc.hdl_parameters()
             store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
                          TRAIN_R=d["TRAIN_R"], TRAIN_D=d["TRAIN_D"], CFAR_KIND=d["KIND"],
                          BLANK_TOP=d["BLANK_TOP"], SCALE_W=d["SCALE_W"],

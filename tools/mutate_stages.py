@@ -59,6 +59,10 @@ TESTS: dict[str, list[list[str]]] = {
     "nci": [[_Q_NCI], [_Q_DC]],
     "static_removal": [[_Q_SR], ["tb/static_removal"]],
     "cfar_2d": [[_Q_CFAR], [_Q_DC]],
+    "cfar_vsum": [[_Q_CFAR], [_Q_DC]],
+    "cfar_peak": [[_Q_CFAR], [_Q_DC]],
+    "cfar_sums": [[_Q_CFAR], [_Q_DC]],
+    "cfar_os": [[_Q_CFAR]],
     "detect_records": [[_Q_REC], [_Q_DC]],
     "detect_chain": [[_Q_DC], ["tb/detect_chain"]],
     # the detect-mode top (OUTPUT_MODE 1: g_detect, the detector's flag in the status merge)
@@ -110,10 +114,10 @@ EQUIVALENT: dict[str, str] = {
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
-    "cfar_2d:rel:12": (
+    "cfar_2d:rel:9": (
         "lo = (q < PR) ? PR - q : 0 with <= instead of <: the two differ only at q == PR, "
         "where the taken arm gives PR - q = 0, the same as the other arm"),
-    "cfar_2d:rel:14": (
+    "cfar_2d:rel:11": (
         "if (hi > PR) hi = PR with >= instead of >: the two differ only at hi == PR, where "
         "the assignment writes the value hi already has"),
     "detect_records:noreset:6": (

@@ -65,15 +65,19 @@ MAX_FPGA_DETECTIONS = 65535
 def fpga_config(args: argparse.Namespace, cfg: RadarConfig, params: DetectionParams
                 ) -> DetectConfig:
     """The on-chip detector's settings from the options (CliError on a bad combination)."""
-    if args.detector != "ca":
-        raise CliError(f"--detect fpga: the FPGA runs a CA/GO/SO CFAR (--fpga-cfar), not "
-                       f"--detector {args.detector}")
+    if args.detector == "paper":
+        raise CliError("--detect fpga: the FPGA runs a CFAR (--fpga-cfar ca/go/so, or "
+                       "--detector os), not --detector paper")
+    if args.detector == "os" and args.fpga_cfar != "ca":
+        raise CliError(f"--fpga-cfar {args.fpga_cfar}: --detector os runs the OS-CFAR on chip; "
+                       f"--fpga-cfar chooses among the others with --detector ca")
+    kind = "os" if args.detector == "os" else args.fpga_cfar
     if getattr(args, "plots", None):
         raise CliError("--plots: needs the radar cube, which --detect fpga does not send "
                        "(use --detect host)")
     count(args.max_detections, "--max-detections", MAX_FPGA_DETECTIONS)
     try:
-        return fpga_detect_config(cfg, params.cfar, args.fpga_cfar, args.max_detections,
+        return fpga_detect_config(cfg, params.cfar, kind, args.max_detections,
                                   (params.range_window, params.doppler_window))
     except ValueError as exc:
         raise CliError(f"--detect fpga: {exc}") from None
@@ -198,9 +202,10 @@ def cmd_detect(args: argparse.Namespace) -> int:
 
 def add_fpga_options(p: argparse.ArgumentParser) -> None:
     """Options of the on-chip detector (``--detect fpga``)."""
-    p.add_argument("--fpga-cfar", choices=KINDS, default="ca",
+    p.add_argument("--fpga-cfar", choices=KINDS[:3], default="ca",
                    help="--detect fpga: the on-chip CFAR kind, cell averaging or greatest/"
-                        "smallest of the two Doppler halves (default ca)")
+                        "smallest of the two Doppler halves (default ca; --detector os "
+                        "runs the on-chip OS-CFAR)")
     p.add_argument("--max-detections", type=int, default=DEFAULT_MAX_DETECTIONS,
                    help=f"--detect fpga: MAX_DETECTIONS, records per frame, 1.."
                         f"{MAX_FPGA_DETECTIONS} (default {DEFAULT_MAX_DETECTIONS}; more "

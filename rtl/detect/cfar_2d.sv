@@ -1,23 +1,24 @@
 // SPDX-License-Identifier: Apache-2.0
-// 2-D CFAR on the integrated power map: cell averaging (CA), greatest-of (GO) or
-// smallest-of (SO), circular in Doppler, training window cut at the range ends with a
-// per-edge-row threshold scale, the top BLANK_TOP range bins blanked (never tested, never
-// used for training). Streams the map in (for r, for d) and sends every cell out with its
-// training sum, training cell count, the detection flag and the powers of its four
-// neighbours (range -1/+1, Doppler -1/+1: what the host's peak interpolation needs).
+// 2-D CFAR on the integrated power map, circular in Doppler: cell averaging (CA),
+// greatest-of (GO), smallest-of (SO) or, when built, ordered statistic (OS), chosen at run
+// time (cfg_kind), with an optional 3x3 local-maximum test (cfg_local_max). Training window
+// cut at the range ends with a per-edge-row threshold scale, the top BLANK_TOP range bins
+// blanked (never tested, never used for training). Streams the map in (for r, for d) and
+// sends every cell out with its training sum and cell count, the detection flag and the
+// powers of its four neighbours (what the host's peak interpolation needs).
 //
 // Architecture (docs/detect.md): a column store of N_DOPPLER words, each holding the cells
 // of the last ROWS = 2*PR+2 range rows of that Doppler column. Pass p writes input row p
 // (read-modify-write, one cell per clock) and tests row q = p-PR-1, whose window rows
-// q-PR..q+PR are complete: the vertical sums of every column stream through a shift
-// register of 2*PD+1 columns; the circular wrap is closed by replaying columns 0..2*PD-1
-// after column N_DOPPLER-1 (2*PD extra clocks per tested row). After the last input row,
-// PR+1 passes without input test the remaining rows. Output order per row:
-// d = PD..N_DOPPLER-1, 0..PD-1 (every cell carries its {r, d} in tuser).
-// Detection: CUT * 2^SCALE_FRAC > S * cfg_scale[e] (exact integers), S the training sum
-// of the chosen kind, e the edge index of the row (0..PR-1: PR-e rows cut below,
-// PR: interior, PR+1..2*PR: e-PR rows cut above). The scales come from model/cfar_2d.py
-// (alpha(Pfa, cells) / cells, the host CFAR's statistics).
+// q-PR..q+PR are complete: the vertical sums of every column (cfar_vsum.sv) stream through
+// a shift register of 2*PD+1 columns; the circular wrap is closed by replaying columns
+// 0..2*PD-1 after column N_DOPPLER-1. After the last input row, PR+1 passes without input
+// test the remaining rows. Output order per row: d = PD..N_DOPPLER-1, 0..PD-1 ({r, d} in
+// tuser). Detection: CUT * 2^SCALE_FRAC > S * cfg_scale[e] (exact integers; cfar_sums.sv),
+// S the training sum of the kind, e the edge index of the row (0..PR-1: PR-e rows cut
+// below, PR: interior, PR+1..2*PR: e-PR rows cut above); OS (cfar_os.sv): at least k(e)
+// training cells X with X * 2^SCALE_FRAC < CUT * cfg_scale[e] (the inverse scale); the
+// scales from model/cfar_2d.py. Local maximum (cfar_peak.sv): no 8-neighbour greater.
 `default_nettype none
 
 module cfar_2d #(
@@ -33,10 +34,17 @@ module cfar_2d #(
   // Training cells per side along range / Doppler, 1..15.
   parameter int TRAIN_R = 4,
   parameter int TRAIN_D = 8,
-  // 0: CA (all training cells), 1: GO (greater of the left/right Doppler halves),
-  // 2: SO (smaller of the halves). Halves: Doppler offsets < 0 and > 0 (the CUT's own
+  // Default kind (what cfg_kind is tied to when it is not a register; a cfg_kind code of a
+  // kind not built selects KIND): 0: CA (all training cells), 1: GO (greater of the
+  // left/right Doppler halves), 2: SO (smaller of the halves), 3: OS (k-th smallest
+  // training cell; builds the OS test). Halves: Doppler offsets < 0 and > 0 (the CUT's own
   // column is not in either half).
   parameter int KIND = 0,
+  // Build the OS test (cfar_os.sv: the window's column words and one comparator per
+  // training cell): 1 when KIND = 3, else 0 unless set. OS rank k = OS_RANK / 1000 of the
+  // training cells (rounded half to even, at least 1).
+  parameter bit OS_BUILD = (KIND == 3),
+  parameter int OS_RANK = 750,
   // Top range bins blanked (the negative beat frequencies of a complex-IF range FFT):
   // rows N_RANGE-BLANK_TOP..N_RANGE-1 are not tested and not used as training cells,
   // 0..N_RANGE-2*(GUARD_R+TRAIN_R)-1.
@@ -59,6 +67,9 @@ module cfar_2d #(
   input  wire logic                     rst,
   // Threshold scale per edge index e = 0..2*PR (quasi-static: change only while idle)
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_scale,
+  // Kind, 0 CA, 1 GO, 2 SO, 3 OS (quasi-static); the 3x3 local-maximum test on (quasi-static)
+  input  wire logic [1:0]               cfg_kind,
+  input  wire logic                     cfg_local_max,
   // Power map, order (r, d), TLAST on Doppler bin N_DOPPLER-1 (checked only)
   input  wire logic [IN_W-1:0]          s_axis_tdata,
   input  wire logic                     s_axis_tvalid,
@@ -90,7 +101,6 @@ module cfar_2d #(
   localparam int S_W   = $clog2(N_DOPPLER + 2 * PD + 1);
   localparam int N_EFF = N_RANGE - BLANK_TOP;        // rows that exist for the CFAR
   localparam int CW_W  = ROWS * POW_W;               // column word
-  localparam int PROD_W = SUM_W + SCALE_W;
 
   // Parameter checks: stop elaboration on illegal values.
   if (N_RANGE < 4 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
@@ -113,8 +123,8 @@ module cfar_2d #(
     $fatal(1, "%m: TRAIN_D/GUARD_D: window %0d wider than N_DOPPLER=%0d",
            2 * PD + 1, N_DOPPLER);
   end
-  if (KIND < 0 || KIND > 2) begin : g_bad_kind
-    $fatal(1, "%m: KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", KIND);
+  if (KIND < 0 || KIND > 3 || (KIND == 3 && !OS_BUILD)) begin : g_bad_kind
+    $fatal(1, "%m: KIND=%0d not 0 (CA), 1 (GO), 2 (SO) or 3 (OS, OS_BUILD = 1)", KIND);
   end
   if (BLANK_TOP < 0 || N_EFF < 2 * PR + 1) begin : g_bad_blank_top
     $fatal(1, "%m: BLANK_TOP=%0d leaves %0d rows, need >= %0d",
@@ -161,20 +171,13 @@ module cfar_2d #(
   // ---------------------------------------------------------------------------------------
   // Pipeline: one column step per clock, no stall inside (a step is taken only when the
   // output FIFOs have room for every cell in flight). Stage k = k clocks after the step:
-  //    1  column store read data (the RAM's own read register); the step's row geometry
-  //    2  read data registered again (block RAM output before any logic); written back
-  //       with the input cell (read-modify-write); slot masks of the window rows
-  //    3  vertical sums, first two adder levels over the masked slots; the CUT-row and
-  //       range-neighbour cells picked from the word
-  //    4  vertical sums done (vo: window rows, vi: guard rows): the column arrives, shifts
-  //       into the column shift registers and updates the running window sums
-  //    5  window sums (CA total or the GO/SO halves); the cell, its neighbours, count,
-  //       {r, d} and TLAST -> early output FIFO
-  //    6  training sum S (GO/SO select), the row's threshold scale: multiplier inputs
-  //    7  partial products S_i * scale_j (17 x 17 bits: one DSP48E2 / MULT18 each)
-  //    8  partial products summed per scale chunk
-  //    9  product S * scale
-  //   10  decision CUT * 2^SCALE_FRAC > S * scale -> late output FIFO with S
+  //  1 column store read (the RAM's own register), the row geometry; 2 read data registered
+  //  again, written back with the input cell, slot masks; 3-4 vertical sums (cfar_vsum.sv):
+  //  the column arrives, shifts into the column shift register; 5 window sums; the cell,
+  //  its neighbours, count, {r, d}, TLAST -> early output FIFO; 6 training sum of the kind,
+  //  local maximum (cfar_peak.sv); 7-9 S * scale (17 x 17-bit partial products, one
+  //  DSP48E2 each; cfar_sums.sv); OS (cfar_os.sv) comparators 5, popcount 6-8, count >= k 9;
+  //  10 the decision of the kind -> late output FIFO with S
   localparam int LAT_E = 5;     // step -> early FIFO entry
   localparam int LAT_L = 10;    // step -> late FIFO entry (the output's valid)
 
@@ -209,8 +212,9 @@ module cfar_2d #(
 
   // ---------------------------------------------------------------------------------------
   // Row geometry of pass p (tested row q = p - PR - 1): which window rows exist, the edge
-  // index, whether the row may detect and has range neighbours. It changes only between passes, so the next pass's geometry is computed ahead in three
-  // register stages (a pass lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
+  // index, whether the row may detect and has range neighbours. It changes only between
+  // passes, so the next pass's geometry is computed ahead in three register stages (a pass
+  // lasts at least N_DOPPLER >= 4 clocks) and loaded at the pass end.
   localparam int E_W   = $clog2(NE);
   localparam int NR_W  = $clog2(NE + 1);
   localparam int GEO_W = 3 + BR + E_W + NE;   // {cut_ok, rm_ok, rp_ok, r, e, rowv}
@@ -272,6 +276,12 @@ module cfar_2d #(
   logic [NE-1:0]     rowv1_q;
   logic [NR_W-1:0]   n_out1_q, n_in1_q;
   logic [CNT_W-1:0]  cnt_q [5:2];
+  logic [1:0]        kind_q;     // cfg_kind, a kind that is not built replaced by KIND
+  logic              lm_q;
+  always_ff @(posedge clk) begin
+    kind_q <= (cfg_kind == 2'd3 && !OS_BUILD) ? 2'(KIND) : cfg_kind;
+    lm_q   <= cfg_local_max;
+  end
 
   always_ff @(posedge clk) begin
     st_col1_q   <= col;
@@ -302,252 +312,92 @@ module cfar_2d #(
     end
     s_q2 <= s_q1;
     s_q3 <= s_q2;
-    if (KIND == 0)
-      cnt_q[2] <= CNT_W'(n_out1_q * (2 * PD + 1) - n_in1_q * (2 * GUARD_D + 1));
-    else
+    if (kind_q == 2'd1 || kind_q == 2'd2)
       cnt_q[2] <= CNT_W'(n_out1_q * PD - n_in1_q * GUARD_D);
+    else
+      cnt_q[2] <= CNT_W'(n_out1_q * (2 * PD + 1) - n_in1_q * (2 * GUARD_D + 1));
     for (int k = 3; k <= 5; k++) cnt_q[k] <= cnt_q[k-1];
   end
 
-  // Stage 2: slot masks. Window row k of the tested row sits in slot (slot+1+k) mod ROWS.
-  logic [ROWS-1:0] mo2_q, mi2_q, mc2_q, mrm2_q, mrp2_q;
-  always_ff @(posedge clk) begin
-    for (int s = 0; s < ROWS; s++) begin
-      wsel2_q[s] <= (st_slot1_q == SLOT_W'(s));
-      mo2_q[s]   <= 1'b0;
-      mi2_q[s]   <= 1'b0;
-      mc2_q[s]   <= 1'b0;
-      mrm2_q[s]  <= 1'b0;
-      mrp2_q[s]  <= 1'b0;
-      for (int k = 0; k < NE; k++)
-        if (st_slot1_q == SLOT_W'((s + ROWS - 1 - k) % ROWS)) begin
-          mo2_q[s]  <= rowv1_q[k];
-          mi2_q[s]  <= rowv1_q[k] && k >= PR - GUARD_R && k <= PR + GUARD_R;
-          mc2_q[s]  <= (k == PR);
-          mrm2_q[s] <= (k == PR - 1);
-          mrp2_q[s] <= (k == PR + 1);
-        end
-    end
-  end
-
-  // Stage 3: masked slots summed in two adder levels (64 -> 16 terms; slots beyond ROWS
-  // are constant zero), the CUT-row and range-neighbour cells selected (AND-OR over slots)
-  logic [SUM_W-1:0] po3_q [16], pi3_q [16];
-  logic [POW_W-1:0] c3_q, rm3_q, rp3_q;
-  always_ff @(posedge clk) begin
-    logic [SUM_W-1:0] xo [64], xi [64];
-    logic [POW_W-1:0] c, m, p, w;
-    c = '0;
-    m = '0;
-    p = '0;
-    for (int s = 0; s < 64; s++) begin
-      xo[s] = '0;
-      xi[s] = '0;
-      if (s < ROWS) begin
-        w = cw2_q[(s % ROWS) * POW_W +: POW_W];
-        if (mo2_q[s % ROWS]) xo[s] = SUM_W'(w);
-        if (mi2_q[s % ROWS]) xi[s] = SUM_W'(w);
-        if (mc2_q[s % ROWS]) c = c | w;
-        if (mrm2_q[s % ROWS]) m = m | w;
-        if (mrp2_q[s % ROWS]) p = p | w;
-      end
-    end
-    for (int i = 0; i < 32; i++) begin
-      xo[i] = xo[2 * i] + xo[2 * i + 1];
-      xi[i] = xi[2 * i] + xi[2 * i + 1];
-    end
-    for (int i = 0; i < 16; i++) begin
-      po3_q[i] <= xo[2 * i] + xo[2 * i + 1];
-      pi3_q[i] <= xi[2 * i] + xi[2 * i + 1];
-    end
-    c3_q  <= c;
-    rm3_q <= m;
-    rp3_q <= p;
-  end
-
-  // Stage 4: vertical sums complete (the remaining adder levels)
+  // Stage 1: write-back slot; stages 2..4: slot masks, vertical sums (cfar_vsum.sv)
+  always_ff @(posedge clk)
+    for (int s = 0; s < ROWS; s++) wsel2_q[s] <= (st_slot1_q == SLOT_W'(s));
+  logic [ROWS-1:0]  mo2_q, mi2_q;
   logic [SUM_W-1:0] vo4_q, vi4_q;
   logic [POW_W-1:0] vcut4_q, rm4_q, rp4_q;
   logic             first4_q;    // column step 0 of the pass (the running sums restart)
-  always_ff @(posedge clk) begin
-    logic [SUM_W-1:0] xo [16], xi [16];
-    for (int i = 0; i < 16; i++) begin
-      xo[i] = po3_q[i];
-      xi[i] = pi3_q[i];
-    end
-    for (int w = 8; w >= 1; w = w / 2)
-      for (int i = 0; i < w; i++) begin
-        xo[i] = xo[2 * i] + xo[2 * i + 1];
-        xi[i] = xi[2 * i] + xi[2 * i + 1];
-      end
-    vo4_q    <= xo[0];
-    vi4_q    <= xi[0];
-    vcut4_q  <= c3_q;
-    rm4_q    <= rm3_q;
-    rp4_q    <= rp3_q;
-    first4_q <= (s_q3 == '0);
-  end
+  cfar_vsum #(.ROWS(ROWS), .NE(NE), .PR(PR), .GUARD_R(GUARD_R), .POW_W(POW_W),
+              .SUM_W(SUM_W)) u_vsum (
+    .clk(clk), .slot1(st_slot1_q), .rowv1(rowv1_q), .cw2(cw2_q), .mo2(mo2_q), .mi2(mi2_q),
+    .vo4(vo4_q), .vi4(vi4_q), .vcut4(vcut4_q), .rm4(rm4_q), .rp4(rp4_q)
+  );
+  always_ff @(posedge clk) first4_q <= (s_q3 == '0);
 
   // ---------------------------------------------------------------------------------------
-  // Shift register of the previous 2*PD columns' sums (index 0 = newest), of the previous
-  // PD+1 columns' CUT-row cells (the CUT at PD-1, its Doppler neighbours at PD and PD-2)
-  // and of the previous PD columns' cells in rows q-1 and q+1 (the CUT's column at PD-1)
+  // Shift register of the previous 2*PD columns' sums (index 0 = newest)
   logic             ev4;         // a tested row's column arrives
-  logic [SUM_W-1:0] sr_o [2*PD];
-  logic [SUM_W-1:0] sr_i [2*PD];
-  logic [POW_W-1:0] sr_c [PD+1];
-  logic [POW_W-1:0] sr_rm [PD];
-  logic [POW_W-1:0] sr_rp [PD];
+  logic [2*PD-1:0][SUM_W-1:0] sr_o, sr_i;
   assign ev4 = v_q[4] && test_q[4];
   always_ff @(posedge clk) begin
     if (ev4) begin
       sr_o[0]  <= vo4_q;
       sr_i[0]  <= vi4_q;
-      sr_c[0]  <= vcut4_q;
-      sr_rm[0] <= rm4_q;
-      sr_rp[0] <= rp4_q;
       for (int k = 1; k < 2 * PD; k++) begin
         sr_o[k] <= sr_o[k-1];
         sr_i[k] <= sr_i[k-1];
       end
-      for (int k = 1; k <= PD; k++) sr_c[k] <= sr_c[k-1];
-      for (int k = 1; k < PD; k++) begin
-        sr_rm[k] <= sr_rm[k-1];
-        sr_rp[k] <= sr_rp[k-1];
-      end
     end
   end
 
-  // Running window sums: wsum[w] = sum of sr_x[A..B] before the shift (x = o or i), kept
-  // by adding the entry that enters position A and subtracting the one leaving B at each
-  // shift; an entry counts only once it belongs to this pass (at column step s, position k
-  // holds the pass's column s-1-k), so the sum restarts at step 0. CA: w0 = sr_o[0..2PD-1],
-  // w1 = sr_i[guard columns]; GO/SO: w0/w1 = left half o/i, w2/w3 = right half o/i.
-  // (results assigned to the function name, no `return`: Yosys reads the file as written)
-  function automatic int win_a(input int w);
-    if (KIND == 0) win_a = (w == 0) ? 0 : PD - 1 - GUARD_D;
-    else           win_a = (w < 2) ? PD : ((w == 2) ? 0 : PD - 1 - GUARD_D);
-  endfunction
-  function automatic int win_b(input int w);
-    if (KIND == 0) win_b = (w == 0) ? 2 * PD - 1 : PD - 1 + GUARD_D;
-    else           win_b = (w == 0) ? 2 * PD - 1 : ((w == 1) ? PD - 1 + GUARD_D : PD - 2);
-  endfunction
-  localparam int NW = (KIND == 0) ? 2 : 4;
-  logic [SUM_W-1:0] wsum [4];
-  for (genvar w = 0; w < 4; w++) begin : g_win
-    localparam int A = win_a(w);
-    localparam int B = win_b(w);
-    localparam bit IS_O = (w % 2 == 0);
-    if (w >= NW || B < A) begin : g_empty
-      assign wsum[w] = '0;
-    end else begin : g_run
-      logic [SUM_W-1:0] w_q, enter, leave;
-      logic             en_q, lv_q;
-      if (A == 0) begin : g_arriving
-        assign enter = IS_O ? vo4_q : vi4_q;
-        assign en_q  = 1'b1;
-      end else begin : g_shifted
-        assign enter = IS_O ? sr_o[A-1] : sr_i[A-1];
-        always_ff @(posedge clk) en_q <= (s_q3 >= S_W'(A));
-      end
-      assign leave   = IS_O ? sr_o[B] : sr_i[B];
-      assign wsum[w] = first4_q ? '0 : w_q;
-      always_ff @(posedge clk) begin
-        lv_q <= (s_q3 >= S_W'(B + 1));
-        if (ev4) w_q <= wsum[w] + (en_q ? enter : '0) - (lv_q ? leave : '0);
-      end
-    end
-  end
-
-  logic [POW_W-1:0] nb_dp4;
-  if (PD > 1) begin : g_dp_sr
-    assign nb_dp4 = sr_c[PD-2];
-  end else begin : g_dp_arriving
-    assign nb_dp4 = vcut4_q;
-  end
-
-  // Stage 5: window sums; the cell, its neighbours (Doppler +1 is the arriving column when
-  // PD = 1) and its sideband for the early FIFO
-  logic [SUM_W-1:0] sa5_q, sb5_q;
+  // Stages 4..6: the cell, its neighbours, the local-maximum test (cfar_peak.sv)
   logic [POW_W-1:0] cut5_q, nb_rm5_q, nb_rp5_q, nb_dm5_q, nb_dp5_q;
-  logic             last5_q, ok5_q;
+  logic             peak6;
+  cfar_peak #(.PD(PD), .POW_W(POW_W)) u_peak (
+    .clk(clk), .ev4(ev4), .vcut4(vcut4_q), .rm4(rm4_q), .rp4(rp4_q), .rm_ok4(rm_ok_q[4]),
+    .rp_ok4(rp_ok_q[4]), .cut5(cut5_q), .nb_rm5(nb_rm5_q), .nb_rp5(nb_rp5_q),
+    .nb_dm5(nb_dm5_q), .nb_dp5(nb_dp5_q), .peak6(peak6)
+  );
+
+  logic last5_q, ok5_q;
+  logic peak_q [10:7];
+  logic ok_q [10:6];
   always_ff @(posedge clk) begin
-    if (KIND == 0) begin
-      sa5_q <= wsum[0] + vo4_q - wsum[1];
-      sb5_q <= '0;
-    end else begin
-      sa5_q <= wsum[0] - wsum[1];
-      sb5_q <= wsum[2] + vo4_q - wsum[3];
-    end
-    cut5_q   <= sr_c[PD-1];
-    nb_rm5_q <= rm_ok_q[4] ? sr_rm[PD-1] : '0;
-    nb_rp5_q <= rp_ok_q[4] ? sr_rp[PD-1] : '0;
-    nb_dm5_q <= sr_c[PD];
-    nb_dp5_q <= nb_dp4;
-    last5_q  <= last_q[4];
-    ok5_q    <= cut_ok_q[4];
+    last5_q   <= last_q[4];
+    ok5_q     <= cut_ok_q[4];
+    ok_q[6]   <= ok5_q;
+    peak_q[7] <= peak6;
+    for (int k = 7; k <= 10; k++) ok_q[k] <= ok_q[k-1];
+    for (int k = 8; k <= 10; k++) peak_q[k] <= peak_q[k-1];
   end
 
-  // Stage 6: training sum S of the kind, the row's threshold scale (multiplier inputs)
-  logic [SUM_W-1:0]   sum_q [10:6];
-  logic [SCALE_W-1:0] scale6_q;
-  logic [POW_W-1:0]   cut_q [9:6];
-  logic               ok_q [9:6];
-  always_ff @(posedge clk) begin
-    unique case (KIND)
-      1:       sum_q[6] <= (sa5_q > sb5_q) ? sa5_q : sb5_q;
-      2:       sum_q[6] <= (sa5_q < sb5_q) ? sa5_q : sb5_q;
-      default: sum_q[6] <= sa5_q;
-    endcase
-    scale6_q <= cfg_scale[e_q[5] * SCALE_W +: SCALE_W];
-    cut_q[6] <= cut5_q;
-    ok_q[6]  <= ok5_q;
-    for (int k = 7; k <= 10; k++) sum_q[k] <= sum_q[k-1];
-    for (int k = 7; k <= 9; k++) begin
-      cut_q[k] <= cut_q[k-1];
-      ok_q[k]  <= ok_q[k-1];
-    end
+  // Stages 4..10: window sums, training sum of the kind, CUT * 2^SCALE_FRAC > S * scale
+  logic [SUM_W-1:0] sum10;
+  logic             over10;
+  cfar_sums #(.PD(PD), .GUARD_D(GUARD_D), .POW_W(POW_W), .SUM_W(SUM_W), .S_W(S_W),
+              .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC)) u_sums (
+    .clk(clk), .ev4(ev4), .first4(first4_q), .s3(s_q3), .vo4(vo4_q), .vi4(vi4_q),
+    .sr_o(sr_o), .sr_i(sr_i), .kind(kind_q), .cut5(cut5_q),
+    .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum10(sum10), .over10(over10)
+  );
+
+  // OS: stages 2..9 (the window's column words, comparators, popcount, count >= k)
+  logic os_q [10:10];
+  if (OS_BUILD) begin : g_os
+    logic os9;
+    cfar_os #(.ROWS(ROWS), .NE(NE), .PR(PR), .PD(PD), .GUARD_R(GUARD_R), .GUARD_D(GUARD_D),
+              .POW_W(POW_W), .CNT_W(CNT_W), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
+              .OS_RANK(OS_RANK)) u_os (
+      .clk(clk), .cw2(cw2_q), .mo2(mo2_q), .mi2(mi2_q), .e2(e_q[2]), .ev4(ev4),
+      .vcut4(vcut4_q), .cfg_scale(cfg_scale), .os9(os9)
+    );
+    always_ff @(posedge clk) os_q[10] <= os9;
+  end else begin : g_no_os
+    assign os_q[10] = 1'b0;
   end
 
-  // Stages 7-9: S * scale from CH-bit chunks, S = sum_i S_i 2^(CH i), scale likewise:
-  // products registered (7), then per scale chunk j the even-i and odd-i products, each a
-  // concatenation (a product is 2 CH bits wide), added (8), then the chunk sums (9)
-  localparam int CH = 17;
-  localparam int NA = (SUM_W + CH - 1) / CH;
-  localparam int NB = (SCALE_W + CH - 1) / CH;
-  logic [NA*CH-1:0]   a6;
-  logic [NB*CH-1:0]   b6;
-  logic [2*CH-1:0]    pp7_q [NA][NB];
-  logic [(NA+1)*CH:0] col8_q [NB];
-  logic [PROD_W-1:SCALE_FRAC] prod9_q;   // the product's bits that the decision uses
-  assign a6 = (NA * CH)'(sum_q[6]);
-  assign b6 = (NB * CH)'(scale6_q);
-  always_ff @(posedge clk) begin
-    logic [(NA+1)*CH-1:0] ev, od;
-    logic [PROD_W-1:0]    acc;
-    for (int i = 0; i < NA; i++)
-      for (int j = 0; j < NB; j++)
-        pp7_q[i][j] <= (2 * CH)'(a6[i * CH +: CH]) * (2 * CH)'(b6[j * CH +: CH]);
-    for (int j = 0; j < NB; j++) begin
-      ev = '0;
-      od = '0;
-      for (int i = 0; i < NA; i++)
-        if (i % 2 == 0) ev[i * CH +: 2 * CH] = pp7_q[i][j];
-        else            od[i * CH +: 2 * CH] = pp7_q[i][j];
-      col8_q[j] <= ((NA + 1) * CH + 1)'(ev) + ((NA + 1) * CH + 1)'(od);
-    end
-    acc = '0;
-    for (int j = 0; j < NB; j++) acc = acc + (PROD_W'(col8_q[j]) << (j * CH));
-    prod9_q <= acc[PROD_W-1:SCALE_FRAC];
-  end
-
-  // Stage 10: CUT * 2^SCALE_FRAC > P  <=>  CUT > floor(P / 2^SCALE_FRAC)
-  localparam int PH_W = PROD_W - SCALE_FRAC;
-  logic [PH_W-1:0] prod_hi;
-  logic            det10_q;
-  assign prod_hi = prod9_q;
-  always_ff @(posedge clk)
-    det10_q <= ok_q[9] && (prod_hi[PH_W-1:POW_W] == '0) && (cut_q[9] > prod_hi[POW_W-1:0]);
+  // Stage 10: the decision of the kind, and the local maximum when it is on
+  logic det10;
+  assign det10 = ok_q[10] && ((kind_q == 2'd3) ? os_q[10] : over10) && (!lm_q || peak_q[10]);
 
   // output cells (rows' cells from step 2*PD on) down the pipeline, for the detection count
   logic [10:5] o_q;
@@ -572,7 +422,7 @@ module cfar_2d #(
       st_wr1_q <= step && in_phase;
       st_wr2_q <= st_wr1_q;
       if (step && in_phase && (s_axis_tlast != (s_q == S_W'(N_DOPPLER - 1)))) framing_q <= 1'b1;
-      if (o_q[10] && det10_q && det_cnt_q != '1) det_cnt_q <= det_cnt_q + 1'b1;
+      if (o_q[10] && det10 && det_cnt_q != '1) det_cnt_q <= det_cnt_q + 1'b1;
       if (step) begin
         if (pass_end) begin
           s_q <= '0;
@@ -620,7 +470,7 @@ module cfar_2d #(
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (issue),
-    .in_data       ({det10_q, sum_q[10]}),
+    .in_data       ({det10, sum10}),
     .m_axis_tdata  (fl_data),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
@@ -636,9 +486,9 @@ module cfar_2d #(
   assign frame_count          = frame_cnt_q;
   assign detection_count      = det_cnt_q;
 
-  // input padding bits are not used
+  // input padding bits are not used (the slot masks only by the OS test)
   logic unused_ok;
-  assign unused_ok = ^{s_axis_tdata, e_can_issue, e_valid};
+  assign unused_ok = ^{s_axis_tdata, e_can_issue, e_valid, mo2_q, mi2_q};
 
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(IN_W + 1), .ASSUME(1'b1)) u_chk_s_axis (

@@ -27,8 +27,11 @@ module detect_chain #(
   parameter int GUARD_D = 2,
   parameter int TRAIN_R = 4,
   parameter int TRAIN_D = 8,
-  // CFAR kind: 0 CA, 1 GO, 2 SO (cfar_2d).
+  // Default CFAR kind: 0 CA, 1 GO, 2 SO, 3 OS (builds the OS test); OS_BUILD: build OS with
+  // another default kind; OS_RANK: OS rank per mille (cfar_2d).
   parameter int KIND = 0,
+  parameter bit OS_BUILD = (KIND == 3),
+  parameter int OS_RANK = 750,
   // Top range bins blanked (negative beat frequencies), see cfar_2d.
   parameter int BLANK_TOP = 0,
   // Range rows that may report detections, REPORT_LO <= r < REPORT_HI (cfar_2d).
@@ -50,6 +53,9 @@ module detect_chain #(
   // at most, 1..MAX_DETECTIONS. Change them only in the cycle after frame_start.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_scale,
   input  wire logic [15:0]              cfg_max_detections,
+  // CFAR kind 0 CA, 1 GO, 2 SO, 3 OS; the 3x3 local-maximum test on (quasi-static, cfar_2d)
+  input  wire logic [1:0]               cfg_kind,
+  input  wire logic                     cfg_local_max,
   output logic                          frame_start,   // the settings may change after it
   // Doppler-FFT output in (r, t, d) order, TLAST on Doppler bin N_DOPPLER-1 (checked)
   input  wire logic [NUM_RX*32-1:0]     s_axis_tdata,
@@ -112,8 +118,11 @@ module detect_chain #(
 
   cfar_2d #(.N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .POW_W(POW_W), .GUARD_R(GUARD_R),
             .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D), .KIND(KIND),
-            .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC)) u_cfar (
-    .clk(clk), .rst(rst), .cfg_scale(cfg_scale),
+            .OS_BUILD(OS_BUILD), .OS_RANK(OS_RANK), .BLANK_TOP(BLANK_TOP),
+            .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI), .SCALE_W(SCALE_W),
+            .SCALE_FRAC(SCALE_FRAC)) u_cfar (
+    .clk(clk), .rst(rst), .cfg_scale(cfg_scale), .cfg_kind(cfg_kind),
+    .cfg_local_max(cfg_local_max),
     .s_axis_tdata(nci_tdata), .s_axis_tvalid(nci_tvalid), .s_axis_tready(nci_tready),
     .s_axis_tlast(nci_tlast),
     .m_axis_tdata(cf_tdata), .m_axis_tvalid(cf_tvalid), .m_axis_tready(cf_tready),

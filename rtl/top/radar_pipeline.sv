@@ -100,7 +100,7 @@ module radar_pipeline #(
   // SETTINGS.clutter_removal, on after reset); 0: none, the setting has no effect.
   parameter bit STATIC_REMOVAL = 1'b0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
-  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO), top range bins blanked,
+  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO, 3 OS), top range bins blanked,
   // threshold-scale fixed point, records per frame at most.
   parameter int GUARD_R = 2,
   parameter int GUARD_D = 2,
@@ -273,8 +273,8 @@ module radar_pipeline #(
   begin : g_bad_max_detections
     $fatal(1, "%m: MAX_DETECTIONS=%0d not in 1..65535", MAX_DETECTIONS);
   end
-  if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 2)) begin : g_bad_cfar_kind
-    $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO) or 2 (SO)", CFAR_KIND);
+  if (OUTPUT_MODE == 1 && (CFAR_KIND < 0 || CFAR_KIND > 3)) begin : g_bad_cfar_kind
+    $fatal(1, "%m: CFAR_KIND=%0d not 0 (CA), 1 (GO), 2 (SO) or 3 (OS)", CFAR_KIND);
   end
   if (OUTPUT_MODE == 1 && SCALE_W > 32) begin : g_bad_scale_w
     $fatal(1, "%m: SCALE_W=%0d above 32, the width of a CFAR_SCALE register", SCALE_W);
@@ -503,6 +503,7 @@ module radar_pipeline #(
       .MAX_DETECTIONS(MAX_DETECTIONS)
     ) u_detect (
       .clk, .rst, .cfg_scale(cfg_cfar_scale), .cfg_max_detections,
+      .cfg_kind(2'(CFAR_KIND)), .cfg_local_max(1'b0),
       .frame_start(det_frame_start),
       .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
       .s_axis_tlast(df_tlast),

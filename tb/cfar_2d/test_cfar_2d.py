@@ -1,4 +1,6 @@
-"""cocotb testbench of ``rtl/detect/cfar_2d.sv`` against ``model/cfar_2d.py``."""
+"""cocotb testbench of ``rtl/detect/cfar_2d.sv`` against ``model/cfar_2d.py``: every output
+cell (power, training sum and count, decision, neighbour powers) of every kind built, chosen
+at run time, with the local-maximum test off and on."""
 
 from __future__ import annotations
 
@@ -30,11 +32,20 @@ class TB(AxisTB):
             n_range=param("N_RANGE"), n_doppler=param("N_DOPPLER"), pow_w=param("POW_W"),
             guard=(param("GUARD_R"), param("GUARD_D")), train=(param("TRAIN_R"), param("TRAIN_D")),
             kind=KIND_NAMES[param("KIND")], blank_top=param("BLANK_TOP"),
-            report=(param("REPORT_LO", 0), param("REPORT_HI", param("N_RANGE"))))
-        self.scale = cm.scale_table(self.cfg, PFA, N_CHANNELS)
-        dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg)
+            report=(param("REPORT_LO", 0), param("REPORT_HI", param("N_RANGE"))),
+            os=bool(param("OS_BUILD", 0)))
+        self.set_kind(self.cfg.kind, False)
         self.in_bytes = (self.cfg.pow_w + 7) // 8
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+
+    def set_kind(self, kind: str, local_max: bool) -> None:
+        """Drive cfg_kind (its code, built or not) and cfg_local_max, and cfg_scale with the
+        Pfa-derived table of the kind the RTL then runs."""
+        self.kind, self.local_max = kind, local_max
+        self.scale = cm.scale_table(self.cfg, PFA, N_CHANNELS, kind=kind)
+        self.dut.cfg_kind.value = KIND_NAMES.index(kind)
+        self.dut.cfg_local_max.value = int(local_max)
+        self.dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg)
 
     def random_map(self) -> np.ndarray:
         """Gamma(4) noise (mean 4000) with a few strong cells, one at full scale."""
@@ -45,6 +56,25 @@ class TB(AxisTB):
         p.flat[idx] *= self.rng.uniform(5, 500, n_t)
         p = np.minimum(p.astype(np.int64), (1 << c.pow_w) - 1)
         p.flat[idx[0]] = (1 << c.pow_w) - 1
+        return p
+
+    def tie_map(self) -> np.ndarray:
+        """Background B with, every fourth row r, the cells (r, d), (r, d+1), (r+1, d-1),
+        (r+1, d) and (r+1, d+2) at C(r), the smallest CUT whose OS threshold
+        floor((C * inv - 1) / 2^frac) is exactly B (inv the row's OS scale, or the kind's scale
+        when OS is not built): every background training cell sits on the OS comparison's
+        boundary, and the equal cells are ties for the local maximum along both axes and
+        both diagonals."""
+        c = self.cfg
+        inv = cm.scale_table(c, PFA, N_CHANNELS, kind="os") if c.os_built else self.scale
+        b, nd = 5000, c.n_doppler
+        p = np.full((c.n_range, nd), b, dtype=np.int64)
+        for r in range(0, c.n_range - 1, 4):
+            s = int(inv[cm.edge_index(r, c)])
+            d = int(self.rng.integers(0, nd))
+            cut = ((b << c.scale_frac) + s) // s
+            for dr, dd in ((0, 0), (0, 1), (1, -1), (1, 0), (1, 2)):
+                p[r + dr, (d + dd) % nd] = cut
         return p
 
     async def send_map(self, power: np.ndarray) -> None:
@@ -85,7 +115,7 @@ class TB(AxisTB):
         n_det = 0
         order = cm.output_order(self.cfg)
         for k, (cells, power) in enumerate(zip(got, sent, strict=True)):
-            exp = cm.cfar_2d(power, self.cfg, self.scale)
+            exp = cm.cfar_2d(power, self.cfg, self.scale, self.kind, self.local_max)
             for i, (r, d, pw, s, cnt, det, nb) in enumerate(cells):
                 er, ed = order[i]
                 want = (int(er), int(ed), int(exp.power[er, ed]), int(exp.train_sum[er, ed]),
@@ -159,6 +189,28 @@ async def test_programmed_scale_table(dut):
 
 
 @cocotb.test()
+async def test_run_time_kind_and_local_max(dut):
+    """Every cfg_kind code (a kind not built runs KIND) with the local maximum off and on,
+    changed between frames while idle, under random stalls (a random map and a map of ties,
+    :meth:`TB.tie_map`, each); the detection count adds up."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.set_idle_generator(random_pause(0.2, 5))
+    tb.set_backpressure_generator(random_pause(0.3, 6))
+    total = 0
+    for kind in KIND_NAMES:
+        for lm in (False, True):
+            tb.set_kind(kind, lm)
+            await tb.cycles(4)
+            n_det = await tb.run_maps([tb.random_map(), tb.tie_map()])
+            total += n_det
+            assert n_det > 0 or tb.cfg.n_range * tb.cfg.n_doppler < 64, (kind, lm)
+            await tb.cycles(4)
+    assert int(dut.detection_count.value) == total
+    assert int(dut.frame_count.value) == 4 * len(KIND_NAMES)
+
+
+@cocotb.test()
 async def test_framing_error(dut):
     """A misplaced TLAST is flagged (sticky); cells are still placed by count."""
     tb = TB(dut)
@@ -192,6 +244,7 @@ async def test_reset_recovery(dut):
     assert int(dut.m_axis_tvalid.value) == 0
     tb.set_idle_generator(random_pause(0.2, 9))
     tb.set_backpressure_generator(no_pause())
+    tb.set_kind(KIND_NAMES[-1], True)     # OS if built, else the default kind
     maps = [tb.random_map() for _ in range(2)]
     rx = cocotb.start_soon(tb.recv_maps(2))
     for m in maps:
@@ -210,6 +263,9 @@ PARAMS = [
     # default regression: seconds to build and run)
     dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
          BLANK_TOP=1),
+    # OS built (KIND 3), no Doppler guard, rows cut at both ends and blanked at the top
+    dict(N_RANGE=16, N_DOPPLER=16, POW_W=34, GUARD_R=1, GUARD_D=0, TRAIN_R=2, TRAIN_D=2, KIND=3,
+         BLANK_TOP=2, REPORT_LO=1, REPORT_HI=13),
 ]
 LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
     # SO, Doppler window nearly the whole row (wrap on both sides)
@@ -218,6 +274,9 @@ LONG_PARAMS = [  # make test-detect-long (DETECT_LONG=1)
     # paper-fpga: 64 x 256 map of 1 TX x 4 RX (34-bit power), the host's default window
     dict(N_RANGE=64, N_DOPPLER=256, POW_W=34, GUARD_R=2, GUARD_D=2, TRAIN_R=4, TRAIN_D=8,
          KIND=0, BLANK_TOP=0),
+    # the same with OS built beside the default CA
+    dict(N_RANGE=64, N_DOPPLER=256, POW_W=34, GUARD_R=2, GUARD_D=2, TRAIN_R=4, TRAIN_D=8,
+         KIND=0, BLANK_TOP=0, OS_BUILD=1),
 ]
 if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     PARAMS += LONG_PARAMS
@@ -227,5 +286,5 @@ if os.environ.get("DETECT_LONG", "0") not in ("", "0"):
     f"{k}{v}" for k, v in p.items()))
 def test_cfar_2d(parameters: dict) -> None:
     here = Path(__file__).resolve().parent
-    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/cfar_2d.sv")]
+    sources = [*rtl_sources("common/*.sv", "buffers/buf_*.sv"), *rtl_sources("detect/cfar_*.sv")]
     run_cocotb("cfar_2d", sources, "test_cfar_2d", here, parameters=parameters)

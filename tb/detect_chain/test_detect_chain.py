@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import cocotb
@@ -32,10 +33,17 @@ class TB(AxisTB):
             train=(param("TRAIN_R"), param("TRAIN_D")), kind=cm.KINDS[param("KIND")],
             blank_top=param("BLANK_TOP"), max_detections=param("MAX_DETECTIONS"),
             pfa=float(os.environ["DETECT_PFA"]))
-        self.scale = self.cfg.scale()
-        dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg.cfar)
+        self.set_local_max(False)
         dut.cfg_max_detections.value = self.cfg.max_detections
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+
+    def set_local_max(self, on: bool) -> None:
+        """cfg_kind = the default kind (KIND), cfg_local_max = ``on``, the scale table."""
+        self.cfg = replace(self.cfg, local_max=on)
+        self.scale = self.cfg.scale()
+        self.dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg.cfar)
+        self.dut.cfg_kind.value = param("KIND")
+        self.dut.cfg_local_max.value = int(on)
 
     def random_frame(self, n_targets: int) -> np.ndarray:
         """Doppler-FFT words (r, t, d) of Gaussian noise plus ``n_targets`` strong cells
@@ -126,6 +134,18 @@ async def test_random_stalls(dut):
     tb.set_idle_generator(random_pause(0.3, 1))
     tb.set_backpressure_generator(bursty_pause(2, max_run=4 * nd, busy_fraction=0.5))
     frames = [tb.random_frame(k) for k in (1, 5, 2)]
+    got = await run_frames(tb, frames)
+    tb.check(got, frames)
+
+
+@cocotb.test()
+async def test_local_max(dut):
+    """The 3x3 local-maximum test on: only the peaks become records."""
+    tb = TB(dut)
+    tb.set_local_max(True)
+    await tb.reset()
+    tb.set_backpressure_generator(random_pause(0.3, 4))
+    frames = [tb.random_frame(6), tb.random_frame(2)]
     got = await run_frames(tb, frames)
     tb.check(got, frames)
 
