@@ -66,8 +66,11 @@ module fft_axis #(
   // The whole pipeline moves on `adv`: a real input sample, or a bubble when the input is
   // idle at a frame boundary while valid samples are still inside (self-draining). Bubbles
   // carry a phantom index counting from 0 so every stage keeps its frame alignment.
+  // bub_q = (in_cnt_q == 0 && inflight_q != 0), kept a cycle ahead so adv is a few gates
+  // after registers (with fft_reorder's registered wr_ok).
   logic [LOG2N-1:0] in_cnt_q, ph_cnt_q;
   logic [CNT_W-1:0] inflight_q;
+  logic             bub_q, bub_fire, bub_step;
   logic can_adv, in_fire, bubble, adv;
 
   // last pipeline register (output conversion) and the reorder buffer write side
@@ -79,15 +82,21 @@ module fft_axis #(
   assign can_adv       = !cv_vld_q || wr_ok;
   assign s_axis_tready = can_adv;
   assign in_fire       = s_axis_tvalid && can_adv;
-  assign bubble        = !s_axis_tvalid && can_adv && in_cnt_q == '0 && inflight_q != '0;
+  assign bubble        = !s_axis_tvalid && can_adv && bub_q;
   assign adv           = in_fire || bubble;
+  // bub_q's next value after an input beat / a bubble (a sample leaves when cv_vld_q)
+  assign bub_fire = in_cnt_q == LOG2N'(N - 1) && (!cv_vld_q || inflight_q != '0);
+  assign bub_step = in_cnt_q == '0 && (cv_vld_q ? inflight_q != CNT_W'(1) : inflight_q != '0);
 
   always_ff @(posedge clk) begin
     if (rst) begin
       in_cnt_q   <= '0;
       ph_cnt_q   <= '0;
       inflight_q <= '0;
+      bub_q      <= 1'b0;
     end else begin
+      if (in_fire)     bub_q <= bub_fire;
+      else if (bubble) bub_q <= bub_step;
       if (in_fire) begin
         in_cnt_q <= in_cnt_q + 1'b1;
         ph_cnt_q <= '0;
@@ -182,7 +191,8 @@ module fft_axis #(
 
   fft_reorder #(.N(N), .WIDTH(ODW + 1)) u_reorder (
     .clk, .rst,
-    .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
+    .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_step(adv), .wr_pos_nxt(st_pos[LOG2N]),
+    .wr_data(cv_data_q), .wr_ok,
     .m_axis_tdata(m_word), .m_axis_tvalid(m_axis_tvalid), .m_axis_tready(m_axis_tready),
     .m_axis_tlast(m_axis_tlast), .m_axis_tuser(m_axis_tuser)
   );
@@ -206,6 +216,13 @@ module fft_axis #(
   assign event_overflow         = ev_ov_q;
 
   // ---------------------------------------------------------------- protocol checks
+`ifdef FORMAL
+  // the look-ahead bubble flag (formal/fft_axis.sby)
+  logic f_past = 1'b0;
+  always_ff @(posedge clk) f_past <= 1'b1;
+  always_comb if (f_past && !rst) assert (bub_q == (in_cnt_q == '0 && inflight_q != '0));
+`endif
+
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(ODW + 1), .ASSUME(1'b1)) u_chk_s_axis (
     .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),
