@@ -119,7 +119,9 @@ module fft_axis #(
     .WINDOW(WINDOW)
   ) u_window (
     .clk, .rst, .en(adv),
-    .in_data(s_axis_tdata), .in_vld(in_fire), .in_pos(in_fire ? in_cnt_q : ph_cnt_q),
+    // (the window uses in_pos only when en = adv, where in_fire = s_axis_tvalid: the Hann ROM
+    // address does not wait for adv)
+    .in_data(s_axis_tdata), .in_vld(in_fire), .in_pos(s_axis_tvalid ? in_cnt_q : ph_cnt_q),
     .out_data(st_data[0]), .out_vld(st_vld[0]), .out_pos(st_pos[0])
   );
   assign st_ov[0] = 1'b0;
