@@ -83,8 +83,11 @@ module fft_axis #(
   // idle at a frame boundary while valid samples are still inside (self-draining). Bubbles
   // carry a phantom index counting from 0 so every stage keeps its frame alignment.
   // Samples N_IN..N-1 of a vector are zeros (`fill`), one per advance, the input held off.
+  // bub_q = (in_cnt_q == 0 && inflight_q != 0), kept a cycle ahead so adv is a few gates
+  // after registers (with fft_reorder's registered wr_ok).
   logic [LOG2N-1:0] in_cnt_q, ph_cnt_q;
   logic [CNT_W-1:0] inflight_q;
+  logic             bub_q, bub_fire, bub_step;
   logic can_adv, in_fire, fill_q, zero_fire, take, bubble, adv;
 
   // last pipeline register (output conversion) and the reorder buffer write side
@@ -98,8 +101,11 @@ module fft_axis #(
   assign in_fire       = s_axis_tvalid && s_axis_tready;
   assign zero_fire     = fill_q && can_adv;
   assign take          = in_fire || zero_fire;          // a sample of a vector enters
-  assign bubble        = !s_axis_tvalid && can_adv && in_cnt_q == '0 && inflight_q != '0;
+  assign bubble        = !s_axis_tvalid && can_adv && bub_q;
   assign adv           = take || bubble;
+  // bub_q's next value after a sample enters / a bubble (a sample leaves when cv_vld_q)
+  assign bub_fire = in_cnt_q == LOG2N'(N - 1) && (!cv_vld_q || inflight_q != '0);
+  assign bub_step = in_cnt_q == '0 && (cv_vld_q ? inflight_q != CNT_W'(1) : inflight_q != '0);
 
   always_ff @(posedge clk) begin
     if (rst) begin
@@ -107,7 +113,10 @@ module fft_axis #(
       ph_cnt_q   <= '0;
       inflight_q <= '0;
       fill_q     <= 1'b0;
+      bub_q      <= 1'b0;
     end else begin
+      if (take)        bub_q <= bub_fire;
+      else if (bubble) bub_q <= bub_step;
       if (take) begin
         in_cnt_q <= in_cnt_q + 1'b1;
         ph_cnt_q <= '0;
@@ -134,7 +143,10 @@ module fft_axis #(
     .WINDOW(WINDOW), .N_IN(N_IN)
   ) u_window (
     .clk, .rst, .en(adv),
-    .in_data(fill_q ? '0 : s_axis_tdata), .in_vld(take), .in_pos(take ? in_cnt_q : ph_cnt_q),
+    // (the window uses in_pos only when en = adv: a sample enters exactly when the input is
+    // valid or a fill zero is due, so the Hann ROM address does not wait for adv)
+    .in_data(fill_q ? '0 : s_axis_tdata), .in_vld(take),
+    .in_pos((s_axis_tvalid || fill_q) ? in_cnt_q : ph_cnt_q),
     .out_data(st_data[0]), .out_vld(st_vld[0]), .out_pos(st_pos[0])
   );
   assign st_ov[0] = 1'b0;
@@ -206,7 +218,8 @@ module fft_axis #(
 
   fft_reorder #(.N(N), .WIDTH(ODW + 1), .N_OUT(N_OUT)) u_reorder (
     .clk, .rst,
-    .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_data(cv_data_q), .wr_ok,
+    .wr_en(adv && cv_vld_q), .wr_pos(cv_pos_q), .wr_step(adv), .wr_pos_nxt(st_pos[LOG2N]),
+    .wr_data(cv_data_q), .wr_ok,
     .m_axis_tdata(m_word), .m_axis_tvalid(m_axis_tvalid), .m_axis_tready(m_axis_tready),
     .m_axis_tlast(m_axis_tlast), .m_axis_tuser(m_axis_tuser)
   );
@@ -230,6 +243,13 @@ module fft_axis #(
   assign event_overflow         = ev_ov_q;
 
   // ---------------------------------------------------------------- protocol checks
+`ifdef FORMAL
+  // the look-ahead bubble flag (formal/fft_axis.sby)
+  logic f_past = 1'b0;
+  always_ff @(posedge clk) f_past <= 1'b1;
+  always_comb if (f_past && !rst) assert (bub_q == (in_cnt_q == '0 && inflight_q != '0));
+`endif
+
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(ODW + 1), .ASSUME(1'b1)) u_chk_s_axis (
     .clk, .rst, .tvalid(s_axis_tvalid), .tready(s_axis_tready),

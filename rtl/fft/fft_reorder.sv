@@ -2,7 +2,9 @@
 // Bit-reverse to natural order buffer of the streaming FFT: two banks of N words written at
 // the bit-reversed sample index and read in natural order onto an AXI4-Stream style output
 // register. A bank slot may be rewritten as soon as it has been read, so continuous frames
-// pass without a gap.
+// pass without a gap. wr_ok comes from registers only: the slot compare of the write position
+// it concerns (`wr_addr < rd_ptr_q`) is computed a cycle ahead from wr_step / wr_pos_nxt, so
+// the caller's advance enable does not wait for a comparator.
 `default_nettype none
 
 module fft_reorder #(
@@ -16,9 +18,13 @@ module fft_reorder #(
 ) (
   input  logic clk,
   input  logic rst,
-  // Write side: wr_en only when wr_ok; wr_pos is the pipeline (bit-reversed) index.
+  // Write side: wr_en only when wr_ok; wr_pos is the pipeline (bit-reversed) index, a
+  // register of the caller that takes wr_pos_nxt on the cycles wr_step is set and holds
+  // otherwise (any value out of reset).
   input  logic                    wr_en,
   input  logic [$clog2(N)-1:0]    wr_pos,
+  input  logic                    wr_step,
+  input  logic [$clog2(N)-1:0]    wr_pos_nxt,
   input  logic [WIDTH-1:0]        wr_data,
   output logic                    wr_ok,
   // Read side (natural order, registered outputs).
@@ -41,22 +47,37 @@ module fft_reorder #(
   logic [1:0]       full_q, full_d;      // bank holds a complete frame not yet fully read
   logic             wb_q, rb_q;          // bank being written / read
   logic [LOG2N-1:0] rd_ptr_q;            // next natural-order address to read
-  logic [LOG2N-1:0] wr_addr;
+  logic [LOG2N-1:0] wr_addr, nxt_addr;
   logic             pop, rd_last, wr_last;
+  logic             lt_q, lt_d;              // wr_addr < rd_ptr_q, from registers
   logic [WIDTH-1:0] m_data_q;
   logic [LOG2N-1:0] m_user_q;
   logic             m_last_q, m_valid_q;
 
   always_comb begin
-    wr_addr = '0;
-    for (int b = 0; b < LOG2N; b++) wr_addr[b] = wr_pos[LOG2N-1-b];
+    wr_addr  = '0;
+    nxt_addr = '0;
+    for (int b = 0; b < LOG2N; b++) begin
+      wr_addr[b]  = wr_pos[LOG2N-1-b];
+      nxt_addr[b] = wr_pos_nxt[LOG2N-1-b];
+    end
   end
 
   // Free bank, or the slot of the bank under read has already been read.
-  assign wr_ok   = !full_q[wb_q] || (rb_q == wb_q && wr_addr < rd_ptr_q);
+  assign wr_ok   = !full_q[wb_q] || (rb_q == wb_q && lt_q);
   assign pop     = full_q[rb_q] && (!m_valid_q || m_axis_tready);
   assign rd_last = rd_ptr_q == LOG2N'(N_OUT - 1);
   assign wr_last = wr_pos == LOG2N'(N - 1);
+
+  // Next cycle's wr_addr < rd_ptr_q: the four compares (write position held or stepped x
+  // read pointer held or advanced) from registers, then selected by wr_step and pop. An
+  // advanced pointer is rd_ptr_q + 1 (a < p + 1 is a <= p), or 0 after the bank's last word.
+  always_comb begin
+    logic lt_hold, lt_step;
+    lt_hold = pop ? (!rd_last && wr_addr <= rd_ptr_q) : wr_addr < rd_ptr_q;
+    lt_step = pop ? (!rd_last && nxt_addr <= rd_ptr_q) : nxt_addr < rd_ptr_q;
+    lt_d    = wr_step ? lt_step : lt_hold;
+  end
 
   always_comb begin
     full_d = full_q;
@@ -79,9 +100,11 @@ module fft_reorder #(
       wb_q     <= 1'b0;
       rb_q     <= 1'b0;
       rd_ptr_q <= '0;
+      lt_q     <= 1'b0;                    // nothing is below rd_ptr_q = 0
       m_valid_q <= 1'b0;
     end else begin
       full_q <= full_d;
+      lt_q   <= lt_d;
       if (wr_en && wr_last) wb_q <= ~wb_q;
       if (pop) begin
         rd_ptr_q <= rd_last ? '0 : rd_ptr_q + 1'b1;
@@ -106,8 +129,11 @@ module fft_reorder #(
 `ifdef FORMAL
   // Formal properties (formal/fft_reorder.sby). Bank reuse: a slot is written only when it
   // holds no unread sample (f_pend: written, not yet read) and read only when it holds one;
-  // the reader takes the banks in the order they were filled; TLAST/TUSER positions.
+  // the reader takes the banks in the order they were filled; TLAST/TUSER positions; the
+  // look-ahead compare lt_q equals the compare of the current write position.
   logic         f_past = 1'b0;
+  logic         f_stepped = 1'b0;          // the previous cycle was out of reset
+  logic [LOG2N-1:0] f_pos_nxt = '0;       // wr_pos this cycle by the wr_step contract
   logic [2*N-1:0] f_pend = '0;
   logic [LOG2N-1:0] f_wpos = '0;   // write positions arrive in pipeline order 0..N-1
   logic             f_written, f_unread;
@@ -115,7 +141,9 @@ module fft_reorder #(
     for (int b = 0; b < LOG2N; b++) f_bitrev[b] = x[LOG2N-1-b];
   endfunction
   always_ff @(posedge clk) begin
-    f_past <= 1'b1;
+    f_past    <= 1'b1;
+    f_stepped <= !rst;
+    f_pos_nxt <= wr_step ? wr_pos_nxt : wr_pos;
     if (rst) begin
       f_pend <= '0;
       f_wpos <= '0;
@@ -132,6 +160,7 @@ module fft_reorder #(
   always_comb if (!rst) begin
     assume (!wr_en || wr_ok);
     assume (wr_pos == f_wpos);
+    if (f_stepped) assume (wr_pos == f_pos_nxt);
   end
 `endif
   always_comb begin
@@ -140,6 +169,7 @@ module fft_reorder #(
     if (f_past && !rst) begin
     if (wr_en) assert (!f_pend[{wb_q, wr_addr}] || (pop && {rb_q, rd_ptr_q} == {wb_q, wr_addr}));
     if (pop) assert (f_pend[{rb_q, rd_ptr_q}]);
+    assert (lt_q == (wr_addr < rd_ptr_q));
     // bank order invariants
     if (wb_q != rb_q) assert (!full_q[wb_q]);
     if (wb_q == rb_q) assert (full_q[0] == full_q[1]);
