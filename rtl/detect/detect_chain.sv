@@ -27,11 +27,14 @@ module detect_chain #(
   parameter int GUARD_D = 2,
   parameter int TRAIN_R = 4,
   parameter int TRAIN_D = 8,
-  // Default CFAR kind: 0 CA, 1 GO, 2 SO, 3 OS (builds the OS test); OS_BUILD: build OS with
-  // another default kind; OS_RANK: OS rank per mille (cfar_2d).
+  // Default CFAR kind: 0 CA, 1 GO, 2 SO, 3 OS (builds the OS test); RUN_KINDS: the kinds
+  // CA/GO/SO cfg_kind may select; OS_BUILD: build OS with another default kind; OS_RANK: OS
+  // rank per mille; LOCAL_MAX_BUILD: build the local-maximum test (cfar_2d).
   parameter int KIND = 0,
+  parameter logic [2:0] RUN_KINDS = 3'b111,
   parameter bit OS_BUILD = (KIND == 3),
   parameter int OS_RANK = 750,
+  parameter bit LOCAL_MAX_BUILD = 1'b1,
   // Top range bins blanked (negative beat frequencies), see cfar_2d.
   parameter int BLANK_TOP = 0,
   // Range rows that may report detections, REPORT_LO <= r < REPORT_HI (cfar_2d).
@@ -118,7 +121,8 @@ module detect_chain #(
 
   cfar_2d #(.N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .POW_W(POW_W), .GUARD_R(GUARD_R),
             .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D), .KIND(KIND),
-            .OS_BUILD(OS_BUILD), .OS_RANK(OS_RANK), .BLANK_TOP(BLANK_TOP),
+            .RUN_KINDS(RUN_KINDS), .OS_BUILD(OS_BUILD), .OS_RANK(OS_RANK),
+            .LOCAL_MAX_BUILD(LOCAL_MAX_BUILD), .BLANK_TOP(BLANK_TOP),
             .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI), .SCALE_W(SCALE_W),
             .SCALE_FRAC(SCALE_FRAC)) u_cfar (
     .clk(clk), .rst(rst), .cfg_scale(cfg_scale), .cfg_kind(cfg_kind),
