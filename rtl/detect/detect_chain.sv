@@ -3,11 +3,12 @@
 // records out. nci (|x|^2 over NUM_TX x NUM_RX) -> cfar_2d -> detect_records, whose
 // snapshot ring is written from the same input stream. The record stream has a fixed
 // FRAME_WORDS per frame, ready for axis_packetizer (header, sequence numbers, loss flags).
-// Run-time settings (cfg_scale, cfg_max_detections) change only in the cycle after a
-// frame_start pulse: the CFAR takes the first word of a frame's range row 1. By then the
-// CFAR has tested every row of the previous frame (it tests a frame's last rows before it
-// takes the next frame's input, and its pipeline reads the scale 6 clocks after a step,
-// fewer than the N_DOPPLER >= 8 words of row 0; the top has >= 16), and it tests no row of
+// Run-time settings (cfg_scale, cfg_kind, cfg_local_max, cfg_max_detections) change only in
+// the cycle after a frame_start pulse: the CFAR takes the first word of a frame's range
+// row 1. By then the CFAR has tested every row of the previous frame (it tests a frame's
+// last rows before it takes the next frame's input, and its pipeline reads the scale 6 and
+// the kind / local maximum at most 9 clocks after a step, fewer than the N_DOPPLER >= 8
+// steps of row 0 before the pulse; the top has >= 16), and it tests no row of
 // the new frame before it takes row GUARD_R+TRAIN_R+1; detect_records takes the record
 // limit with a frame's first cell, which comes after that pulse too.
 // Formats and the pass schedule: docs/detect.md; model: model/detect_chain.py.
@@ -56,7 +57,8 @@ module detect_chain #(
   // at most, 1..MAX_DETECTIONS. Change them only in the cycle after frame_start.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_scale,
   input  wire logic [15:0]              cfg_max_detections,
-  // CFAR kind 0 CA, 1 GO, 2 SO, 3 OS; the 3x3 local-maximum test on (quasi-static, cfar_2d)
+  // CFAR kind 0 CA, 1 GO, 2 SO, 3 OS; the 3x3 local-maximum test on (cfar_2d); change them
+  // only in the cycle after frame_start, as cfg_scale
   input  wire logic [1:0]               cfg_kind,
   input  wire logic                     cfg_local_max,
   output logic                          frame_start,   // the settings may change after it
