@@ -160,6 +160,8 @@ async def settings_written_mid_frame(dut) -> None:
     tb.set_idle_generator(random_pause(0.2, 21))
     tb.set_backpressure_generator(random_pause(0.2, 22))
     await tb.reset()
+    caps2 = regs.decode("CAPS2", await tb.read32(regs.address("CAPS2")))
+    assert caps2["cfar_kinds"] == 0b0111, caps2           # CA, GO, SO built, not OS
     dcfg = chain.detect_config(cfg)
     old_scale = dcfg.scale()
     new_scale = replace(dcfg, pfa=1e-2, run_kind="go").scale()
