@@ -89,7 +89,7 @@ def test_on_chip_local_max_same_points(kind: str):
     adc = simulate_scene(scene, frame_index=0).samples
     clouds, records = [], []
     for d in (dcfg, replace(dcfg, local_max=True)):
-        (frame,) = list(source.record_frames([adc], cfg, d))
+        (frame,) = list(source.dma_frames([adc], cfg, d))
         fc = frame_cloud(frame, cfg, params, 0, "detect")
         clouds.append(fc.cloud.records())
         records.append(len(fc.records.range_bin))
