@@ -7,7 +7,7 @@ docs/design.md 3.4). The record stream then goes through ``axis_packetizer``
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -108,18 +108,25 @@ def detections(words: np.ndarray, cfg: DetectConfig, scale: np.ndarray
 def detect_stream(frames: Iterable[np.ndarray], cfg: DetectConfig,
                   scale: np.ndarray | None = None, first_frame_id: int = 0,
                   scales: Sequence[np.ndarray] | None = None,
-                  limits: Sequence[int] | None = None) -> list[np.ndarray]:
+                  limits: Sequence[int] | None = None,
+                  kinds: Sequence[str] | None = None,
+                  local_max: Sequence[bool] | None = None) -> list[np.ndarray]:
     """Record streams of consecutive frames after reset: list of uint32
     ``(frame_words, num_rx)``, one per frame (frame ids from ``first_frame_id``, sticky
     truncation from the first frame on). Run-time settings per frame k, as the registers
     applied them at that frame's start (docs/regs.md): ``scales[k]`` (int64 ``(2PR+1,)``;
-    None: ``scale`` for every frame, by default ``cfg.scale()``) and ``limits[k]`` (records
-    at most, 1..cfg.max_detections; None: cfg.max_detections)."""
+    None: ``scale`` for every frame, by default ``cfg.scale()``), ``limits[k]`` (records
+    at most, 1..cfg.max_detections; None: cfg.max_detections), ``kinds[k]`` (the CFAR kind
+    run, ``cfg_kind``; None: ``cfg.run_kind``) and ``local_max[k]`` (``cfg_local_max``;
+    None: ``cfg.local_max``)."""
     sc = cfg.scale() if scale is None else scale
     out = []
     sticky = False
     for k, f in enumerate(frames):
-        recs, _ = detections(f, cfg, sc if scales is None else scales[k])
+        run = cfg if kinds is None and local_max is None else replace(
+            cfg, run_kind=cfg.run_kind if kinds is None else kinds[k],
+            local_max=cfg.local_max if local_max is None else bool(local_max[k]))
+        recs, _ = detections(f, run, sc if scales is None else scales[k])
         limit = cfg.max_detections if limits is None else limits[k]
         out.append(detect_records.encode_frame(recs, len(recs), cfg.num_tx, cfg.num_rx,
                                                cfg.max_detections, frame_id=first_frame_id + k,

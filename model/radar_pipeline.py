@@ -41,7 +41,6 @@ from model.axis_packetizer import (
     packetize,
     unpack_iq,
 )
-from model.cfar_2d import OS_RANK
 from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
@@ -149,7 +148,9 @@ class PipelineParams:
         """All HDL parameters of ``radar_pipeline`` for ``cfg`` with these chain settings
         (:func:`model.hdl.hdl_parameters` plus PACKET_WORDS, WINDOW, the scaling
         schedules and HEADER; FRAME_STORE, AXI_DATA_W and FS_TILE_R when ``frame_store``;
-        OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1;
+        OUTPUT_MODE and the detector's parameters when ``output_mode`` is 1: CFAR_KIND the
+        kind after reset, CFAR_OS_BUILD / CFAR_OS_RANK, CFAR_LOCAL_MAX the local-maximum
+        switch after reset;
         STATIC_REMOVAL when ``static_removal``)."""
         store = ({"FRAME_STORE": 1, "AXI_DATA_W": self.axi_data_w,
                   "FS_TILE_R": self.store_tile_r(cfg)} if self.frame_store else {})
@@ -157,11 +158,9 @@ class PipelineParams:
             store["STATIC_REMOVAL"] = 1
         if self.output_mode == 1:
             dc = self.detect_config(cfg)
-            if dc.os or dc.os_rank != OS_RANK or dc.run_kind not in (None, dc.kind) \
-                    or dc.local_max:
-                raise ValueError("detect: the top builds its detector from CFAR_KIND alone and "
-                                 "ties cfg_kind to it and the local-maximum test off (no "
-                                 "OS_BUILD, OS_RANK, run-time kind or local maximum)")
+            if dc.run_kind not in (None, dc.kind):
+                raise ValueError("detect: the top's CFAR kind after reset is CFAR_KIND (run "
+                                 "another kind through SETTINGS.cfar_kind, FrameSettings.kinds)")
             d = dc.hdl_parameters()
             store.update(OUTPUT_MODE=1, GUARD_R=d["GUARD_R"], GUARD_D=d["GUARD_D"],
                          TRAIN_R=d["TRAIN_R"], TRAIN_D=d["TRAIN_D"], CFAR_KIND=d["KIND"],
@@ -169,6 +168,9 @@ class PipelineParams:
                          SCALE_FRAC=d["SCALE_FRAC"], MAX_DETECTIONS=d["MAX_DETECTIONS"],
                          REPORT_LO=d.get("REPORT_LO", 0),
                          REPORT_HI=d.get("REPORT_HI", cfg.n_range_bins))
+            store.update({f"CFAR_{k}": d[k] for k in ("OS_BUILD", "OS_RANK") if k in d})
+            if dc.local_max:
+                store["CFAR_LOCAL_MAX"] = 1
         return hdl_parameters(cfg, PACKET_WORDS=self.packet_words, WINDOW=int(self.window),
                               RANGE_SCALE_SCH=self.range_schedule(cfg),
                               DOPPLER_SCALE_SCH=self.doppler_scale_sch, HEADER=int(self.header),
@@ -367,11 +369,15 @@ class FrameSettings:
 
     ``packet_words``: PACKET.words at the packetizer; ``max_detections``:
     SETTINGS.max_detections at the detector (mode 1); ``scales``: the CFAR_SCALE table at
-    the detector (mode 1), int ``(2PR+1,)`` each."""
+    the detector (mode 1), int ``(2PR+1,)`` each; ``kinds``: SETTINGS.cfar_kind at the
+    detector (mode 1), kind names of ``model.cfar_2d.KINDS``; ``local_max``:
+    SETTINGS.local_max at the detector (mode 1)."""
 
     packet_words: Sequence[int] | None = None
     max_detections: Sequence[int] | None = None
     scales: Sequence[np.ndarray] | None = None
+    kinds: Sequence[str] | None = None
+    local_max: Sequence[bool] | None = None
 
 
 @dataclass(frozen=True)
@@ -419,7 +425,8 @@ def dma_frames(adc_frames: list[np.ndarray], cfg: RadarConfig,
                 yield pack_iq(dop)
         payloads = detect_stream(words(), params.detect_config(cfg),
                                  first_frame_id=first_frame_id, scales=settings.scales,
-                                 limits=settings.max_detections)
+                                 limits=settings.max_detections, kinds=settings.kinds,
+                                 local_max=settings.local_max)
     else:
         payloads = []
         for adc, fp in zip(adc_frames, per_frame, strict=True):

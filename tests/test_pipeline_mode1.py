@@ -4,6 +4,8 @@ framing; mode 0 is unchanged."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -13,6 +15,7 @@ from model.config import RadarConfig, get_preset
 from model.detect_chain import DetectConfig, detect_stream
 from model.detect_records import decode_frame
 from model.radar_pipeline import (
+    FrameSettings,
     PipelineParams,
     chain_gain,
     dma_packets,
@@ -135,3 +138,29 @@ def test_report_rows_only_mask_the_decision() -> None:
     np.testing.assert_array_equal(b.detect[1:28], a.detect[1:28])
     np.testing.assert_array_equal(b.train_sum, a.train_sum)
     assert part.hdl_parameters()["REPORT_HI"] == 28 and "REPORT_LO" not in full.hdl_parameters()
+
+
+def test_run_time_kind_and_local_max_per_frame() -> None:
+    """FrameSettings.kinds / local_max: frame k's records are those of a detector run with
+    frame k's kind and local-maximum switch (the registers at that frame's start); the top's
+    parameters carry OS_BUILD, OS_RANK and the reset local maximum, not a run_kind."""
+    base = small4_detect(max_detections=32, pfa=1e-3)
+    params = PipelineParams(packet_words=64, output_mode=1, detect=base)
+    frames = small4_frames(3)
+    kinds, lm = ["ca", "go", "so"], [False, True, True]
+    runs = [replace(base, run_kind=k, local_max=m) for k, m in zip(kinds, lm, strict=True)]
+    scales = [r.scale() for r in runs]
+    got = dma_packets(frames, SMALL4, params,
+                      settings=FrameSettings(scales=scales, kinds=kinds, local_max=lm))
+    want = [p for k, r in enumerate(runs)
+            for p in dma_packets([frames[k]], SMALL4, replace(params, detect=r),
+                                 first_frame_id=k)]
+    assert len(got) == len(want)
+    assert all(np.array_equal(g, w) for g, w in zip(got, want, strict=True))
+    plain = dma_packets(frames, SMALL4, params, settings=FrameSettings(scales=scales))
+    assert not all(np.array_equal(g, p) for g, p in zip(got, plain, strict=True))
+    hp = replace(params, detect=replace(base, os=True, os_rank=600, local_max=True))
+    top = hp.hdl_parameters(SMALL4)
+    assert (top["CFAR_OS_BUILD"], top["CFAR_OS_RANK"], top["CFAR_LOCAL_MAX"]) == (1, 600, 1)
+    with pytest.raises(ValueError, match="SETTINGS.cfar_kind"):
+        replace(params, detect=replace(base, run_kind="go")).hdl_parameters(SMALL4)

@@ -45,6 +45,12 @@ module cfar_2d #(
   // training cells (rounded half to even, at least 1).
   parameter bit OS_BUILD = (KIND == 3),
   parameter int OS_RANK = 750,
+  // Kinds CA, GO, SO that cfg_kind may select (bit k: kind k; KIND is always built): 3'b111
+  // (default) all three; with KIND's bit alone and no OS_BUILD the one kind, the smaller
+  // build (CA alone: two running window sums instead of four, no kind multiplexers).
+  parameter logic [2:0] RUN_KINDS = 3'b111,
+  // Build the 3x3 local-maximum test (0: cfg_local_max is ignored, the test off).
+  parameter bit LOCAL_MAX_BUILD = 1'b1,
   // Top range bins blanked (the negative beat frequencies of a complex-IF range FFT):
   // rows N_RANGE-BLANK_TOP..N_RANGE-1 are not tested and not used as training cells,
   // 0..N_RANGE-2*(GUARD_R+TRAIN_R)-1.
@@ -100,6 +106,9 @@ module cfar_2d #(
   localparam int P_W   = $clog2(NPASS + 1);
   localparam int S_W   = $clog2(N_DOPPLER + 2 * PD + 1);
   localparam int N_EFF = N_RANGE - BLANK_TOP;        // rows that exist for the CFAR
+  // kinds built (bit k: kind k) and whether cfg_kind has a choice
+  localparam logic [3:0] BUILT = {OS_BUILD, RUN_KINDS} | (4'b0001 << KIND);
+  localparam bit ONE_KIND = (BUILT == (4'b0001 << KIND));
   localparam int CW_W  = ROWS * POW_W;               // column word
 
   // Parameter checks: stop elaboration on illegal values.
@@ -278,9 +287,15 @@ module cfar_2d #(
   logic [CNT_W-1:0]  cnt_q [5:2];
   logic [1:0]        kind_q;     // cfg_kind, a kind that is not built replaced by KIND
   logic              lm_q;
-  always_ff @(posedge clk) begin
-    kind_q <= (cfg_kind == 2'd3 && !OS_BUILD) ? 2'(KIND) : cfg_kind;
-    lm_q   <= cfg_local_max;
+  if (ONE_KIND) begin : g_one_kind
+    assign kind_q = 2'(KIND);
+  end else begin : g_run_kind
+    always_ff @(posedge clk) kind_q <= BUILT[cfg_kind] ? cfg_kind : 2'(KIND);
+  end
+  if (LOCAL_MAX_BUILD) begin : g_local_max
+    always_ff @(posedge clk) lm_q <= cfg_local_max;
+  end else begin : g_no_local_max
+    assign lm_q = 1'b0;
   end
 
   always_ff @(posedge clk) begin
@@ -374,7 +389,8 @@ module cfar_2d #(
   logic [SUM_W-1:0] sum10;
   logic             over10;
   cfar_sums #(.PD(PD), .GUARD_D(GUARD_D), .POW_W(POW_W), .SUM_W(SUM_W), .S_W(S_W),
-              .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC)) u_sums (
+              .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
+              .CA_ONLY(BUILT[2:1] == 2'b00)) u_sums (
     .clk(clk), .ev4(ev4), .first4(first4_q), .s3(s_q3), .vo4(vo4_q), .vi4(vi4_q),
     .sr_o(sr_o), .sr_i(sr_i), .kind(kind_q), .cut5(cut5_q),
     .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum10(sum10), .over10(over10)
@@ -486,9 +502,11 @@ module cfar_2d #(
   assign frame_count          = frame_cnt_q;
   assign detection_count      = det_cnt_q;
 
-  // input padding bits are not used (the slot masks only by the OS test)
+  // input padding bits are not used (the slot masks only by the OS test, the settings not
+  // in a build without their choice)
   logic unused_ok;
-  assign unused_ok = ^{s_axis_tdata, e_can_issue, e_valid, mo2_q, mi2_q};
+  assign unused_ok = ^{s_axis_tdata, e_can_issue, e_valid, mo2_q, mi2_q, cfg_kind,
+                       cfg_local_max};
 
   // AXI4-Stream protocol on every port (rtl/common/axis_checker.sv)
   axis_checker #(.PAYLOAD_W(IN_W + 1), .ASSUME(1'b1)) u_chk_s_axis (

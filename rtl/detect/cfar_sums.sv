@@ -13,7 +13,10 @@ module cfar_sums #(
   parameter int SUM_W = 43,
   parameter int S_W = 9,          // column step counter width
   parameter int SCALE_W = 32,
-  parameter int SCALE_FRAC = 20
+  parameter int SCALE_FRAC = 20,
+  // 1: only the CA sum is ever used (kind constant CA or OS): two running sums, as before
+  // the run-time kind; 0: the GO/SO halves too (four running sums)
+  parameter bit CA_ONLY = 1'b0
 ) (
   input  wire logic                          clk,
   // stage 4: a tested row's column arrives (the shift register shifts), column step 0 of
@@ -44,20 +47,24 @@ module cfar_sums #(
   // shift; an entry counts only once it belongs to this pass (at column step s, position k
   // holds the pass's column s-1-k), so the sum restarts at step 0. w0/w1: left half o/i
   // (positions PD..2PD-1), w2/w3: right half o/i (the arriving column and 0..PD-2); the
-  // CUT's column (position PD-1) is added for CA.
+  // CUT's column (position PD-1) is added for CA. CA_ONLY: w0 = o over positions 0..2PD-1,
+  // w1 = i over the guard columns.
   // (results assigned to the function name, no `return`: Yosys reads the file as written)
   function automatic int win_a(input int w);
-    win_a = (w < 2) ? PD : ((w == 2) ? 0 : PD - 1 - GUARD_D);
+    if (CA_ONLY) win_a = (w == 0) ? 0 : PD - 1 - GUARD_D;
+    else         win_a = (w < 2) ? PD : ((w == 2) ? 0 : PD - 1 - GUARD_D);
   endfunction
   function automatic int win_b(input int w);
-    win_b = (w == 0) ? 2 * PD - 1 : ((w == 1) ? PD - 1 + GUARD_D : PD - 2);
+    if (CA_ONLY) win_b = (w == 0) ? 2 * PD - 1 : PD - 1 + GUARD_D;
+    else         win_b = (w == 0) ? 2 * PD - 1 : ((w == 1) ? PD - 1 + GUARD_D : PD - 2);
   endfunction
+  localparam int NW = CA_ONLY ? 2 : 4;
   logic [SUM_W-1:0] wsum [4];
   for (genvar w = 0; w < 4; w++) begin : g_win
     localparam int A = win_a(w);
     localparam int B = win_b(w);
     localparam bit IS_O = (w % 2 == 0);
-    if (B < A) begin : g_empty
+    if (w >= NW || B < A) begin : g_empty
       assign wsum[w] = '0;
     end else begin : g_run
       logic [SUM_W-1:0] w_q, enter, leave;
@@ -78,12 +85,26 @@ module cfar_sums #(
     end
   end
 
-  // Stage 5: the two halves and the CUT's column
-  logic [SUM_W-1:0] sa5_q, sb5_q, sc5_q;
-  always_ff @(posedge clk) begin
-    sa5_q <= wsum[0] - wsum[1];
-    sb5_q <= wsum[2] + vo4 - wsum[3];
-    sc5_q <= sr_o[PD-1] - sr_i[PD-1];
+  // Stage 5: the two halves and the CUT's column (CA_ONLY: the CA sum)
+  logic [SUM_W-1:0] sa5_q, s5;   // s5: the training sum of the kind
+  if (CA_ONLY) begin : g_ca_sum
+    always_ff @(posedge clk) sa5_q <= wsum[0] + vo4 - wsum[1];
+    assign s5 = sa5_q;
+    logic unused_kind;            // the kind is CA or OS (the CA sum) by construction
+    assign unused_kind = ^kind;
+  end else begin : g_half_sums
+    logic [SUM_W-1:0] sb5_q, sc5_q;
+    always_ff @(posedge clk) begin
+      sa5_q <= wsum[0] - wsum[1];
+      sb5_q <= wsum[2] + vo4 - wsum[3];
+      sc5_q <= sr_o[PD-1] - sr_i[PD-1];
+    end
+    always_comb
+      unique case (kind)
+        2'd1:    s5 = (sa5_q > sb5_q) ? sa5_q : sb5_q;
+        2'd2:    s5 = (sa5_q < sb5_q) ? sa5_q : sb5_q;
+        default: s5 = sa5_q + sb5_q + sc5_q;
+      endcase
   end
 
   // Stage 6: training sum S of the kind, the row's threshold scale (multiplier inputs)
@@ -91,11 +112,7 @@ module cfar_sums #(
   logic [SCALE_W-1:0] scale6_q;
   logic [POW_W-1:0]   cut_q [9:6];
   always_ff @(posedge clk) begin
-    unique case (kind)
-      2'd1:    sum_q[6] <= (sa5_q > sb5_q) ? sa5_q : sb5_q;
-      2'd2:    sum_q[6] <= (sa5_q < sb5_q) ? sa5_q : sb5_q;
-      default: sum_q[6] <= sa5_q + sb5_q + sc5_q;
-    endcase
+    sum_q[6] <= s5;
     scale6_q <= scale5;
     cut_q[6] <= cut5;
     for (int k = 7; k <= 10; k++) sum_q[k] <= sum_q[k-1];

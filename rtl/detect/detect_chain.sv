@@ -3,11 +3,12 @@
 // records out. nci (|x|^2 over NUM_TX x NUM_RX) -> cfar_2d -> detect_records, whose
 // snapshot ring is written from the same input stream. The record stream has a fixed
 // FRAME_WORDS per frame, ready for axis_packetizer (header, sequence numbers, loss flags).
-// Run-time settings (cfg_scale, cfg_max_detections) change only in the cycle after a
-// frame_start pulse: the CFAR takes the first word of a frame's range row 1. By then the
-// CFAR has tested every row of the previous frame (it tests a frame's last rows before it
-// takes the next frame's input, and its pipeline reads the scale 6 clocks after a step,
-// fewer than the N_DOPPLER >= 8 words of row 0; the top has >= 16), and it tests no row of
+// Run-time settings (cfg_scale, cfg_kind, cfg_local_max, cfg_max_detections) change only in
+// the cycle after a frame_start pulse: the CFAR takes the first word of a frame's range
+// row 1. By then the CFAR has tested every row of the previous frame (it tests a frame's
+// last rows before it takes the next frame's input, and its pipeline reads the scale 6 and
+// the kind / local maximum at most 9 clocks after a step, fewer than the N_DOPPLER >= 8
+// steps of row 0 before the pulse; the top has >= 16), and it tests no row of
 // the new frame before it takes row GUARD_R+TRAIN_R+1; detect_records takes the record
 // limit with a frame's first cell, which comes after that pulse too.
 // Formats and the pass schedule: docs/detect.md; model: model/detect_chain.py.
@@ -27,11 +28,14 @@ module detect_chain #(
   parameter int GUARD_D = 2,
   parameter int TRAIN_R = 4,
   parameter int TRAIN_D = 8,
-  // Default CFAR kind: 0 CA, 1 GO, 2 SO, 3 OS (builds the OS test); OS_BUILD: build OS with
-  // another default kind; OS_RANK: OS rank per mille (cfar_2d).
+  // Default CFAR kind: 0 CA, 1 GO, 2 SO, 3 OS (builds the OS test); RUN_KINDS: the kinds
+  // CA/GO/SO cfg_kind may select; OS_BUILD: build OS with another default kind; OS_RANK: OS
+  // rank per mille; LOCAL_MAX_BUILD: build the local-maximum test (cfar_2d).
   parameter int KIND = 0,
+  parameter logic [2:0] RUN_KINDS = 3'b111,
   parameter bit OS_BUILD = (KIND == 3),
   parameter int OS_RANK = 750,
+  parameter bit LOCAL_MAX_BUILD = 1'b1,
   // Top range bins blanked (negative beat frequencies), see cfar_2d.
   parameter int BLANK_TOP = 0,
   // Range rows that may report detections, REPORT_LO <= r < REPORT_HI (cfar_2d).
@@ -53,7 +57,8 @@ module detect_chain #(
   // at most, 1..MAX_DETECTIONS. Change them only in the cycle after frame_start.
   input  wire logic [(2*(GUARD_R+TRAIN_R)+1)*SCALE_W-1:0] cfg_scale,
   input  wire logic [15:0]              cfg_max_detections,
-  // CFAR kind 0 CA, 1 GO, 2 SO, 3 OS; the 3x3 local-maximum test on (quasi-static, cfar_2d)
+  // CFAR kind 0 CA, 1 GO, 2 SO, 3 OS; the 3x3 local-maximum test on (cfar_2d); change them
+  // only in the cycle after frame_start, as cfg_scale
   input  wire logic [1:0]               cfg_kind,
   input  wire logic                     cfg_local_max,
   output logic                          frame_start,   // the settings may change after it
@@ -118,7 +123,8 @@ module detect_chain #(
 
   cfar_2d #(.N_RANGE(N_RANGE), .N_DOPPLER(N_DOPPLER), .POW_W(POW_W), .GUARD_R(GUARD_R),
             .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D), .KIND(KIND),
-            .OS_BUILD(OS_BUILD), .OS_RANK(OS_RANK), .BLANK_TOP(BLANK_TOP),
+            .RUN_KINDS(RUN_KINDS), .OS_BUILD(OS_BUILD), .OS_RANK(OS_RANK),
+            .LOCAL_MAX_BUILD(LOCAL_MAX_BUILD), .BLANK_TOP(BLANK_TOP),
             .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI), .SCALE_W(SCALE_W),
             .SCALE_FRAC(SCALE_FRAC)) u_cfar (
     .clk(clk), .rst(rst), .cfg_scale(cfg_scale), .cfg_kind(cfg_kind),

@@ -41,9 +41,9 @@
 // (the corner turn's output: the active switch follows the pending one in every cycle that
 // ends with that input between two frames and is frozen from the cycle of a frame's first
 // word to the cycle of its last word; static_removal samples it with a frame's first word);
-// the CFAR scales and the record limit at detect_chain's frame_start (the CFAR takes the
-// first word of a frame's range row 1); the packet length at the packetizer's input
-// boundary, as the removal's. The event counters and sticky flags count what the status
+// the CFAR kind, local-maximum switch, scales and record limit at detect_chain's frame_start
+// (the CFAR takes the first word of a frame's range row 1); the packet length at the
+// packetizer's input boundary, as the removal's. The event counters and sticky flags count what the status
 // ports below count (frames and packets out of the packetizer, dropped ADC chirps and DMA
 // words, framing errors, FFT saturation, memory errors); the status ports stay until rtlsim
 // reads the registers instead.
@@ -100,13 +100,22 @@ module radar_pipeline #(
   // SETTINGS.clutter_removal, on after reset); 0: none, the setting has no effect.
   parameter bit STATIC_REMOVAL = 1'b0,
   // Detector (OUTPUT_MODE = 1, detect_chain / cfar_2d): guard and training cells per side
-  // along range (R) and Doppler (D), CFAR kind (0 CA, 1 GO, 2 SO, 3 OS), top range bins blanked,
-  // threshold-scale fixed point, records per frame at most.
+  // along range (R) and Doppler (D), CFAR kind after reset (SETTINGS.cfar_kind: 0 CA, 1 GO,
+  // 2 SO, 3 OS), the kinds CA/GO/SO built for SETTINGS.cfar_kind (CFAR_RUN_KINDS, bit k:
+  // kind k; CFAR_KIND always), the OS test built (CFAR_OS_BUILD, rank CFAR_OS_RANK per
+  // mille), the local-maximum test built (CFAR_LOCAL_MAX_BUILD; without it
+  // SETTINGS.local_max has no effect) and on after reset (CFAR_LOCAL_MAX), top range bins
+  // blanked, threshold-scale fixed point, records per frame at most (docs/detect.md).
   parameter int GUARD_R = 2,
   parameter int GUARD_D = 2,
   parameter int TRAIN_R = 4,
   parameter int TRAIN_D = 8,
   parameter int CFAR_KIND = 0,
+  parameter logic [2:0] CFAR_RUN_KINDS = 3'b111,
+  parameter bit CFAR_OS_BUILD = (CFAR_KIND == 3),
+  parameter int CFAR_OS_RANK = 750,
+  parameter bit CFAR_LOCAL_MAX_BUILD = 1'b1,
+  parameter bit CFAR_LOCAL_MAX = 1'b0,
   parameter int BLANK_TOP = 0,
   // Range rows that may report detections, REPORT_LO <= r < REPORT_HI: the host's
   // RadarConfig.detection_bins (PipelineParams sets them; docs/detect.md, range edges).
@@ -492,18 +501,25 @@ module radar_pipeline #(
   logic [N_SCALES*CTRL_SCALE_W-1:0] cfg_cfar_scale;
   logic [15:0]       cfg_max_detections;
   logic              det_frame_start;
+  logic [1:0]        cfg_cfar_kind;         // CFAR kind and local-maximum test
+  logic              cfg_local_max;
+  // kinds built (CAPS2.cfar_kinds, cfar_2d's): none but the reset code 0 in mode 0
+  localparam logic [3:0] CFAR_KINDS =
+    (OUTPUT_MODE == 1) ? {CFAR_OS_BUILD, CFAR_RUN_KINDS} | (4'b0001 << CFAR_KIND) : 4'b0001;
 
   if (OUTPUT_MODE == 1) begin : g_detect
     logic        det_framing;
     detect_chain #(
       .NUM_TX(NUM_TX), .NUM_RX(NUM_RX), .N_RANGE(N_RBINS), .N_DOPPLER(N_DOPPLER),
       .GUARD_R(GUARD_R), .GUARD_D(GUARD_D), .TRAIN_R(TRAIN_R), .TRAIN_D(TRAIN_D),
-      .KIND(CFAR_KIND), .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI),
+      .KIND(CFAR_KIND), .RUN_KINDS(CFAR_RUN_KINDS), .OS_BUILD(CFAR_OS_BUILD),
+      .OS_RANK(CFAR_OS_RANK), .LOCAL_MAX_BUILD(CFAR_LOCAL_MAX_BUILD),
+      .BLANK_TOP(BLANK_TOP), .REPORT_LO(REPORT_LO), .REPORT_HI(REPORT_HI),
       .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
       .MAX_DETECTIONS(MAX_DETECTIONS)
     ) u_detect (
       .clk, .rst, .cfg_scale(cfg_cfar_scale), .cfg_max_detections,
-      .cfg_kind(2'(CFAR_KIND)), .cfg_local_max(1'b0),
+      .cfg_kind(cfg_cfar_kind), .cfg_local_max,
       .frame_start(det_frame_start),
       .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
       .s_axis_tlast(df_tlast),
@@ -528,7 +544,7 @@ module radar_pipeline #(
     assign det_frame_start   = 1'b0;   // no detector: its settings are stored, not applied
     /* verilator lint_off UNUSEDSIGNAL */
     logic unused_det;
-    assign unused_det = ^{cfg_cfar_scale, cfg_max_detections};
+    assign unused_det = ^{cfg_cfar_scale, cfg_max_detections, cfg_cfar_kind, cfg_local_max};
     /* verilator lint_on UNUSEDSIGNAL */
   end
 
@@ -670,11 +686,6 @@ module radar_pipeline #(
   assign ctrl_drop        = ev[7] | ev[6];
   assign ctrl_error       = (|ev[5:0]) | rf_ev_ovf | df_ev_ovf | fft_tlast_event;
 
-  // CFAR kind and local maximum: stored and read back; the detector takes its kind from
-  // the HDL parameter CFAR_KIND (the one kind built in, CAPS2.cfar_kinds) until cfar_2d has
-  // run-time inputs for them
-  logic [1:0]  cfg_cfar_kind;
-  logic        cfg_local_max;
   logic [15:0] cfg_packet_words;
   // shortest packet: at most 4096 packets a frame (axis_packetizer's PW_MIN)
   localparam int PACKET_WORDS_MIN = ((FRAME_WORDS + 4095) / 4096 > 2)
@@ -682,9 +693,10 @@ module radar_pipeline #(
   radar_ctrl #(
     .MAX_DETECTIONS((OUTPUT_MODE == 1) ? MAX_DETECTIONS : 256), .PACKET_WORDS(PACKET_WORDS),
     .PACKET_WORDS_MIN(PACKET_WORDS_MIN),
-    .CFAR_KINDS(4'(1 << ((OUTPUT_MODE == 1) ? CFAR_KIND : 0))),
+    .CFAR_KINDS(CFAR_KINDS),
     .CFAR_KIND((OUTPUT_MODE == 1) ? CFAR_KIND : 0), .N_SCALES(N_SCALES),
-    .SCALE_W(CTRL_SCALE_W), .CFAR_SCALE(0), .LOCAL_MAX(1'b0),
+    .SCALE_W(CTRL_SCALE_W), .CFAR_SCALE(0),
+    .LOCAL_MAX((OUTPUT_MODE == 1) && CFAR_LOCAL_MAX_BUILD && CFAR_LOCAL_MAX),
     .CLUTTER_REMOVAL(STATIC_REMOVAL)
   ) u_ctrl (
     .clk, .rst,
@@ -704,13 +716,12 @@ module radar_pipeline #(
   // frame-start / discontinuity marks (its counters report drops), the corner turn's
   // frame-start mark (after static removal) and output frame count, the ping-pong's
   // dropped-sample count (chirps dropped are reported instead), and the static removal's
-  // saturation flag (the model reports it; no status port yet), the CFAR kind and local
-  // maximum settings (above). Waiver: reduced into a deliberately unused bit.
+  // saturation flag (the model reports it; no status port yet). Waiver: reduced into a
+  // deliberately unused bit.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
   assign unused_ok = ^{rf_tuser, df_tuser, sr_tuser, ct_frames_out, pp_drop_samples,
-                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated,
-                       cfg_cfar_kind, cfg_local_max};
+                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

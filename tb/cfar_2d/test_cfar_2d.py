@@ -40,10 +40,15 @@ class TB(AxisTB):
 
     def set_kind(self, kind: str, local_max: bool) -> None:
         """Drive cfg_kind (its code, built or not) and cfg_local_max, and cfg_scale with the
-        Pfa-derived table of the kind the RTL then runs."""
-        self.kind, self.local_max = kind, local_max
+        Pfa-derived table of the kind the RTL then runs (a CA/GO/SO code outside RUN_KINDS
+        runs KIND; the local maximum is off unless LOCAL_MAX_BUILD)."""
+        code, default = KIND_NAMES.index(kind), param("KIND")
+        if code < 3 and not (param("RUN_KINDS", 7) | 1 << default) >> code & 1:
+            kind = KIND_NAMES[default]
+        self.kind = kind
+        self.local_max = local_max and bool(param("LOCAL_MAX_BUILD", 1))
         self.scale = cm.scale_table(self.cfg, PFA, N_CHANNELS, kind=kind)
-        self.dut.cfg_kind.value = KIND_NAMES.index(kind)
+        self.dut.cfg_kind.value = code
         self.dut.cfg_local_max.value = int(local_max)
         self.dut.cfg_scale.value = cm.pack_scale(self.scale, self.cfg)
 
@@ -263,6 +268,9 @@ PARAMS = [
     # default regression: seconds to build and run)
     dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
          BLANK_TOP=1),
+    # the same built for CA alone, no local maximum (cfg_kind / cfg_local_max ignored)
+    dict(N_RANGE=4, N_DOPPLER=4, POW_W=24, GUARD_R=0, GUARD_D=0, TRAIN_R=1, TRAIN_D=1, KIND=0,
+         BLANK_TOP=1, RUN_KINDS=1, LOCAL_MAX_BUILD=0),
     # OS built (KIND 3), no Doppler guard, rows cut at both ends and blanked at the top
     dict(N_RANGE=16, N_DOPPLER=16, POW_W=34, GUARD_R=1, GUARD_D=0, TRAIN_R=2, TRAIN_D=2, KIND=3,
          BLANK_TOP=2, REPORT_LO=1, REPORT_HI=13),

@@ -141,10 +141,11 @@ async def reset_mid_stream(dut) -> None:
 
 @cocotb.test()
 async def settings_written_mid_frame(dut) -> None:
-    """SETTINGS.max_detections and the CFAR_SCALE table written while the CFAR works on
-    frame 0 (after its frame start, the CFAR's row 1): ACTIVE_* keep the old values, frame 0
-    runs with them, frames 1 and 2 with the new ones (the model with ``FrameSettings``);
-    random AXI4-Lite stalls."""
+    """SETTINGS (CFAR kind CA -> GO, local maximum off -> on, max_detections) and the
+    CFAR_SCALE table written while the CFAR works on frame 0 (after its frame start, the
+    CFAR's row 1): ACTIVE_* keep the old values, frame 0 runs with them, frames 1 and 2 with
+    the new ones (the model with ``FrameSettings``, compared frame by frame); random
+    AXI4-Lite stalls."""
     from dataclasses import replace
 
     from host import regs
@@ -159,11 +160,13 @@ async def settings_written_mid_frame(dut) -> None:
     tb.set_idle_generator(random_pause(0.2, 21))
     tb.set_backpressure_generator(random_pause(0.2, 22))
     await tb.reset()
+    caps2 = regs.decode("CAPS2", await tb.read32(regs.address("CAPS2")))
+    assert caps2["cfar_kinds"] == 0b0111, caps2           # CA, GO, SO built, not OS
     dcfg = chain.detect_config(cfg)
     old_scale = dcfg.scale()
-    new_scale = replace(dcfg, pfa=1e-2).scale()
+    new_scale = replace(dcfg, pfa=1e-2, run_kind="go").scale()
     assert not np.array_equal(new_scale, old_scale)
-    limit = 5
+    limit = 3
     for adc in frames:
         await tb.send_frame(adc)
     det = tb.dut.g_detect.u_detect
@@ -172,19 +175,31 @@ async def settings_written_mid_frame(dut) -> None:
         await tb.cycles(1)
     before = int(det.cin_q.value)
     await tb.write32(regs.address("SETTINGS"),
-                     regs.encode("SETTINGS", max_detections=limit, clutter_removal=0))
+                     regs.encode("SETTINGS", max_detections=limit, clutter_removal=0,
+                                 cfar_kind=1, local_max=1))
     for e, v in enumerate(new_scale):
         await tb.write32(regs.address("CFAR_SCALE", e), int(v))
     assert before < int(det.cin_q.value), "the writes did not end inside frame 0"
     act = regs.decode("ACTIVE_SETTINGS", await tb.read32(regs.address("ACTIVE_SETTINGS")))
-    assert act["max_detections"] == dcfg.max_detections, "applied mid-frame"
+    assert (act["max_detections"], act["cfar_kind"], act["local_max"]) == (
+        dcfg.max_detections, 0, 0), "applied mid-frame"
     assert await tb.read32(regs.address("ACTIVE_CFAR_SCALE", 0)) == old_scale[0]
     got = await tb.recv_frames(len(frames), 2 * tb.frame_timeout_cycles())
     assert (await tb.read32(regs.address("CFG_ERRORS"))) == 0
+    act = regs.decode("ACTIVE_SETTINGS", await tb.read32(regs.address("ACTIVE_SETTINGS")))
+    assert (act["cfar_kind"], act["local_max"]) == (1, 1), act
     settings = FrameSettings(max_detections=[dcfg.max_detections, limit, limit],
-                             scales=[old_scale, new_scale, new_scale])
-    assert_packets_equal(got, dma_packets(frames, cfg, chain, settings=settings),
-                         "detector settings written mid-frame")
+                             scales=[old_scale, new_scale, new_scale],
+                             kinds=[dcfg.kind, "go", "go"], local_max=[False, True, True])
+    want = dma_packets(frames, cfg, chain, settings=settings)
+    same_kind = replace(settings, kinds=None, local_max=None)
+    assert not all(np.array_equal(a, b) for a, b in zip(
+        dma_packets(frames, cfg, chain, settings=same_kind), want, strict=True)), \
+        "kind and local maximum change the records"
+    n = len(want) // len(frames)
+    for k in range(len(frames)):
+        assert_packets_equal(got[k * n:(k + 1) * n], want[k * n:(k + 1) * n],
+                             f"detector settings written mid-frame, frame {k}")
     tr = trailers(cfg, chain, got)
     assert [t.limit for t in tr] == [dcfg.max_detections, limit, limit], tr
     assert tr[1].records == limit < tr[1].detections, tr
