@@ -11,8 +11,14 @@ Output order (Doppler vectors): word ``j = (t * n_range + r) * n_doppler + d``, 
 ``(num_tx, n_range, n_doppler, num_rx)``, TLAST after every ``n_doppler`` words
 (``read_order=0``, the RTL's READ_ORDER = 0), or with ``read_order=1`` (on-chip detection)
 ``j = (r * num_tx + t) * n_doppler + d``, i.e. ``(n_range, num_tx, n_doppler, num_rx)``.
-Order 0 maps output j to input ``p(j) = rotl(j, ROT)``; order 1 to a bit permutation
-``p(j)[a] = j[sigma(a)]``; the in-place scheme writes frame k at ``p^k`` for both.
+
+In-place address schemes (docs/buffers.md), frame k written at ``W_k`` and read at ``W_{k+1}``:
+order 0 maps output j to input ``p(j) = j * M mod (N - 1)`` (``M = num_tx * n_range``,
+``N`` words a frame, ``p(N-1) = N-1``), so ``W_k(i) = i * M^k mod (N - 1)``, for a power-of-two
+frame the bit rotation ``rotl(i, k * log2 M mod log2 N)``. Order 1 with a power-of-two
+num_tx: the bit permutation ``p(j)[a] = j[sigma(a)]``, ``W_k = p^k``; with any other num_tx
+the memory is num_tx banks of ``n_range * n_doppler`` words, bank t holding TX t's chirps as
+an in-place ``n_doppler x n_range`` transpose (rotation by log2 n_range).
 """
 
 from __future__ import annotations
@@ -25,6 +31,10 @@ def _log2(n: int, name: str) -> int:
     if n < 1 or (1 << b) != n:
         raise ValueError(f"{name}={n} must be a power of two")
     return b
+
+
+def _pow2(n: int) -> bool:
+    return n >= 1 and n & (n - 1) == 0
 
 
 def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
@@ -43,7 +53,8 @@ def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
 
 
 def sigma(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
-    """int ``(B,)``: READ_ORDER = 1 bit permutation, bit a of p(j) is bit sigma[a] of j."""
+    """int ``(B,)``: READ_ORDER = 1 bit permutation (power-of-two num_tx), bit a of p(j) is bit
+    sigma[a] of j."""
     bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
                   _log2(n_doppler, "n_doppler"))
     a = np.arange(bt + br + bd)
@@ -58,13 +69,6 @@ def _permute(x: np.ndarray, perm: np.ndarray) -> np.ndarray:
     return out
 
 
-def address_bits(num_tx: int, n_range: int, n_doppler: int) -> tuple[int, int]:
-    """(B, ROT): address bits of one frame and the per-frame rotation of the in-place scheme."""
-    bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
-                  _log2(n_doppler, "n_doppler"))
-    return bt + br + bd, bt + br
-
-
 def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
     """Rotate ``bits``-bit integers left by ``s`` (0 <= s < bits)."""
     x = np.asarray(x, dtype=np.int64)
@@ -72,22 +76,48 @@ def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
     return ((x << s) | (x >> (bits - s))) & mask if s else x & mask
 
 
+def stride(k: int, num_tx: int, n_range: int, n_doppler: int) -> int:
+    """READ_ORDER 0 address step of frame k: ``M^k mod (N - 1)``, M = num_tx * n_range."""
+    n = num_tx * n_range * n_doppler
+    return pow(num_tx * n_range, k, n - 1)
+
+
+def _bank_slot(k: int, t: np.ndarray, n: np.ndarray, n_range: int, n_doppler: int
+               ) -> np.ndarray:
+    """READ_ORDER 1, num_tx not a power of two: slot of bank word n of TX t in frame k's
+    address pattern, ``t * n_range * n_doppler + rotl(n, k * log2 n_range)``."""
+    br = _log2(n_range, "n_range")
+    m = br + _log2(n_doppler, "n_doppler")
+    return t * (1 << m) + rotl(n, (k * br) % m, m)
+
+
 def write_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
                     read_order: int = 0) -> np.ndarray:
-    """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i) = p^k(i)."""
-    b, rot = address_bits(num_tx, n_range, n_doppler)
+    """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i)."""
+    n = num_tx * n_range * n_doppler
+    i = np.arange(n, dtype=np.int64)
     if read_order == 0:
-        return rotl(np.arange(1 << b), (k * rot) % b, b)
+        return np.where(i == n - 1, n - 1, i * stride(k, num_tx, n_range, n_doppler) % (n - 1))
+    if not _pow2(num_tx):   # input (d, t, r): bank t, bank word d * n_range + r
+        d, rest = np.divmod(i, num_tx * n_range)
+        t, r = np.divmod(rest, n_range)
+        return _bank_slot(k, t, d * n_range + r, n_range, n_doppler)
     s = sigma(num_tx, n_range, n_doppler)
-    perm = np.arange(b)
+    perm = np.arange(len(s))
     for _ in range(k):
         perm = s[perm]
-    return _permute(np.arange(1 << b, dtype=np.int64), perm)
+    return _permute(i, perm)
 
 
 def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
                    read_order: int = 0) -> np.ndarray:
-    """int64 ``(frame_words,)``: slot read for output word j of frame k, R_k = W_{k+1}."""
+    """int64 ``(frame_words,)``: slot read for output word j of frame k: ``W_{k+1}(j)``, with
+    TX banks bank word ``r * n_doppler + d`` of TX t in frame k+1's pattern."""
+    if read_order == 1 and not _pow2(num_tx):   # output (r, t, d)
+        j = np.arange(num_tx * n_range * n_doppler, dtype=np.int64)
+        r, rest = np.divmod(j, num_tx * n_doppler)
+        t, d = np.divmod(rest, n_doppler)
+        return _bank_slot(k + 1, t, r * n_doppler + d, n_range, n_doppler)
     return write_addresses(k + 1, num_tx, n_range, n_doppler, read_order)
 
 
@@ -100,9 +130,9 @@ def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
     """
     if not frames:
         return []
-    b, _ = address_bits(num_tx, n_range, n_doppler)
-    mem = np.zeros((1 << b,) + frames[0].shape[1:], dtype=frames[0].dtype)
-    read = np.ones(1 << b, dtype=bool)
+    n = num_tx * n_range * n_doppler
+    mem = np.zeros((n,) + frames[0].shape[1:], dtype=frames[0].dtype)
+    read = np.ones(n, dtype=bool)
     out = []
     for k, f in enumerate(frames):
         wa = write_addresses(k, num_tx, n_range, n_doppler, read_order)
@@ -116,13 +146,21 @@ def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
 
 
 def frame_period(num_tx: int, n_range: int, n_doppler: int, read_order: int = 0) -> int:
-    """Frames after which the in-place address pattern repeats: B / gcd(B, ROT) for order
-    0, the order of the bit permutation sigma for order 1."""
-    b, rot = address_bits(num_tx, n_range, n_doppler)
+    """Frames after which the in-place address pattern repeats: the multiplicative order of
+    M = num_tx * n_range modulo N - 1 for order 0 (B / gcd(B, log2 M) for a power-of-two
+    frame of 2^B words), the order of the bit permutation sigma for order 1 (with TX banks,
+    m / gcd(m, log2 n_range), m = log2(n_range * n_doppler))."""
     if read_order == 0:
-        return b // np.gcd(b, rot)
+        k = 1
+        while stride(k, num_tx, n_range, n_doppler) != 1:
+            k += 1
+        return k
+    if not _pow2(num_tx):
+        br = _log2(n_range, "n_range")
+        m = br + _log2(n_doppler, "n_doppler")
+        return m // int(np.gcd(m, br))
     s = sigma(num_tx, n_range, n_doppler)
     perm, k = s.copy(), 1
-    while not np.array_equal(perm, np.arange(b)):
+    while not np.array_equal(perm, np.arange(len(s))):
         perm, k = s[perm], k + 1
     return k

@@ -219,6 +219,10 @@ PARAMS = [
     dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
     # on-chip detection order (r, t, d): bit-permutation addresses, period 7 frames
     dict(NUM_TX=4, NUM_RX=2, N_RANGE=4, N_DOPPLER=8, READ_ORDER=1),
+    # 3 TX (xWR1843): modular address stepping, stride 12^k mod 95, period 12 frames
+    dict(NUM_TX=3, NUM_RX=2, N_RANGE=4, N_DOPPLER=8),
+    # 3 TX in order (r, t, d): three TX banks of in-place 8 x 8 transposes, period 2 frames
+    dict(NUM_TX=3, NUM_RX=2, N_RANGE=8, N_DOPPLER=8, READ_ORDER=1),
 ]
 
 
@@ -231,7 +235,8 @@ def test_corner_turn(parameters: dict) -> None:
 
 
 @pytest.mark.parametrize("read_order", [0, 1])
-@pytest.mark.parametrize("shape", [(1, 4, 8), (4, 8, 16), (2, 4, 4), (4, 2, 2), (1, 64, 256)])
+@pytest.mark.parametrize("shape", [(1, 4, 8), (4, 8, 16), (2, 4, 4), (4, 2, 2), (1, 64, 256),
+                                   (3, 4, 8), (3, 16, 64), (5, 2, 4), (6, 4, 8)])
 def test_in_place_model(shape: tuple[int, int, int], read_order: int) -> None:
     """The in-place address scheme (one frame of memory) reproduces the transpose over more
     than a full period of its address pattern, never overwriting an unread slot."""
