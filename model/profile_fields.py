@@ -80,7 +80,8 @@ def unsupported_features(cfg: RadarConfig) -> list[str]:
 def preset_chain_features(cfg: RadarConfig) -> list[str]:
     """What of ``cfg`` the presets' fixed-point chain (the bit-accurate model, the RTL) does
     not run, one phrase each (empty for the presets): zero padding, a firing order other
-    than 0..num_tx-1, a real ADC, a virtual array other than the contiguous lambda/2 ULA."""
+    than 0..num_tx-1, a real ADC. The array's geometry is the host's (host.points): the
+    chain moves the NUM_TX x NUM_RX channels whatever their positions."""
     out = []
     if cfg.n_samples != cfg.n_range:
         out.append(f"{cfg.n_samples} samples per chirp zero-padded to a {cfg.n_range}-point "
@@ -91,8 +92,6 @@ def preset_chain_features(cfg: RadarConfig) -> list[str]:
         out.append(f"TX firing order {list(cfg.tx_sequence)}")
     if cfg.adc != "complex":
         out.append("real-valued ADC")
-    if not cfg.uniform_linear_array:
-        out.append("a virtual array other than the contiguous horizontal lambda/2 ULA")
     return out
 
 
