@@ -139,7 +139,6 @@ module corner_turn #(
   assign s_axis_tready = !rst && !pending_q && (!rd_active_q || wr_free);
   assign wr_beat       = s_axis_tvalid && s_axis_tready;
   assign wr_frame_end  = (wr_cnt_q == B'(N - 1));
-  assign rd_frame_end  = (rd_cnt_q == B'(N - 1));
   assign chirp_end     = (wr_cnt_q[BR-1:0] == '1);
   assign ram_wr_en     = wr_beat;
 
@@ -157,6 +156,34 @@ module corner_turn #(
     assign ram_wr_addr = rotl(wr_cnt_q, wr_shift_q);
     assign ram_rd_addr = rotl(rd_cnt_q, rd_shift_q);
     assign wr_free     = (wr_cnt_q < rd_cnt_q);
+  end else if (POW2) begin : g_perm
+    // SIGMA[a]: input-index bits are {d, t, r} (r lowest), output-index bits {r, t, d}
+    function automatic logic [SH_W-1:0] sigma(input int a);
+      if (a < BR)           sigma = SH_W'(BT + BD + a);        // r
+      else if (a < BR + BT) sigma = SH_W'(BD + (a - BR));       // t
+      else                  sigma = SH_W'(a - BR - BT);         // d
+    endfunction
+    logic [SH_W-1:0] wr_perm_q [B];
+    logic [SH_W-1:0] rd_perm_q [B];
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        for (int a = 0; a < B; a++) wr_perm_q[a] <= SH_W'(a);
+      end else if (wr_beat && wr_frame_end) begin
+        for (int a = 0; a < B; a++) begin
+          for (int c = 0; c < B; c++) if (wr_perm_q[a] == SH_W'(c)) wr_perm_q[a] <= sigma(c);
+        end
+      end
+      if (rd_start) rd_perm_q <= wr_perm_q;   // already advanced to sigma_{k+1}
+    end
+    always_comb begin
+      for (int a = 0; a < B; a++) begin
+        ram_wr_addr[a] = wr_cnt_q[wr_perm_q[a]];
+        ram_rd_addr[a] = rd_cnt_q[rd_perm_q[a]];
+      end
+    end
+    assign wr_free = (wr_cnt_q < rd_cnt_q);
+    logic unused_rot;
+    assign unused_rot = ^{rd_shift_q};
   end else if (READ_ORDER == 0) begin : g_mod
     // Any NUM_TX: address += stride mod (N-1), word N-1 at slot N-1. Strides M^k mod (N-1)
     // of the frame written (ws_q) and read (rs_q, = the writer's next); the next stride
@@ -207,7 +234,7 @@ module corner_turn #(
     assign wr_free     = (wr_cnt_q < rd_cnt_q);
     logic unused_shift;
     assign unused_shift = ^{wr_shift_q, rd_shift_q};
-  end else if (!POW2) begin : g_bank
+  end else begin : g_bank
     // READ_ORDER 1, NUM_TX not a power of two: NUM_TX banks of N_RANGE*N_DOPPLER words,
     // bank t an in-place N_DOPPLER x N_RANGE transpose of TX t's chirps (bank word {d, r}
     // written at rotl({d, r}, k*BR mod RB), bank word {r, d} read at rotl({r, d},
@@ -241,35 +268,9 @@ module corner_turn #(
     assign wr_free     = ({1'b0, wd_q, wr_cnt_q[BR-1:0]} < rd_done);
     assign ram_wr_addr = {wt_q, rotl({wd_q, wr_cnt_q[BR-1:0]}, wr_shift_q)};
     assign ram_rd_addr = {rt_q, rotl({rr_q, rd_cnt_q[BD-1:0]}, rd_shift_q)};
-  end else begin : g_perm
-    // SIGMA[a]: input-index bits are {d, t, r} (r lowest), output-index bits {r, t, d}
-    function automatic logic [SH_W-1:0] sigma(input int a);
-      if (a < BR)           sigma = SH_W'(BT + BD + a);        // r
-      else if (a < BR + BT) sigma = SH_W'(BD + (a - BR));       // t
-      else                  sigma = SH_W'(a - BR - BT);         // d
-    endfunction
-    logic [SH_W-1:0] wr_perm_q [B];
-    logic [SH_W-1:0] rd_perm_q [B];
-    always_ff @(posedge clk) begin
-      if (rst) begin
-        for (int a = 0; a < B; a++) wr_perm_q[a] <= SH_W'(a);
-      end else if (wr_beat && wr_frame_end) begin
-        for (int a = 0; a < B; a++) begin
-          for (int c = 0; c < B; c++) if (wr_perm_q[a] == SH_W'(c)) wr_perm_q[a] <= sigma(c);
-        end
-      end
-      if (rd_start) rd_perm_q <= wr_perm_q;   // already advanced to sigma_{k+1}
-    end
-    always_comb begin
-      for (int a = 0; a < B; a++) begin
-        ram_wr_addr[a] = wr_cnt_q[wr_perm_q[a]];
-        ram_rd_addr[a] = rd_cnt_q[rd_perm_q[a]];
-      end
-    end
-    assign wr_free = (wr_cnt_q < rd_cnt_q);
-    logic unused_rot;
-    assign unused_rot = ^{rd_shift_q};
   end
+
+  assign rd_frame_end = (rd_cnt_q == B'(N - 1));
 
   always_ff @(posedge clk) begin
     p_last_q  <= (rd_cnt_q[BD-1:0] == '1);

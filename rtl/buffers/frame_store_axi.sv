@@ -277,7 +277,9 @@ module frame_store_axi #(
   logic            aw_hs, w_hs, w_end, b_hs, w_ok;
   logic [63:0]     aw_off;
   // digits of aw_idx_q = (d*NUM_TX + t)*S + s
-  logic [(BS > 0 ? BS : 1)-1:0] aw_s_q;
+  localparam int AWS_W = (BS > 0) ? BS : 1;
+  localparam logic [AWS_W-1:0] AW_S_LAST = AWS_W'(S - 1);   // 0 with one strip (never counts)
+  logic [AWS_W-1:0] aw_s_q;
   logic [BT-1:0]   aw_t_q;
   logic [BD-1:0]   aw_d_q;
 
@@ -515,7 +517,7 @@ module frame_store_axi #(
           aw_idx_q <= '0;
           aw_f_q   <= aw_f_q + 1'b1;
         end
-        if (BS == 0 || aw_s_q == '1) begin
+        if (aw_s_q == AW_S_LAST) begin
           aw_t_q <= (aw_t_q == BT'(NUM_TX - 1)) ? '0 : aw_t_q + 1'b1;
           if (aw_t_q == BT'(NUM_TX - 1)) aw_d_q <= aw_d_q + 1'b1;
         end
