@@ -65,7 +65,7 @@ def setup(dut) -> tuple[PipelineTB, PipelineParams]:
     chain = SETS[os.environ["RP_TX3_SET"]]
     assert (tb.num_tx, tb.frame_words) == (3, chain.frame_words(TX3))
     if chain.output_mode == 1:
-        tb.set_cfar_scale(chain.cfar_scale(TX3))
+        tb.cfar_scales = chain.cfar_scales(TX3)
     if chain.frame_store:
         ram = AxiRam(AxiBus.from_prefix(dut, "m_axi_mem"), dut.clk, dut.rst,
                      size=MEM_BASE + chain.store_geometry(TX3).memory_bytes)
