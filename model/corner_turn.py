@@ -11,8 +11,14 @@ Output order (Doppler vectors): word ``j = (t * n_range + r) * n_doppler + d``, 
 ``(num_tx, n_range, n_doppler, num_rx)``, TLAST after every ``n_doppler`` words
 (``read_order=0``, the RTL's READ_ORDER = 0), or with ``read_order=1`` (on-chip detection)
 ``j = (r * num_tx + t) * n_doppler + d``, i.e. ``(n_range, num_tx, n_doppler, num_rx)``.
-Order 0 maps output j to input ``p(j) = rotl(j, ROT)``; order 1 to a bit permutation
-``p(j)[a] = j[sigma(a)]``; the in-place scheme writes frame k at ``p^k`` for both.
+
+In-place address schemes (docs/buffers.md), frame k written at ``W_k`` and read at ``W_{k+1}``:
+order 0 maps output j to input ``p(j) = j * M mod (N - 1)`` (``M = num_tx * n_range``,
+``N`` words a frame, ``p(N-1) = N-1``), so ``W_k(i) = i * M^k mod (N - 1)``, for a power-of-two
+frame the bit rotation ``rotl(i, k * log2 M mod log2 N)``. Order 1 with a power-of-two
+num_tx: the bit permutation ``p(j)[a] = j[sigma(a)]``, ``W_k = p^k``; with any other num_tx
+the memory is num_tx banks of ``n_range * n_doppler`` words, bank t holding TX t's chirps as
+an in-place ``n_doppler x n_range`` transpose (rotation by log2 n_range).
 
 ``n_loops < n_doppler`` (the RTL's N_LOOPS: fewer loops than the Doppler FFT length): a frame
 is the ``n_loops`` chirps per TX (the input indices i < num_tx * n_range * n_loops) and each
@@ -32,6 +38,10 @@ def _log2(n: int, name: str) -> int:
     return b
 
 
+def _pow2(n: int) -> bool:
+    return n >= 1 and n & (n - 1) == 0
+
+
 def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
                 read_order: int = 0, n_loops: int | None = None) -> np.ndarray:
     """Reorder one frame from chirp order to Doppler-vector order.
@@ -49,7 +59,8 @@ def corner_turn(frame: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
 
 
 def sigma(num_tx: int, n_range: int, n_doppler: int) -> np.ndarray:
-    """int ``(B,)``: READ_ORDER = 1 bit permutation, bit a of p(j) is bit sigma[a] of j."""
+    """int ``(B,)``: READ_ORDER = 1 bit permutation (power-of-two num_tx), bit a of p(j) is bit
+    sigma[a] of j."""
     bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
                   _log2(n_doppler, "n_doppler"))
     a = np.arange(bt + br + bd)
@@ -64,13 +75,6 @@ def _permute(x: np.ndarray, perm: np.ndarray) -> np.ndarray:
     return out
 
 
-def address_bits(num_tx: int, n_range: int, n_doppler: int) -> tuple[int, int]:
-    """(B, ROT): address bits of one frame and the per-frame rotation of the in-place scheme."""
-    bt, br, bd = (_log2(num_tx, "num_tx"), _log2(n_range, "n_range"),
-                  _log2(n_doppler, "n_doppler"))
-    return bt + br + bd, bt + br
-
-
 def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
     """Rotate ``bits``-bit integers left by ``s`` (0 <= s < bits)."""
     x = np.asarray(x, dtype=np.int64)
@@ -78,23 +82,62 @@ def rotl(x: np.ndarray, s: int, bits: int) -> np.ndarray:
     return ((x << s) | (x >> (bits - s))) & mask if s else x & mask
 
 
+def stride(k: int, num_tx: int, n_range: int, n_doppler: int) -> int:
+    """READ_ORDER 0 address step of frame k: ``M^k mod (N - 1)``, M = num_tx * n_range."""
+    n = num_tx * n_range * n_doppler
+    return pow(num_tx * n_range, k, n - 1)
+
+
+def _bank_slot(k: int, t: np.ndarray, n: np.ndarray, n_range: int, n_doppler: int
+               ) -> np.ndarray:
+    """READ_ORDER 1, num_tx not a power of two: slot of bank word n of TX t in frame k's
+    address pattern, ``t * n_range * n_doppler + rotl(n, k * log2 n_range)``."""
+    br = _log2(n_range, "n_range")
+    m = br + _log2(n_doppler, "n_doppler")
+    return t * (1 << m) + rotl(n, (k * br) % m, m)
+
+
 def write_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
                     read_order: int = 0) -> np.ndarray:
-    """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i) = p^k(i)."""
-    b, rot = address_bits(num_tx, n_range, n_doppler)
+    """int64 ``(frame_words,)``: memory slot of input word i of frame k, W_k(i)."""
+    n = num_tx * n_range * n_doppler
+    i = np.arange(n, dtype=np.int64)
     if read_order == 0:
-        return rotl(np.arange(1 << b), (k * rot) % b, b)
+        return np.where(i == n - 1, n - 1, i * stride(k, num_tx, n_range, n_doppler) % (n - 1))
+    if not _pow2(num_tx):   # input (d, t, r): bank t, bank word d * n_range + r
+        d, rest = np.divmod(i, num_tx * n_range)
+        t, r = np.divmod(rest, n_range)
+        return _bank_slot(k, t, d * n_range + r, n_range, n_doppler)
     s = sigma(num_tx, n_range, n_doppler)
-    perm = np.arange(b)
+    perm = np.arange(len(s))
     for _ in range(k):
         perm = s[perm]
-    return _permute(np.arange(1 << b, dtype=np.int64), perm)
+    return _permute(i, perm)
 
 
 def read_addresses(k: int, num_tx: int, n_range: int, n_doppler: int,
                    read_order: int = 0) -> np.ndarray:
-    """int64 ``(frame_words,)``: slot read for output word j of frame k, R_k = W_{k+1}."""
+    """int64 ``(frame_words,)``: slot read for output word j of frame k: ``W_{k+1}(j)``, with
+    TX banks bank word ``r * n_doppler + d`` of TX t in frame k+1's pattern."""
+    if read_order == 1 and not _pow2(num_tx):   # output (r, t, d)
+        j = np.arange(num_tx * n_range * n_doppler, dtype=np.int64)
+        r, rest = np.divmod(j, num_tx * n_doppler)
+        t, d = np.divmod(rest, n_doppler)
+        return _bank_slot(k + 1, t, r * n_doppler + d, n_range, n_doppler)
     return write_addresses(k + 1, num_tx, n_range, n_doppler, read_order)
+
+
+def _write_waits_for(i: np.ndarray, num_tx: int, n_range: int, n_doppler: int,
+                     read_order: int) -> np.ndarray:
+    """int64 like ``i``: the output index j of frame k whose read the RTL's writer waits for
+    before writing input word i of frame k+1 (reads are issued in j order): j = i, or with
+    TX banks bank t's read of bank word ``d * n_range + r`` (read as ``r' * n_doppler + d'``)."""
+    if read_order == 0 or _pow2(num_tx):
+        return np.asarray(i, dtype=np.int64)
+    d, rest = np.divmod(np.asarray(i, dtype=np.int64), num_tx * n_range)
+    t, r = np.divmod(rest, n_range)
+    rb, db = np.divmod(d * n_range + r, n_doppler)
+    return (rb * num_tx + t) * n_doppler + db
 
 
 def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
@@ -102,26 +145,28 @@ def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
                     ) -> list[np.ndarray]:
     """Run the in-place address scheme on a one-frame memory (checks the method itself),
     writing and reading only the words of ``n_loops`` loops (default ``n_doppler``), in
-    the RTL's order: word i of frame k+1 is written only after read i of frame k.
+    the RTL's order: word i of frame k+1 is written only after read i of frame k (TX banks:
+    after its bank's read of the same bank word).
 
     frames: list of input frames ``(num_tx * n_loops * n_range, num_rx)``. Returns the
     output frames. Raises AssertionError if a slot would be overwritten before being read.
     """
     if not frames:
         return []
-    b, _ = address_bits(num_tx, n_range, n_doppler)
+    n = num_tx * n_range * n_doppler
     n_loops = n_doppler if n_loops is None else n_loops
     live_in = np.arange(num_tx * n_range * n_loops)            # input indices that exist
-    live_out = np.flatnonzero(np.arange(1 << b) % n_doppler < n_loops)
-    mem = np.zeros((1 << b,) + frames[0].shape[1:], dtype=frames[0].dtype)
-    unread = np.zeros(1 << b, dtype=bool)
+    live_out = np.flatnonzero(np.arange(n) % n_doppler < n_loops)
+    waits = _write_waits_for(live_in, num_tx, n_range, n_doppler, read_order)
+    mem = np.zeros((n,) + frames[0].shape[1:], dtype=frames[0].dtype)
+    unread = np.zeros(n, dtype=bool)
     out = []
     for k, f in enumerate(frames):
         wa = write_addresses(k, num_tx, n_range, n_doppler, read_order)[live_in]
         ra = read_addresses(k - 1, num_tx, n_range, n_doppler, read_order) if k else []
         done = 0                                        # frame k-1's reads issued
-        for i, slot in zip(live_in, wa, strict=True):   # its reads j <= i came first
-            while k and done < len(live_out) and live_out[done] <= i:
+        for i, slot, g in zip(live_in, wa, waits, strict=True):  # its reads j <= g first
+            while k and done < len(live_out) and live_out[done] <= g:
                 unread[ra[live_out[done]]] = False
                 done += 1
             assert not unread[slot], "in-place scheme overwrote an unread slot"
@@ -134,13 +179,21 @@ def in_place_stream(frames: list[np.ndarray], num_tx: int, n_range: int,
 
 
 def frame_period(num_tx: int, n_range: int, n_doppler: int, read_order: int = 0) -> int:
-    """Frames after which the in-place address pattern repeats: B / gcd(B, ROT) for order
-    0, the order of the bit permutation sigma for order 1."""
-    b, rot = address_bits(num_tx, n_range, n_doppler)
+    """Frames after which the in-place address pattern repeats: the multiplicative order of
+    M = num_tx * n_range modulo N - 1 for order 0 (B / gcd(B, log2 M) for a power-of-two
+    frame of 2^B words), the order of the bit permutation sigma for order 1 (with TX banks,
+    m / gcd(m, log2 n_range), m = log2(n_range * n_doppler))."""
     if read_order == 0:
-        return b // np.gcd(b, rot)
+        k = 1
+        while stride(k, num_tx, n_range, n_doppler) != 1:
+            k += 1
+        return k
+    if not _pow2(num_tx):
+        br = _log2(n_range, "n_range")
+        m = br + _log2(n_doppler, "n_doppler")
+        return m // int(np.gcd(m, br))
     s = sigma(num_tx, n_range, n_doppler)
     perm, k = s.copy(), 1
-    while not np.array_equal(perm, np.arange(b)):
+    while not np.array_equal(perm, np.arange(len(s))):
         perm, k = s[perm], k + 1
     return k

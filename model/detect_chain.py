@@ -47,8 +47,8 @@ class DetectConfig:
     local_max: bool = False
 
     def __post_init__(self) -> None:
-        if self.num_tx < 1 or self.num_tx > 16 or self.num_tx & (self.num_tx - 1):
-            raise ValueError(f"num_tx={self.num_tx} must be a power of two in 1..16")
+        if not 1 <= self.num_tx <= 16:
+            raise ValueError(f"num_tx={self.num_tx} not in 1..16")
         if not 1 <= self.num_rx <= 64:
             raise ValueError(f"num_rx={self.num_rx} not in 1..64")
         if not 1 <= self.max_detections <= 65535:

@@ -19,8 +19,10 @@ word (t, d, r)::
 
 A *group* is what the on-chip buffer holds at a time: one strip (order 0) or the ``num_tx``
 strips of one s (order 1), contiguous either way. Write bursts: one row per (chirp, strip)
-in input order. Read bursts: the area linearly, in bursts of ``min(4096, group_bytes)`` bytes;
-each group leaves as its Doppler vectors, (r, t, d) inside the group.
+in input order. Read bursts: the area linearly, in bursts of :attr:`StoreGeometry.read_burst_bytes`
+(the largest power of two dividing the group, at most 4096 bytes); each group leaves as its
+Doppler vectors, (r, t, d) inside the group. Any num_tx in 1..16: a count that is not a power
+of two only makes the order-1 group (and so the frame area) a non-power-of-two size.
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ class StoreGeometry:
 
     def __post_init__(self) -> None:
         checks = [
-            (_pow2(self.num_tx) and self.num_tx <= 16, "num_tx", "a power of two in 1..16"),
+            (1 <= self.num_tx <= 16, "num_tx", "in 1..16"),
             (_pow2(self.num_rx) and self.num_rx <= 16, "num_rx", "a power of two in 1..16"),
             (_pow2(self.n_range) and 2 <= self.n_range <= 4096, "n_range",
              "a power of two in 2..4096"),
@@ -121,7 +123,9 @@ class StoreGeometry:
 
     @property
     def read_burst_bytes(self) -> int:
-        return min(AXI_BOUNDARY, self.group_bytes)
+        """One read burst: the largest power of two dividing the group, at most 4 KiB (the
+        whole group when it is a power of two of at most 4 KiB)."""
+        return min(AXI_BOUNDARY, self.group_bytes & -self.group_bytes)
 
     def strip_index(self, t: np.ndarray | int, s: np.ndarray | int) -> np.ndarray | int:
         """Position of strip (TX t, range strip s) inside a frame area: ``t*strips + s``
@@ -150,8 +154,10 @@ class StoreGeometry:
 
     @property
     def strip_buffer_bits(self) -> int:
-        """On-chip read buffer: two groups (two strips in order 0, 2*num_tx in order 1)."""
-        return 2 * self.group_bytes * 8
+        """On-chip read buffer: two halves of a group each (two strips in order 0, 2*num_tx
+        in order 1), each half rounded up to a power of two of buffer entries."""
+        units = self.group_bytes * 8 // self.unit_bits
+        return 2 * (1 << (units - 1).bit_length()) * self.unit_bits
 
     def area_base(self, k: int) -> int:
         """Byte address of frame k's area."""

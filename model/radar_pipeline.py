@@ -122,13 +122,15 @@ class PipelineParams:
     def store_tile_r(self, cfg: RadarConfig) -> int:
         """FS_TILE_R: ``fs_tile_r`` if given, else the largest tile whose on-chip read buffer
         is at most the mode-0 store's with 16-bin strips (2 x 16 x n_doppler words): 16 in
-        mode 0, 16 // num_tx in mode 1 (whose buffer holds the num_tx strips of one range
-        strip, docs/frame_store.md), and at least one AXI beat per row."""
+        mode 0, the power of two at most 16 // num_tx in mode 1 (whose buffer holds the
+        num_tx strips of one range strip, docs/frame_store.md), and at least one AXI beat
+        per row."""
         if self.fs_tile_r is not None:
             return self.fs_tile_r
         group = cfg.num_tx if self.output_mode == 1 else 1
         beat_words = max(1, self.axi_data_w // (cfg.num_rx * 32))
-        return min(cfg.n_range_bins, max(FS_TILE_WORDS // group, beat_words, 1))
+        return min(cfg.n_range_bins, max(1 << (FS_TILE_WORDS // group).bit_length() - 1,
+                                         beat_words))
 
     def store_geometry(self, cfg: RadarConfig) -> StoreGeometry:
         """The external frame store's geometry (FRAME_STORE = 1); its read order is the

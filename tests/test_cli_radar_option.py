@@ -36,8 +36,11 @@ format = "npy"
 """
 """2 TX x 4 RX, 32 x 32: a profile every backend runs, fast (0.78 m range bins to 22 m)."""
 THREE_TX = SMALL.replace('"small"', '"three"').replace(
-    "tx = [[0, 0], [4, 0]]", "tx = [[0, 0], [4, 0], [8, 0]]")
-"""3 TX: the float chain processes it, the RTL does not elaborate it (NUM_TX a power of two)."""
+    "tx = [[0, 0], [4, 0]]", "tx = [[0, 0], [2, 1], [4, 0]]")
+"""3 TX, the middle one raised for elevation (xWR1843): every backend runs it."""
+WIDE_ADC = SMALL.replace('"small"', '"wide"').replace("loops              = 32",
+                                                      "loops              = 32\nadc_bits = 18")
+"""An 18-bit ADC: the float chain processes it, the RTL does not (DATA_W = 16)."""
 SCENE = {"preset": "full", "seed": 2,
          "targets": [{"range_m": 10.0, "azimuth_deg": 10.0, "radial_velocity_mps": 1.0,
                       "rcs_m2": 10.0}]}
@@ -47,9 +50,10 @@ SCENE = {"preset": "full", "seed": 2,
 def files(tmp_path: Path) -> dict[str, str]:
     (tmp_path / "small.toml").write_text(SMALL)
     (tmp_path / "three.toml").write_text(THREE_TX)
+    (tmp_path / "wide.toml").write_text(WIDE_ADC)
     (tmp_path / "scene.json").write_text(json.dumps(SCENE))
     return {k: str(tmp_path / f) for k, f in (("small", "small.toml"), ("three", "three.toml"),
-                                               ("scene", "scene.json"))}
+                                               ("wide", "wide.toml"), ("scene", "scene.json"))}
 
 
 def _one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
@@ -195,22 +199,41 @@ def test_radar_and_preset_together_refused(tmp_path, capsys, command):
 def test_a_profile_the_rtl_cannot_run_is_refused(tmp_path, files, capsys, command, named,
                                                  suggested):
     """Before any work (nothing written, no RTL build): one line naming the option, the
-    reason (NUM_TX must be a power of two) and the float source where it is an option."""
+    reason (DATA_W = 16 bits) and the float source where it is an option."""
     out = tmp_path / "out"
     argv = [a.replace("{tmp}", str(out)).replace("{scene}", files["scene"]) for a in command]
-    assert main([*argv, "--radar", files["three"]]) == 2
+    assert main([*argv, "--radar", files["wide"]]) == 2
     err = _one_line_error(capsys)
-    assert f"error: {named}" in err and "3 TX" in err and "NUM_TX" in err, err
+    assert f"error: {named}" in err and "18-bit ADC" in err and "DATA_W" in err, err
     assert (f"({suggested} runs it)" in err) if suggested else "runs it" not in err, err
     assert not [p for p in out.rglob("*") if p.is_file()]      # nothing written
 
 
 def test_the_float_backend_runs_that_profile(tmp_path, files):
     out = tmp_path / "p.json"
-    assert main(["detect", "--scene", files["scene"], "--radar", files["three"], "--backend",
+    assert main(["detect", "--scene", files["scene"], "--radar", files["wide"], "--backend",
                  "float", "--json", str(out)]) == 0
     doc = json.loads(out.read_text())
-    assert doc["preset"] == "three" and len(doc["points"]) == 1
+    assert doc["preset"] == "wide" and len(doc["points"]) == 1
+
+
+def test_three_tx_through_the_bit_accurate_model(tmp_path, files):
+    """3 TX (one raised): the model's cube (--detect host) and its detection records
+    (--detect fpga) decode to the float chain's target (the host handles the geometry)."""
+    docs = {}
+    for name, extra in (("float", ["--backend", "float"]), ("cube", ["--backend", "model"]),
+                        ("records", ["--backend", "model", "--detect", "fpga"])):
+        out = tmp_path / f"{name}.json"
+        assert main(["detect", "--scene", files["scene"], "--radar", files["three"], *extra,
+                     "--json", str(out)]) == 0
+        docs[name] = json.loads(out.read_text())
+    want = docs["float"]["points"]
+    assert len(want) == 1
+    for name in ("cube", "records"):
+        got = docs[name]["points"]
+        assert docs[name]["preset"] == "three" and len(got) == 1, (name, got)
+        for key, tol in (("range_m", 0.05), ("azimuth_deg", 1.0), ("radial_velocity_mps", 0.1)):
+            assert abs(got[0][key] - want[0][key]) <= tol, (name, key, got[0], want[0])
 
 
 def test_a_bad_profile_is_one_line(tmp_path, capsys):

@@ -4,23 +4,26 @@
 // written into the slots just read.
 //
 // Input word i of a frame (i = (d*NUM_TX + t)*N_RANGE + r, chirp c = d*NUM_TX + t sent by
-// TX t, range bin r) and output word j (j = (t*N_RANGE + r)*N_DOPPLER + d) are B-bit numbers,
-// B = log2(NUM_TX*N_RANGE*N_DOPPLER); the reorder maps output j to input p(j) = rotl(j, ROT),
-// ROT = log2(NUM_TX) + log2(N_RANGE). In-place scheme: frame k is written at addresses
-// W_k(i) = p^k(i) = rotl(i, k*ROT mod B) and read at R_k(j) = W_k(p(j)) = rotl(j, (k+1)*ROT
-// mod B) = W_{k+1}(j), so frame k+1's word i goes to the slot that frame k's read number i
-// has just freed. The writer only ever trails the reader (write count < read count), which
-// is when s_axis_tready is low. Details and memory figures: docs/buffers.md.
+// TX t, range bin r) and output word j (j = (t*N_RANGE + r)*N_DOPPLER + d), N words a frame:
+// the reorder maps output j to input p(j) = j*M mod (N-1), M = NUM_TX*N_RANGE (p(N-1) = N-1).
+// In-place scheme: frame k is written at addresses W_k(i) = p^k(i) = i*M^k mod (N-1) and read
+// at R_k(j) = W_k(p(j)) = W_{k+1}(j), so frame k+1's word i goes to the slot that frame k's
+// read number i has just freed. For a power-of-two NUM_TX (N = 2^B) this is the bit rotation
+// rotl(i, k*ROT mod B), ROT = log2(M); any other NUM_TX steps the address by the stride M^k
+// mod (N-1). The writer only ever trails the reader (write count < read count), which is when
+// s_axis_tready is low. READ_ORDER 1: below. Details and memory figures: docs/buffers.md.
 //
 // N_LOOPS < N_DOPPLER (fewer loops than the Doppler FFT length, which zero-fills): a frame
 // is the first N_LOOPS chirps per TX (input words i < NUM_TX*N_RANGE*N_LOOPS, the top index
 // field is d) and a Doppler vector its first N_LOOPS words (d < N_LOOPS): both counters skip
 // the indices of the missing loops, so the scheme above holds unchanged on the words that
-// exist (a slot a frame's read skips held no word of that frame).
+// exist (a slot a frame's read skips held no word of that frame). Address stepping jumps
+// over the skipped words at each vector end (stride (N_DOPPLER-N_LOOPS+1)*M^(k+1) mod (N-1)).
 `default_nettype none
 
 module corner_turn #(
-  // TX slots (TDM chirps interleaved), power of two, 1..16.
+  // TX slots (TDM chirps interleaved), 1..16 (READ_ORDER 1 with a count that is not a
+  // power of two: TX banks, docs/buffers.md).
   parameter int NUM_TX = 1,
   // Receive lanes per word, 1..64.
   parameter int NUM_RX = 4,
@@ -62,13 +65,17 @@ module corner_turn #(
   localparam int BT     = $clog2(NUM_TX);
   localparam int BR     = $clog2(N_RANGE);
   localparam int BD     = $clog2(N_DOPPLER);
-  localparam int B      = BT + BR + BD;           // address bits, one frame = 2^B words
-  localparam int ROT    = BT + BR;                // rotation per frame
-  localparam int SH_W   = $clog2(B);
+  localparam bit POW2   = (1 << BT) == NUM_TX;     // frame of 2^B words
+  localparam int N      = NUM_TX * N_RANGE * N_DOPPLER;   // words per frame
+  localparam int B      = BT + BR + BD;           // address bits (N <= 2^B)
+  // rotated index: the whole frame (power-of-two NUM_TX) or one TX bank (READ_ORDER 1)
+  localparam int RB     = POW2 ? B : BR + BD;
+  localparam int ROT    = POW2 ? BT + BR : BR;    // rotation per frame
+  localparam int SH_W   = $clog2(RB);
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_num_tx
-    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16) begin : g_bad_num_tx
+    $fatal(1, "%m: NUM_TX=%0d not in 1..16", NUM_TX);
   end
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
     $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
@@ -92,17 +99,17 @@ module corner_turn #(
     $fatal(1, "%m: READ_ORDER=%0d not 0 or 1", READ_ORDER);
   end
 
-  // rotl(x, s) on B bits, 0 <= s < B
+  // rotl(x, s) on RB bits, 0 <= s < RB
   // (function results assigned to the function name: Yosys does not parse `return`)
-  function automatic logic [B-1:0] rotl(input logic [B-1:0] x, input logic [SH_W-1:0] s);
-    rotl = B'({x, x} >> (B - 32'(s)));
+  function automatic logic [RB-1:0] rotl(input logic [RB-1:0] x, input logic [SH_W-1:0] s);
+    rotl = RB'({x, x} >> (RB - 32'(s)));
   endfunction
 
-  // (a + ROT) mod B for a shift amount a < B
+  // (a + ROT) mod RB for a shift amount a < RB
   function automatic logic [SH_W-1:0] next_shift(input logic [SH_W-1:0] a);
     logic [SH_W:0] t;
     t = {1'b0, a} + (SH_W+1)'(ROT);
-    if (t >= (SH_W+1)'(B)) t = t - (SH_W+1)'(B);
+    if (t >= (SH_W+1)'(RB)) t = t - (SH_W+1)'(RB);
     next_shift = t[SH_W-1:0];
   endfunction
 
@@ -113,7 +120,7 @@ module corner_turn #(
   logic [B-1:0]      ram_wr_addr, ram_rd_addr;
   logic [WORD_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(1 << B), .OUT_REG(1'b1)) u_ram (
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(N), .OUT_REG(1'b1)) u_ram (
     .clk     (clk),
     .wr_en   (ram_wr_en),
     .wr_addr (ram_wr_addr),
@@ -130,25 +137,26 @@ module corner_turn #(
   logic            pending_q;    // a completely written frame waits for the reader
   logic            framing_q;
   logic [31:0]     framing_cnt_q, frames_in_q, frames_out_q;
-  logic            wr_beat, wr_frame_end, chirp_end;
+  logic            wr_beat, wr_frame_end, chirp_end, wr_free;
 
   // Read side
   logic [B-1:0]    rd_cnt_q;     // output word index (reads issued) within the frame
   logic [SH_W-1:0] rd_shift_q;   // (k+1)*ROT mod B for the frame being read
   logic            rd_active_q;
-  logic            can_issue, rd_issue, rd_start;
+  logic            can_issue, rd_issue, rd_start, rd_frame_end;
   logic            p_last_q, p_sof_q, p2_last_q, p2_sof_q;
 
   // Last input word of a frame and last read of a frame; the read skips d >= N_LOOPS.
   localparam logic [B-1:0] WR_LAST = B'(NUM_TX * N_RANGE * N_LOOPS - 1);
-  localparam logic [B-1:0] RD_LAST = {{(B - BD){1'b1}}, BD'(N_LOOPS - 1)};
+  localparam logic [B-1:0] RD_LAST = B'(N - N_DOPPLER + N_LOOPS - 1);
   logic         rd_vec_end;
   logic [B-1:0] rd_next;
   assign rd_vec_end = (rd_cnt_q[BD-1:0] == BD'(N_LOOPS - 1));
   assign rd_next    = rd_vec_end ? {rd_cnt_q[B-1:BD] + 1'b1, BD'(0)} : rd_cnt_q + 1'b1;
 
-  // The writer may use slot W_{k+1}(i) = R_k(i) only once read i was issued (earlier clock).
-  assign s_axis_tready = !rst && !pending_q && (!rd_active_q || (wr_cnt_q < rd_cnt_q));
+  // The writer may use slot W_{k+1}(i) = R_k(i) only once read i was issued (earlier clock):
+  // wr_free (TX banks: once its bank's read of the same bank word was issued).
+  assign s_axis_tready = !rst && !pending_q && (!rd_active_q || wr_free);
   assign wr_beat       = s_axis_tvalid && s_axis_tready;
   assign wr_frame_end  = (wr_cnt_q == WR_LAST);
   assign chirp_end     = (wr_cnt_q[BR-1:0] == '1);
@@ -164,10 +172,11 @@ module corner_turn #(
   // holds for any bit permutation: W_k = p^k, whose bit a is bit sigma_k[a] of the index,
   // sigma_0 = identity, sigma_{k+1}[a] = SIGMA[sigma_k[a]]; the read of frame k uses
   // sigma_{k+1} (= W_{k+1}, as for the rotation).
-  if (READ_ORDER == 0) begin : g_rot
+  if (POW2 && READ_ORDER == 0) begin : g_rot
     assign ram_wr_addr = rotl(wr_cnt_q, wr_shift_q);
     assign ram_rd_addr = rotl(rd_cnt_q, rd_shift_q);
-  end else begin : g_perm
+    assign wr_free     = (wr_cnt_q < rd_cnt_q);
+  end else if (POW2) begin : g_perm
     // SIGMA[a]: input-index bits are {d, t, r} (r lowest), output-index bits {r, t, d}
     function automatic logic [SH_W-1:0] sigma(input int a);
       if (a < BR)           sigma = SH_W'(BT + BD + a);        // r
@@ -192,9 +201,110 @@ module corner_turn #(
         ram_rd_addr[a] = rd_cnt_q[rd_perm_q[a]];
       end
     end
+    assign wr_free = (wr_cnt_q < rd_cnt_q);
     logic unused_rot;
     assign unused_rot = ^{rd_shift_q};
+  end else if (READ_ORDER == 0) begin : g_mod
+    // Any NUM_TX: address += stride mod (N-1), word N-1 at slot N-1. Strides M^k mod (N-1)
+    // of the frame written (ws_q) and read (rs_q, = the writer's next); the next stride
+    // is computed while a frame is written, NUM_TX-1 modular additions (x NUM_TX) then BR
+    // doublings (x N_RANGE), fewer clocks than the frame's words. N_LOOPS < N_DOPPLER: the
+    // read jumps over the N_DOPPLER-N_LOOPS skipped words at each vector end, address +=
+    // J = (N_DOPPLER-N_LOOPS+1)*M^(k+1) mod (N-1), kept as (N_DOPPLER-N_LOOPS+1)*M^k
+    // beside the stride (wj_q) and multiplied by M in the same engine steps.
+    localparam logic [B-1:0] NM1 = B'(N - 1);
+    localparam bit SKIP = N_LOOPS < N_DOPPLER;
+    localparam logic [B-1:0] JUMP0 = B'(N_DOPPLER - N_LOOPS + 1);   // < N-1
+    localparam int ES = NUM_TX - 1 + BR;            // stride engine steps
+    localparam int EW = $clog2(ES + 1);
+    function automatic logic [B-1:0] modadd(input logic [B-1:0] a, input logic [B-1:0] b);
+      logic [B:0] t;
+      t = {1'b0, a} + {1'b0, b};
+      if (t >= {1'b0, NM1}) t = t - {1'b0, NM1};
+      modadd = t[B-1:0];
+    endfunction
+    logic [B-1:0]  ws_q, rs_q, wa_q, ra_q, acc_q, wj_q, rj_q, jacc_q;
+    logic [EW-1:0] e_q;
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        ws_q  <= B'(1);
+        acc_q <= B'(1);
+        e_q   <= '0;
+        wa_q  <= '0;
+        rs_q  <= B'(1);
+        ra_q  <= '0;
+        wj_q   <= JUMP0;
+        jacc_q <= JUMP0;
+        rj_q   <= JUMP0;
+      end else begin
+        if (e_q != EW'(ES)) begin
+          acc_q  <= modadd(acc_q, (e_q < EW'(NUM_TX - 1)) ? ws_q : acc_q);
+          jacc_q <= modadd(jacc_q, (e_q < EW'(NUM_TX - 1)) ? wj_q : jacc_q);
+          e_q    <= e_q + 1'b1;
+        end
+        if (wr_beat) begin
+          wa_q <= (wr_cnt_q == B'(N - 2)) ? NM1 : modadd(wa_q, ws_q);
+          if (wr_frame_end) begin
+            wa_q <= '0;
+            ws_q <= acc_q;          // M^(k+1): the engine finished within the frame
+            wj_q <= jacc_q;
+            e_q  <= '0;
+          end
+        end
+        if (rd_start) begin
+          rs_q <= ws_q;             // already advanced to M^(k+1)
+          rj_q <= wj_q;
+          ra_q <= '0;
+        end else if (rd_issue) begin
+          ra_q <= (rd_cnt_q == B'(N - 2)) ? NM1 :
+                  modadd(ra_q, (SKIP && rd_vec_end) ? rj_q : rs_q);
+        end
+      end
+    end
+    assign ram_wr_addr = wa_q;
+    assign ram_rd_addr = ra_q;
+    assign wr_free     = (wr_cnt_q < rd_cnt_q);
+    logic unused_shift;
+    assign unused_shift = ^{wr_shift_q, rd_shift_q};
+  end else begin : g_bank
+    // READ_ORDER 1, NUM_TX not a power of two: NUM_TX banks of N_RANGE*N_DOPPLER words,
+    // bank t an in-place N_DOPPLER x N_RANGE transpose of TX t's chirps (bank word {d, r}
+    // written at rotl({d, r}, k*BR mod RB), bank word {r, d} read at rotl({r, d},
+    // (k+1)*BR mod RB)). A write waits for its bank's read of the same bank word; with
+    // N_LOOPS < N_DOPPLER each bank skips as the power-of-two scheme does (rd_done counts a
+    // bank row's skipped reads d >= N_LOOPS as done once the reader has passed the row).
+    logic [BD-1:0] wd_q;            // writer chirp index d (r = wr_cnt_q[BR-1:0])
+    logic [BT-1:0] wt_q, rt_q;      // writer / reader TX
+    logic [BR-1:0] rr_q;            // reader range bin (d = rd_cnt_q[BD-1:0])
+    logic [RB:0]   rd_done;         // reads issued in the writer's bank
+    always_ff @(posedge clk) begin
+      if (rst) begin
+        wd_q <= '0;
+        wt_q <= '0;
+        rt_q <= '0;
+        rr_q <= '0;
+      end else begin
+        if (wr_beat && chirp_end) begin
+          wt_q <= (wt_q == BT'(NUM_TX - 1)) ? '0 : wt_q + 1'b1;
+          if (wt_q == BT'(NUM_TX - 1)) wd_q <= wr_frame_end ? '0 : wd_q + 1'b1;
+        end
+        if (rd_issue && rd_vec_end) begin
+          rt_q <= (rt_q == BT'(NUM_TX - 1)) ? '0 : rt_q + 1'b1;
+          if (rt_q == BT'(NUM_TX - 1)) rr_q <= rr_q + 1'b1;
+        end
+      end
+    end
+    always_comb begin
+      rd_done = {1'b0, rr_q, BD'(0)};
+      if (wt_q < rt_q) rd_done = rd_done + (RB+1)'(N_DOPPLER);
+      else if (wt_q == rt_q) rd_done = rd_done + (RB+1)'(rd_cnt_q[BD-1:0]);
+    end
+    assign wr_free     = ({1'b0, wd_q, wr_cnt_q[BR-1:0]} < rd_done);
+    assign ram_wr_addr = {wt_q, rotl({wd_q, wr_cnt_q[BR-1:0]}, wr_shift_q)};
+    assign ram_rd_addr = {rt_q, rotl({rr_q, rd_cnt_q[BD-1:0]}, rd_shift_q)};
   end
+
+  assign rd_frame_end = (rd_cnt_q == RD_LAST);
 
   always_ff @(posedge clk) begin
     p_last_q  <= rd_vec_end;
@@ -235,8 +345,8 @@ module corner_turn #(
         rd_shift_q  <= wr_shift_q;
       end
       if (rd_issue) begin
-        rd_cnt_q <= rd_next;
-        if (rd_cnt_q == RD_LAST) begin
+        rd_cnt_q <= rd_frame_end ? '0 : rd_next;
+        if (rd_frame_end) begin
           rd_active_q  <= 1'b0;
           frames_out_q <= frames_out_q + 1'b1;
         end
@@ -339,7 +449,8 @@ module corner_turn #(
 `else
   // block invariant (in place): never write a slot of the frame being read before reading it
   always_ff @(posedge clk) begin
-    if (!rst && wr_beat && rd_active_q) assert (wr_cnt_q < rd_cnt_q)
+    if (!rst && wr_beat && rd_active_q && (POW2 || READ_ORDER == 0))
+      assert (wr_cnt_q < rd_cnt_q)
       else $error("corner_turn: writer overtook reader");
   end
 `endif

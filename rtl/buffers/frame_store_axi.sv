@@ -14,8 +14,9 @@
 //                                   + (r mod TILE_R)*WORD_B.
 // Write side: each chirp is written as S INCR bursts of one row (TILE_R words, aligned, so
 // never across 4 KiB) straight from a small FIFO. Read side: the frame area is read linearly
-// (INCR bursts of min(4 KiB, group) bytes) into a two-group on-chip buffer, and each group
-// leaves as TILE_R (order 0) or TILE_R*NUM_TX (order 1) Doppler vectors. Frame k+1 is written while frame k is read; the writer
+// (INCR bursts of the largest power of two dividing the group, at most 4 KiB) into a
+// two-group on-chip buffer (each half a power of two of entries), and each group leaves as
+// TILE_R (order 0) or TILE_R*NUM_TX (order 1) Doppler vectors. Frame k+1 is written while frame k is read; the writer
 // starts frame k+2 only once frame k has been read back, the reader starts frame k only once
 // every write of frame k has its BRESP. Memory slower than the input fills the FIFO and
 // drops s_axis_tready: the back-pressure reaches the chirp ping-pong, which drops whole
@@ -23,7 +24,7 @@
 `default_nettype none
 
 module frame_store_axi #(
-  // TX slots (TDM chirps interleaved), power of two, 1..16.
+  // TX slots (TDM chirps interleaved), 1..16.
   parameter int NUM_TX = 1,
   // Receive lanes per word, power of two, 1..16.
   parameter int NUM_RX = 4,
@@ -119,7 +120,7 @@ module frame_store_axi #(
   output logic      [31:0]                   frames_out            // frames completely read out
 );
 
-  // ---- derived sizes (all powers of two) --------------------------------------------------
+  // ---- derived sizes (powers of two, but for NUM_TX's factor) ---------------------------
   localparam int WORD_W  = NUM_RX * 2 * DATA_W;
   localparam int UNIT_W  = (WORD_W > AXI_DATA_W) ? WORD_W : AXI_DATA_W; // on-chip entry
   localparam int WPU     = UNIT_W / WORD_W;       // words per unit
@@ -132,7 +133,8 @@ module frame_store_axi #(
   localparam int     G           = (READ_ORDER == 1) ? NUM_TX : 1;  // strips per group
   localparam longint STRIP_BYTES = WB_BYTES * N_DOPPLER;
   localparam longint GROUP_BYTES = STRIP_BYTES * G;
-  localparam longint RB_BYTES    = (GROUP_BYTES < 4096) ? GROUP_BYTES : 4096; // one read burst
+  localparam longint GROUP_LOW   = GROUP_BYTES & -GROUP_BYTES;       // power-of-two factor
+  localparam longint RB_BYTES    = (GROUP_LOW < 4096) ? GROUP_LOW : 4096; // one read burst
   localparam int     RB_BEATS    = int'(RB_BYTES / AXI_B);
   localparam int     RB_UNITS    = RB_BEATS / BPU;
   localparam int     GROUP_UNITS = int'(GROUP_BYTES * 8 / longint'(UNIT_W));
@@ -144,12 +146,12 @@ module frame_store_axi #(
   localparam int     NGROUPS     = NUM_TX * S / G;                  // groups per frame
 
   localparam int BS  = $clog2(S);
-  localparam int BT  = $clog2(NUM_TX);
+  localparam int BT  = (NUM_TX > 1) ? $clog2(NUM_TX) : 1;
   localparam int BD  = $clog2(N_DOPPLER);
   localparam int BRG = $clog2(N_RANGE);
   localparam int BTR = $clog2(TILE_R);
   localparam int BWPU = $clog2(WPU);
-  localparam int BG  = $clog2(G);
+  localparam int BG  = (G > 1) ? $clog2(G) : 1;
   // counter widths (at least 1 bit)
   localparam int WBW  = (WBURSTS > 1) ? $clog2(WBURSTS) : 1;
   localparam int RBW  = (RBURSTS > 1) ? $clog2(RBURSTS) : 1;
@@ -158,15 +160,16 @@ module frame_store_axi #(
   localparam int BPW_ = (BPU > 1) ? $clog2(BPU) : 1;
   localparam int SIW  = (NGROUPS > 1) ? $clog2(NGROUPS) : 1;
   localparam int OIW  = $clog2(GROUP_WORDS);                        // >= 1 (N_DOPPLER >= 2)
-  localparam int BUF_DEPTH = 2 * GROUP_UNITS;
-  localparam int BUF_AW    = $clog2(BUF_DEPTH);
+  localparam int HALF_AW   = (GROUP_UNITS > 1) ? $clog2(GROUP_UNITS) : 1;
+  localparam int BUF_DEPTH = 2 << HALF_AW;        // two groups, each in 2^HALF_AW entries
+  localparam int BUF_AW    = HALF_AW + 1;
   localparam int CRW       = BUF_AW + 1;
   localparam int OUTW      = $clog2(MAX_OUTSTANDING + 1);
   localparam logic [2:0] AXI_SIZE = 3'($clog2(AXI_DATA_W / 8));
 
   // ---- parameter checks -----------------------------------------------------------------
-  if (NUM_TX < 1 || NUM_TX > 16 || (1 << BT) != NUM_TX) begin : g_bad_num_tx
-    $fatal(1, "frame_store_axi (%m): NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16) begin : g_bad_num_tx
+    $fatal(1, "frame_store_axi (%m): NUM_TX=%0d not in 1..16", NUM_TX);
   end
   if (NUM_RX < 1 || NUM_RX > 16 || (NUM_RX & (NUM_RX - 1)) != 0) begin : g_bad_num_rx
     $fatal(1, "frame_store_axi (%m): NUM_RX=%0d must be a power of two in 1..16", NUM_RX);
@@ -273,15 +276,20 @@ module frame_store_axi #(
   logic            pk_hs, burst_in;
   logic            aw_hs, w_hs, w_end, b_hs, w_ok;
   logic [63:0]     aw_off;
+  // digits of aw_idx_q = (d*NUM_TX + t)*S + s
+  localparam int AWS_W = (BS > 0) ? BS : 1;
+  localparam logic [AWS_W-1:0] AW_S_LAST = AWS_W'(S - 1);   // 0 with one strip (never counts)
+  logic [AWS_W-1:0] aw_s_q;
+  logic [BT-1:0]   aw_t_q;
+  logic [BD-1:0]   aw_d_q;
 
   always_comb begin
-    logic [63:0] idx, s_, t_, d_;
-    idx = 64'(aw_idx_q);
-    s_  = idx & 64'(S - 1);
-    t_  = (idx >> BS) & 64'(NUM_TX - 1);
-    d_  = idx >> (BS + BT);
-    aw_off = ((READ_ORDER == 1 ? ((s_ << BT) + t_) : ((t_ << BS) + s_)) * 64'(N_DOPPLER) + d_)
-             * 64'(WB_BYTES)
+    logic [63:0] s_, t_, d_;
+    s_  = (BS > 0) ? 64'(aw_s_q) : 64'd0;
+    t_  = 64'(aw_t_q);
+    d_  = 64'(aw_d_q);
+    aw_off = ((READ_ORDER == 1 ? (s_ * 64'(NUM_TX) + t_) : (t_ * 64'(S) + s_))
+              * 64'(N_DOPPLER) + d_) * 64'(WB_BYTES)
            + (aw_f_q[0] ? 64'(FRAME_BYTES) : 64'd0);
   end
 
@@ -327,7 +335,7 @@ module frame_store_axi #(
   logic [RBW-1:0]  r_burst_q;
   logic [BPW_-1:0] r_part_q;     // beat within the current unit
   logic [UNIT_W-1:0] r_acc_q;
-  logic [BUF_AW-1:0] buf_wptr_q;
+  logic [BUF_AW-1:0] buf_wptr_q;   // {half, unit within the group}
   logic [1:0]      recv_sc_q;    // strips completely in the buffer (mod 4)
   logic            ar_hs, r_hs, r_end, r_unit, r_last_exp;
   logic [UNIT_W-1:0] r_unit_data;
@@ -386,6 +394,8 @@ module frame_store_axi #(
   // word (t*N_DOPPLER + d)*TILE_R + r of the group (order 0: t = 0)
   // =========================================================================================
   logic [OIW-1:0] o_idx_q;       // (r*G + t)*N_DOPPLER + d within the group
+  logic [BG-1:0]  o_t_q;         // its digits t and r (d = o_idx_q mod N_DOPPLER)
+  logic [BTR > 0 ? BTR - 1 : 0:0] o_r_q;
   logic [SIW-1:0] o_strip_q;     // group within the frame
   logic [1:0]     out_sc_q;      // groups completely read out (mod 4)
   logic           can_issue, o_issue, o_strip_end;
@@ -394,16 +404,15 @@ module frame_store_axi #(
   logic [(BWPU > 0 ? BWPU : 1)-1:0] p_sel_q, p2_sel_q;
 
   always_comb begin
-    logic [31:0] idx, d_, t_, r_;
-    idx = 32'(o_idx_q);
-    d_  = idx & 32'(N_DOPPLER - 1);
-    t_  = (idx >> BD) & 32'(G - 1);
-    r_  = idx >> (BD + BG);
-    o_word = OIW'(((t_ << BD) + d_) * 32'(TILE_R) + r_);
+    logic [31:0] d_, t_, r_;
+    d_  = 32'(o_idx_q) & 32'(N_DOPPLER - 1);
+    t_  = (G > 1) ? 32'(o_t_q) : 32'd0;
+    r_  = (BTR > 0) ? 32'(o_r_q) : 32'd0;
+    o_word = OIW'((t_ * 32'(N_DOPPLER) + d_) * 32'(TILE_R) + r_);
   end
 
   assign o_issue     = (out_sc_q != recv_sc_q) && can_issue;
-  assign o_strip_end = (o_idx_q == '1);
+  assign o_strip_end = (o_idx_q == OIW'(GROUP_WORDS - 1));
   assign ram_rd_en   = o_issue;
   assign ram_rd_addr = {out_sc_q[0], (BUF_AW-1)'(o_word >> BWPU)};
 
@@ -463,6 +472,9 @@ module frame_store_axi #(
       ar_f_q        <= '0;
       r_f_q         <= '0;
       aw_idx_q      <= '0;
+      aw_s_q        <= '0;
+      aw_t_q        <= '0;
+      aw_d_q        <= '0;
       aw_out_q      <= '0;
       w_open_q      <= '0;
       w_beat_q      <= '0;
@@ -471,13 +483,15 @@ module frame_store_axi #(
       avail_q       <= '0;
       ar_idx_q      <= '0;
       ar_out_q      <= '0;
-      credit_q      <= CRW'(BUF_DEPTH);
+      credit_q      <= CRW'(2 * GROUP_UNITS);
       r_beat_q      <= '0;
       r_burst_q     <= '0;
       r_part_q      <= '0;
       buf_wptr_q    <= '0;
       recv_sc_q     <= '0;
       o_idx_q       <= '0;
+      o_t_q         <= '0;
+      o_r_q         <= '0;
       o_strip_q     <= '0;
       out_sc_q      <= '0;
       mem_err_q     <= 1'b0;
@@ -499,7 +513,15 @@ module frame_store_axi #(
       avail_q <= avail_q + AVW'(burst_in) - AVW'(aw_hs);
       if (aw_hs) begin
         aw_idx_q <= aw_idx_q + 1'b1;
-        if (aw_idx_q == WBW'(WBURSTS - 1)) aw_f_q <= aw_f_q + 1'b1;
+        if (aw_idx_q == WBW'(WBURSTS - 1)) begin
+          aw_idx_q <= '0;
+          aw_f_q   <= aw_f_q + 1'b1;
+        end
+        if (aw_s_q == AW_S_LAST) begin
+          aw_t_q <= (aw_t_q == BT'(NUM_TX - 1)) ? '0 : aw_t_q + 1'b1;
+          if (aw_t_q == BT'(NUM_TX - 1)) aw_d_q <= aw_d_q + 1'b1;
+        end
+        if (BS > 0) aw_s_q <= aw_s_q + 1'b1;
       end
       aw_out_q <= aw_out_q + OUTW'(aw_hs) - OUTW'(b_hs);
       w_open_q <= w_open_q + $signed((WBW+2)'(aw_hs)) - $signed((WBW+2)'(w_end));
@@ -507,6 +529,7 @@ module frame_store_axi #(
       if (b_hs) begin
         b_idx_q <= b_idx_q + 1'b1;
         if (b_idx_q == WBW'(WBURSTS - 1)) begin
+          b_idx_q     <= '0;
           b_f_q       <= b_f_q + 1'b1;
           frames_in_q <= frames_in_q + 1'b1;
         end
@@ -514,7 +537,7 @@ module frame_store_axi #(
 
       // ---- AR / R
       if (ar_hs) begin
-        ar_idx_q <= ar_idx_q + 1'b1;
+        ar_idx_q <= (ar_idx_q == RBW'(RBURSTS - 1)) ? '0 : ar_idx_q + 1'b1;
         if (ar_idx_q == RBW'(RBURSTS - 1)) ar_f_q <= ar_f_q + 1'b1;
       end
       ar_out_q <= ar_out_q + OUTW'(ar_hs) - OUTW'(r_end);
@@ -525,17 +548,24 @@ module frame_store_axi #(
         if (BPU > 1) r_part_q <= r_part_q + 1'b1;
       end
       if (r_end) begin
-        r_burst_q <= r_burst_q + 1'b1;
+        r_burst_q <= (r_burst_q == RBW'(RBURSTS - 1)) ? '0 : r_burst_q + 1'b1;
         if (r_burst_q == RBW'(RBURSTS - 1)) r_f_q <= r_f_q + 1'b1;
       end
       if (r_unit) begin
         buf_wptr_q <= buf_wptr_q + 1'b1;
-        if (buf_wptr_q[BUF_AW-2:0] == '1) recv_sc_q <= recv_sc_q + 1'b1;
+        if (buf_wptr_q[BUF_AW-2:0] == (BUF_AW-1)'(GROUP_UNITS - 1)) begin
+          buf_wptr_q <= {~buf_wptr_q[BUF_AW-1], (BUF_AW-1)'(0)};
+          recv_sc_q  <= recv_sc_q + 1'b1;
+        end
       end
 
       // ---- output
       if (o_issue) begin
-        o_idx_q <= o_idx_q + 1'b1;
+        o_idx_q <= o_strip_end ? '0 : o_idx_q + 1'b1;
+        if ((o_idx_q & OIW'(N_DOPPLER - 1)) == OIW'(N_DOPPLER - 1)) begin
+          o_t_q <= (o_t_q == BG'(G - 1)) ? '0 : o_t_q + 1'b1;
+          if (o_t_q == BG'(G - 1)) o_r_q <= o_r_q + 1'b1;
+        end
         if (o_strip_end) begin
           out_sc_q  <= out_sc_q + 1'b1;
           o_strip_q <= (o_strip_q == SIW'(NGROUPS - 1)) ? '0 : o_strip_q + 1'b1;
@@ -598,7 +628,7 @@ module frame_store_axi #(
       if (m_axi_mem_arvalid)
         assert ({1'b0, m_axi_mem_araddr[11:0]} + 13'(RB_BYTES) <= 13'h1000)
           else $error("frame_store_axi: read burst crosses 4 KiB");
-      if (r_unit) assert (credit_q <= CRW'(BUF_DEPTH))
+      if (r_unit) assert (credit_q <= CRW'(2 * GROUP_UNITS))
         else $error("frame_store_axi: group buffer over-reserved");
     end
   end

@@ -15,7 +15,7 @@
 `default_nettype none
 
 module detect_chain #(
-  // TDM transmit slots, power of two, 1..16.
+  // TDM transmit slots, 1..16.
   parameter int NUM_TX = 1,
   // Receive lanes per word (32-bit {Q,I}), 1..64.
   parameter int NUM_RX = 4,

@@ -19,7 +19,7 @@
 `default_nettype none
 
 module detect_records #(
-  // TDM transmit slots, power of two, 1..16.
+  // TDM transmit slots, 1..16.
   parameter int NUM_TX = 1,
   // Receive lanes per word (32-bit {Q,I} each), 1..64.
   parameter int NUM_RX = 4,
@@ -81,9 +81,8 @@ module detect_records #(
   localparam int TS_W   = (NUM_TX > 1) ? $clog2(NUM_TX) : 1;
 
   // Parameter checks: stop elaboration on illegal values.
-  if (NUM_TX < 1 || NUM_TX > 16 || (1 << $clog2(NUM_TX)) != NUM_TX) begin : g_bad_num_tx
-    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16",
-           NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16) begin : g_bad_num_tx
+    $fatal(1, "%m: NUM_TX=%0d not in 1..16", NUM_TX);
   end
   if (NUM_RX < 1 || NUM_RX > 64) begin : g_bad_num_rx
     $fatal(1, "%m: NUM_RX=%0d not in 1..64", NUM_RX);
@@ -116,7 +115,8 @@ module detect_records #(
   end
 
   // ---------------------------------------------------------------------------------------
-  // Snapshot ring: address {global row mod SNAP_ROWS, t, d}
+  // Snapshot ring: address {global row mod SNAP_ROWS, t, d} (t in clog2(NUM_TX) bits: a TX
+  // count that is not a power of two leaves slots t >= NUM_TX of each row unused)
   logic [G_W-1:0] wg_q, rg_q;          // writer / reader global range rows
   logic [BD-1:0]  wd_q;
   logic [TS_W-1:0] wt_q;

@@ -246,8 +246,8 @@ module radar_pipeline #(
   if (NUM_RX < 1 || NUM_RX > 16) begin : g_bad_num_rx
     $fatal(1, "%m: NUM_RX=%0d not in 1..16", NUM_RX);
   end
-  if (NUM_TX < 1 || NUM_TX > 16 || (NUM_TX & (NUM_TX - 1)) != 0) begin : g_bad_num_tx
-    $fatal(1, "%m: NUM_TX=%0d must be a power of two in 1..16", NUM_TX);
+  if (NUM_TX < 1 || NUM_TX > 16) begin : g_bad_num_tx
+    $fatal(1, "%m: NUM_TX=%0d not in 1..16", NUM_TX);
   end
   if (N_RANGE < 16 || N_RANGE > 4096 || (N_RANGE & (N_RANGE - 1)) != 0)
   begin : g_bad_n_range

@@ -222,6 +222,7 @@ PARAMS = [
     # of a truncated frame leaves out_q on the frame's last word while cells still come in
     # (mutant detect_records:count:0 miscounts the detections past MAX_DETECTIONS there)
     _params(4, 16, 8, 16, 4),   # one-word headers, 4-word snapshots
+    _params(3, 2, 8, 8, 3),     # 3 TX (xWR1843): 3-word snapshots, TX wrap at 2
 ]
 
 

@@ -402,6 +402,13 @@ PARAMS = [
     # READ_ORDER 1 with 4 words per beat (one 32-bit lane) and 2 TX: 256-byte groups
     dict(NUM_TX=2, NUM_RX=1, N_RANGE=8, N_DOPPLER=8, TILE_R=4, AXI_DATA_W=128,
          MAX_OUTSTANDING=2, WFIFO_DEPTH=4, MEM_BASE=0x0, READ_ORDER=1),
+    # 3 TX (xWR1843), cube order: 12 KiB frame areas, 4-beat rows
+    dict(NUM_TX=3, NUM_RX=4, N_RANGE=16, N_DOPPLER=16, TILE_R=4, AXI_DATA_W=128,
+         MAX_OUTSTANDING=4, WFIFO_DEPTH=16, MEM_BASE=0x1000),
+    # 3 TX, READ_ORDER 1: 384-byte groups read in 128-byte bursts into 32-entry halves,
+    # 768-byte frame areas (the second one not 4 KiB aligned)
+    dict(NUM_TX=3, NUM_RX=1, N_RANGE=8, N_DOPPLER=8, TILE_R=4, AXI_DATA_W=128,
+         MAX_OUTSTANDING=2, WFIFO_DEPTH=4, MEM_BASE=0x0, READ_ORDER=1),
 ]
 
 
@@ -423,6 +430,11 @@ MODEL_GEOMETRIES = [
     dict(num_tx=4, num_rx=4, n_range=16, n_doppler=32, tile_r=4, read_order=1),
     dict(num_tx=2, num_rx=1, n_range=8, n_doppler=8, tile_r=4, read_order=1),
     dict(num_tx=4, num_rx=16, n_range=256, n_doppler=256, tile_r=4,            # full, mode 1
+         axi_data_w=512, read_order=1),
+    dict(num_tx=3, num_rx=4, n_range=16, n_doppler=16, tile_r=4),              # 3 TX
+    dict(num_tx=3, num_rx=1, n_range=8, n_doppler=8, tile_r=4, read_order=1),
+    dict(num_tx=3, num_rx=4, n_range=8, n_doppler=64, tile_r=4, read_order=1),  # 12 KiB groups
+    dict(num_tx=3, num_rx=4, n_range=256, n_doppler=128, tile_r=4,             # xWR1843, mode 1
          axi_data_w=512, read_order=1),
 ]
 
