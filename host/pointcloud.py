@@ -18,7 +18,8 @@ A :class:`PointCloud` holds parallel numpy arrays of shape (n,), one entry per p
 JSON (``to_json_dict``, read back by ``from_json_dict``) follows docs/design.md 4.4:
 ``{"preset", "frames", "points": [...]}`` with the required fields range_m, azimuth_deg,
 radial_velocity_mps, x_m, y_m, power_db, snr_db plus the extra ones, and z_m and
-elevation_deg when the array has vertical extent (``elevation``).
+elevation_deg when the radar's array has vertical extent (every writer passes its
+``RadarConfig``, so the rule is applied here only).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from model.array import cartesian
+from model.array import cartesian, has_vertical_extent
+from model.config import RadarConfig
 
 FLOAT_FIELDS = ("range_m", "azimuth_deg", "radial_velocity_mps", "x_m", "y_m", "vx_mps",
                 "vy_mps", "power_db", "snr_db", "rcs_dbsm")
@@ -133,12 +135,19 @@ class PointCloud:
             out.append(rec)
         return out
 
-    def to_json_dict(self, preset: str, frames: int, clipped_frames: Collection[int] = (),
-                     elevation: bool = False) -> dict[str, Any]:
-        """The point cloud JSON object; points of ``clipped_frames`` carry ``"clipped":
-        true`` (harmonics of a clipped echo can be false points); ``elevation`` (the array
-        has vertical extent, ``model.array.has_vertical_extent``): z_m and elevation_deg."""
-        return {"preset": preset, "frames": int(frames),
+    def to_json_dict(self, radar: RadarConfig | str, frames: int,
+                     clipped_frames: Collection[int] = ()) -> dict[str, Any]:
+        """The point cloud JSON object of the points of ``radar``: the configuration they
+        came from (its name is the JSON's "preset"; when its virtual array has vertical
+        extent, ``model.array.has_vertical_extent``, every point carries z_m and
+        elevation_deg), or only a radar's name (no configuration known: planar points).
+        Points of ``clipped_frames`` carry ``"clipped": true`` (harmonics of a clipped echo
+        can be false points)."""
+        if isinstance(radar, str):
+            name, elevation = radar, False
+        else:
+            name, elevation = radar.name, has_vertical_extent(radar.virtual_positions_hw)
+        return {"preset": name, "frames": int(frames),
                 "points": self.records(clipped_frames, elevation)}
 
     @classmethod

@@ -167,14 +167,14 @@ def test_permuted_firing_order_gives_the_same_points(order: tuple[int, ...]) -> 
 
 
 def test_elevation_in_json_ros_and_figures() -> None:
-    """z_m and elevation_deg in the JSON only when asked (an array with vertical extent),
+    """z_m and elevation_deg in the JSON only for an array with vertical extent,
     read back; the ROS point's z and elevation; the range-azimuth map of a 2-D array."""
     cfg = xwr1843()
     cloud = process_cube(synth_cube(cfg, SCENE, np.random.default_rng(2)), cfg,
                          DetectionParams(max_speed_mps=cfg.max_speed_mps))
     planar = cloud.to_json_dict("x", 1)["points"]
     assert "z_m" not in planar[0] and "elevation_deg" not in planar[0]
-    doc = json.loads(json.dumps(cloud.to_json_dict("x", 1, elevation=True)))
+    doc = json.loads(json.dumps(cloud.to_json_dict(cfg, 1)))
     assert {"z_m", "elevation_deg"} <= set(doc["points"][0])
     back = PointCloud.from_json_dict(doc)
     np.testing.assert_allclose(back.elevation_deg, cloud.elevation_deg, atol=1e-4)

@@ -140,7 +140,7 @@ def _demo(args: argparse.Namespace, gnn: GnnWorker | None, scene: Scene, source:
                                  f"{cfg.name}: Table I point cloud" + (
                                      " and GNN objects" if objects else ""),
                                  truth_xy(scene, "V"), object_boxes(objects), missed))
-    doc = cloud.to_json_dict(cfg.name, 1, [0] if adc.saturated else [])
+    doc = cloud.to_json_dict(cfg, 1, [0] if adc.saturated else [])
     doc.update({"ego_speed_mps": ego, "objects": objects,
                 "frame_info": [{"frame": 0, "points": len(cloud), "clipped": adc.saturated,
                                 "damaged": False}]})

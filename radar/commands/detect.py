@@ -177,7 +177,7 @@ def cmd_detect(args: argparse.Namespace) -> int:
     warn_clipped(clipped, "detect")
     cloud = PointCloud.concat(clouds)
     done = len(per_frame) if stopped else args.frames
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped)
+    doc: dict[str, Any] = cloud.to_json_dict(cfg, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "remove_static": args.remove_static,
                 "scene": scene.name, **({"radar": profile.source} if args.radar else {}),

@@ -227,7 +227,7 @@ def cmd_receive(args: argparse.Namespace) -> int:
     finally:
         close_recording(rec)
     cloud = PointCloud.concat(clouds)
-    doc = cloud.to_json_dict(cfg.name if cfg else "unknown", len(frames))
+    doc = cloud.to_json_dict(cfg or "unknown", len(frames))
     doc.update({"backend": "udp", "detect": args.detect,
                 "packet_words": decoder.packet_words if decoder else None,
                 "datagrams": rx.datagrams, "interrupted": rx.interrupted,

@@ -32,7 +32,6 @@ from host.dca1000 import Dca1000Capture
 from host.params import GROUPINGS, DetectionParams
 from host.pointcloud import PointCloud
 from host.ros.messages import FrameStatus
-from model.array import has_vertical_extent
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.hdl import DATA_W
@@ -293,8 +292,7 @@ def cmd_process(args: argparse.Namespace) -> int:
     warn_clipped(clipped, "process")
     done = len(per_frame)
     cloud = PointCloud.concat(clouds)
-    doc: dict[str, Any] = cloud.to_json_dict(cfg.name, done, clipped,
-                                             has_vertical_extent(cfg.virtual_positions_hw))
+    doc: dict[str, Any] = cloud.to_json_dict(cfg, done, clipped)
     doc.update({"backend": args.backend, "detector": args.detector, "detect": args.detect,
                 "radar": profile.source,
                 "capture": str(args.capture), "remove_static": args.remove_static,
