@@ -107,16 +107,18 @@ def reflector_range_error(range_m: float, cfg: RadarConfig) -> str | None:
 def estimate_calibration(cubes: Iterable[np.ndarray], cfg: RadarConfig, range_m: float,
                          azimuth_deg: float = 0.0, elevation_deg: float = 0.0) -> Estimate:
     """The calibration of ``cfg``'s array from radar cubes (complex (n_virtual,
-    n_range_bins, n_doppler), ``model.reference.radar_cube``, no static-clutter removal)
-    of one reflector at ``range_m`` and (azimuth, elevation) in deg (module docstring).
-    ValueError (one line) when the range is outside the profile's or no frame is given."""
+    n_range_bins, n_doppler), ``model.reference.radar_cube`` or its fast equivalent
+    ``host.cube.frame_cube``, complex64 as ``radar calibrate`` makes them; both windows on,
+    no static-clutter removal) of one reflector at ``range_m`` and (azimuth, elevation) in
+    deg (module docstring). ValueError (one line) when the range is outside the profile's or
+    no frame is given."""
     why = reflector_range_error(range_m, cfg)
     if why:
         raise ValueError(f"reflector: {why}")
     zero = []                                    # each frame's zero-Doppler (n_v, n_rb)
     for cube in cubes:
         cfg.check_cube(cube)
-        zero.append(np.array(cube[:, :, 0]))
+        zero.append(np.array(cube[:, :, 0], dtype=np.complex128))
     if not zero:
         raise ValueError("capture: no frames to calibrate from")
     power = sum(np.sum(np.abs(z) ** 2, axis=0) for z in zero)

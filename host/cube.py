@@ -14,8 +14,9 @@ mean c = sum(w x) / sum(w)) is linear too, and done after the FFT: the Doppler F
 w (x - c) is Y[k] - c W[k] / n_doppler with W the DFT of the window (zero-padded to
 n_doppler), and Y[0] = c W[0] / n_doppler, so it is Y[k] - Y[0] W[k] / W[0]
 (:func:`_static_response`): a few bins touched instead of two passes over the samples (all
-of them for an unwindowed zero-padded axis, whose W is dense). ``radar process`` builds its
-cubes here in single precision (``radar.commands.process.capture_frame_cloud``), as do
+of them for an unwindowed zero-padded axis, whose W is dense). ``radar process`` and ``radar
+calibrate`` build their cubes here in single precision (``radar.commands.process.
+capture_cube``), as do
 ``host.pipeline.process_frame`` and the float frame source (``radar.sources``) in double;
 the tests hold it to the reference.
 """

@@ -17,8 +17,7 @@ from host.calibration import (
     reflector_range_error,
     save_calibration,
 )
-from model.reference import radar_cube
-from radar.commands.process import capture_of, profile_of
+from radar.commands.process import capture_cube, capture_of, profile_of
 from radar.common import CliError, add_command, out_file, progress, warn
 
 
@@ -51,7 +50,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     capture, frames = capture_of(args, profile, "calibrate")
     t0 = time.perf_counter()
     try:
-        est = estimate_calibration((radar_cube(capture.frame(k), cfg) for k in
+        est = estimate_calibration((capture_cube(capture.frame(k), cfg) for k in
                                     progress(frames, "frames")), cfg, *reflector)
     except ValueError as exc:
         raise CliError(str(exc)) from None

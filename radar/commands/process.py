@@ -188,15 +188,22 @@ def scaled_for(source: FrameSource, cfg: RadarConfig, peak: float) -> FrameSourc
     return get_source(source.name, replace(source.chain, range_scale_sch=sch))
 
 
+def capture_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
+                 doppler_window: bool = True, remove_static: bool = False) -> np.ndarray:
+    """The one way the commands make a cube of a capture's ADC frame (``radar process``,
+    ``radar calibrate``): complex (or real) (chirps in firing order, rx, samples) codes ->
+    the float reference's cube (``model.reference.radar_cube``), computed fast by
+    ``host.cube.frame_cube`` in single precision: complex64 (n_virtual, n_range_bins,
+    n_doppler), within ``host.cube.SINGLE_RTOL`` of it; static clutter removed if asked."""
+    return frame_cube(adc, cfg, range_window, doppler_window,
+                      remove_static_clutter=remove_static, single=True)
+
+
 def capture_frame_cloud(adc: np.ndarray, cfg: RadarConfig, params: DetectionParams,
                         frame_id: int, remove_static: bool) -> FrameCloud:
-    """One ADC frame of a capture, complex (or real) (chirps in firing order, rx, samples)
-    codes, -> its cube (the float reference's, ``model.reference.radar_cube``, computed fast
-    by ``host.cube.frame_cube`` in single precision: complex64, within ``host.cube.
-    SINGLE_RTOL`` of it; static clutter removed if asked) and point cloud
+    """One ADC frame of a capture (:func:`capture_cube`) -> its cube and point cloud
     (``radar.frame_cloud``), as ``radar process`` does."""
-    cube = frame_cube(adc, cfg, params.range_window, params.doppler_window,
-                      remove_static_clutter=remove_static, single=True)
+    cube = capture_cube(adc, cfg, params.range_window, params.doppler_window, remove_static)
     return frame_cloud(cube, cfg, params, frame_id, "process")
 
 
