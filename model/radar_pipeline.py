@@ -45,9 +45,9 @@ from model.config import RadarConfig
 from model.corner_turn import corner_turn
 from model.detect_chain import DetectConfig, detect_stream
 from model.fft_axis import fft_fixed_planar, from_planar, to_planar
+from model.fft_rom import COEF_FRAC, hann_window
 from model.frame_store_axi import StoreGeometry, store_frames
 from model.hdl import DATA_W, check_hdl, hdl_parameters
-from model.reference import hann_periodic
 from model.static_removal import remove_static_planar
 
 RANGE_SCALE_SCH = 0xFFF
@@ -222,11 +222,16 @@ def range_scale_for_peak(cfg: RadarConfig, peak: float, params: PipelineParams |
     and its Doppler schedule) within the DATA_W-bit cube, so no such frame can saturate;
     :data:`RANGE_SCALE_SCH` (every stage, the default) when even that is needed. A capture
     far below full scale (the OpenRadar frame peaks at 265 of 32767) then keeps its noise
-    above the rounding instead of a cube of zeros (docs/profiles.md)."""
+    above the rounding instead of a cube of zeros (docs/profiles.md). The worst case sums
+    the samples that exist: n_samples of n_range along range and n_loops of n_doppler along
+    Doppler (zero fill adds nothing), each weighted by the chain's window over its own count
+    (``model.fft_rom.hann_window``) or 1 without windows."""
     params = params or PipelineParams()
-    mean_w = (hann_periodic(cfg.n_range).mean() * hann_periodic(cfg.n_doppler).mean()
-              if params.window else 1.0)
-    limit = (2 ** (DATA_W - 1) - 1) / (max(float(peak), 1.0) * np.sqrt(2.0) * mean_w)
+    gain = 1.0                  # the worst tone's bin over peak, through the 1/N-scaled FFTs
+    for n_in, n_fft in ((cfg.n_samples, cfg.n_range), (cfg.n_loops, cfg.n_doppler)):
+        w_sum = hann_window(n_in).sum() / 2**COEF_FRAC if params.window else n_in
+        gain *= w_sum / n_fft
+    limit = (2 ** (DATA_W - 1) - 1) / (max(float(peak), 1.0) * np.sqrt(2.0) * gain)
     stages = cfg.n_range.bit_length() - 1
     for halved in range(stages):
         sch = (1 << halved) - 1

@@ -14,6 +14,8 @@ import pytest
 
 from host.adc_capture import open_capture, write_npy
 from model.array import slot_channels
+from model.config import RadarConfig
+from model.hdl import hdl_unsupported
 from model.profile import load_profile, profile_from_toml, profile_to_toml
 from model.radar_pipeline import RANGE_SCALE_SCH, PipelineParams, range_scale_for_peak, run_chain
 from model.scene import Scatterers
@@ -94,6 +96,31 @@ def test_range_scale_for_the_capture_level():
     assert np.abs(out.payload.real).max() == 16000
     less = run_chain(worst, cfg, PipelineParams(range_scale_sch=sch >> 2))
     assert less.doppler_overflow > 0
+
+
+ZERO_FILLED = RadarConfig(name="zero-filled", num_tx=2, num_rx=4, n_range=64, n_doppler=16,
+                          sample_rate_hz=10e6, chirp_period_s=40e-6, design_max_range_m=3.0,
+                          sweep_bandwidth_hz=1.5e9, samples_per_chirp=50, loops=15)
+"""50 samples of a 64-point range FFT, 15 loops of a 16-point Doppler FFT (window ROMs of
+both counts exist: ``model.fft_rom.WINDOW_LENGTHS``)."""
+
+
+@pytest.mark.parametrize("window,peak", [(True, 1500), (True, 7000), (False, 200),
+                                         (False, 1500)])
+def test_range_scale_for_a_zero_filled_profile(window, peak):
+    """Zero fill adds nothing to a tone: the worst case sums the samples and loops that
+    exist (each axis' window over its own count), so the schedule is the tightest one: the
+    worst frame of the peak (constant peak on I and Q) does not saturate, and with one
+    stage fewer halved it does (a bound over the FFT lengths, 64 / 50 x 16 / 15 = 1.37 too
+    high, halves one stage more at these peaks)."""
+    assert not hdl_unsupported(ZERO_FILLED)
+    worst = np.full(ZERO_FILLED.adc_shape, peak + 1j * peak, np.complex64)
+    sch = range_scale_for_peak(ZERO_FILLED, peak, PipelineParams(window=window))
+    out = run_chain(worst, ZERO_FILLED, PipelineParams(window=window, range_scale_sch=sch))
+    assert out.range_overflow == out.doppler_overflow == 0
+    less = run_chain(worst, ZERO_FILLED, PipelineParams(window=window,
+                                                        range_scale_sch=sch >> 1))
+    assert less.range_overflow + less.doppler_overflow > 0
 
 
 def test_model_detect_fpga_on_the_real_frame(tmp_path):
