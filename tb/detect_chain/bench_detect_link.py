@@ -1,5 +1,5 @@
 """Link budget of the detection records (OUTPUT_MODE = 1) against the cube (mode 0): bytes per
-frame and Mbit/s at the radar's frame rate, with the axis_packetizer header words.
+frame and Mbit/s at the radar's frame rate, with the axis_packetizer header and CRC words.
 
 Usage: python tb/detect_chain/bench_detect_link.py [--fps 111] [--packet-words 256]
 Prints a table; the record layout comes from model/detect_records.py.
@@ -9,14 +9,18 @@ from __future__ import annotations
 
 import argparse
 
+import numpy as np
+
 from model import detect_records as dr
-from model.axis_packetizer import packets_per_frame
+from model.axis_packetizer import packetize, words_to_bytes
 from model.config import PRESETS
 
 
 def link_bytes(words: int, num_rx: int, packet_words: int) -> int:
-    """Bytes on the link for ``words`` payload words cut into headed packets."""
-    return (words + packets_per_frame(words, packet_words)) * num_rx * 4
+    """Bytes on the link for ``words`` payload words cut into packets as the RTL sends them
+    (``model.axis_packetizer.packetize``: a header word, the payload, a CRC word each)."""
+    return sum(len(words_to_bytes(p)) for p in packetize(
+        np.zeros((words, num_rx), np.uint32), packet_words))
 
 
 def main() -> None:
