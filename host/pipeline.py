@@ -44,7 +44,7 @@ import numpy as np
 from host.cells import Cells, peak_offsets
 from host.cfar import (
     CfarParams,
-    cfar_threshold,
+    cfar_detect,
     detection_mask,
     local_peaks,
     paper_threshold,
@@ -66,7 +66,8 @@ GROUPING_SIZE = {"peak": (3, 3), "doppler": (1, 3)}
 def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
              params: DetectionParams) -> np.ndarray:
     """``mask`` (bool (n_range, n_doppler)) less the cells whose ``power`` is not
-    ``params.min_snr_db`` above ``noise`` (both float of that shape); unchanged if None."""
+    ``params.min_snr_db`` above ``noise`` (both float of that shape; ``noise`` is read at
+    the mask's cells only); unchanged if None."""
     if params.min_snr_db is None:
         return mask
     return mask & (power > noise * 10.0 ** (params.min_snr_db / 10.0))
@@ -94,9 +95,8 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     else:
         if params.detector == "ca":
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
-        threshold, noise_map = cfar_threshold(nci, cfg.n_virtual, cf, windowed)
-        cells = local_peaks(nci, _min_snr(nci > threshold, nci, noise_map, params), size,
-                            mirrored)
+        detected, noise_map = cfar_detect(nci, cfg.n_virtual, cf, windowed)
+        cells = local_peaks(nci, _min_snr(detected, nci, noise_map, params), size, mirrored)
     ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]
     if params.sidelobe_margin_db is not None and len(cells):
