@@ -7,8 +7,8 @@ cells. Two kernels, both on the map padded by the window's half extent (``host.c
 - :func:`os_kth`: x_(k) of every cell (``host.cfar.cfar_threshold``'s maps): per cell the
   training cells gathered and the k-th found from the previous cell's x_(k), which the
   heavily overlapping windows of neighbours keep a few ranks away (:func:`_kth_near`: the
-  guess's rank counted, then one scan for the value that many ranks away; a quickselect,
-  :func:`_select`, when it is far).
+  guess's rank counted, then the value that many ranks away found without data-dependent
+  branches; a quickselect, :func:`_select`, when it is far).
 - :func:`os_detect`: whether at least k training cells x of a cell have fl(alpha x) < the
   cell's power p. Multiplying by a positive alpha in floating point is monotone (x <= y
   gives fl(alpha x) <= fl(alpha y)), so p > fl(alpha x_(k)), the threshold test, holds
@@ -70,12 +70,14 @@ guess (else it selects)."""
 
 
 @njit()
-def _kth_near(buf: np.ndarray, n: int, k: int, guess: float, best: np.ndarray) -> float:
+def _kth_near(buf: np.ndarray, n: int, k: int, guess: float, side: np.ndarray) -> float:
     """The k-th smallest (k 0-based) of buf[:n] (float64), near ``guess`` (NaN: none): the
-    ranks of ``guess`` counted (less, equal); when the k-th is at most :data:`NEAR_RANKS`
+    ranks of ``guess`` counted (less, equal); when the k-th is j <= :data:`NEAR_RANKS`
     ranks above (below) them, it is the j-th smallest value above (largest below) the
-    guess, found in one scan that keeps the j best in ``best`` (float64 (NEAR_RANKS,),
-    scratch, sorted); else :func:`_select` (which may rearrange buf)."""
+    guess: those values gathered into ``side`` (float64 (n,), scratch; negated below) and
+    the minimum taken out j times, all without data-dependent branches (a scan that
+    inserts into a sorted list mispredicts on every other value); else :func:`_select`
+    (which may rearrange buf)."""
     if guess == guess:
         less, equal = 0, 0
         for i in range(n):
@@ -87,20 +89,24 @@ def _kth_near(buf: np.ndarray, n: int, k: int, guess: float, best: np.ndarray) -
         above = k >= less + equal
         j = k - less - equal + 1 if above else less - k
         if j <= NEAR_RANKS:
-            sign = 1.0 if above else -1.0          # below: the same scan on -v
+            sign = 1.0 if above else -1.0          # below: the same on -v
             g = sign * guess
-            best[:j] = np.inf
-            bound = np.inf                         # best[j - 1]
+            m = 0
             for i in range(n):
                 v = sign * buf[i]
-                if v < bound and v > g:            # (rarely true once j are held)
-                    q = j - 1                      # insert v among the j best
-                    while q > 0 and best[q - 1] > v:
-                        best[q] = best[q - 1]
-                        q -= 1
-                    best[q] = v
-                    bound = best[j - 1]
-            return sign * bound
+                side[m] = v
+                m += v > g
+            value = 0.0
+            for _ in range(j):
+                value = np.inf
+                at = 0
+                for i in range(m):
+                    v = side[i]
+                    at = i if v < value else at
+                    value = v if v < value else value
+                m -= 1
+                side[at] = side[m]
+            return sign * value
     return _select(buf, n, k, guess)
 
 
@@ -137,13 +143,13 @@ def os_kth(padded: np.ndarray, guard_r: int, guard_d: int, train_r: int, train_d
     nr, nd = padded.shape[0] - 2 * pr, padded.shape[1] - 2 * pd
     n = (2 * pr + 1) * (2 * pd + 1) - (2 * guard_r + 1) * (2 * guard_d + 1)
     buf = np.empty(n)
-    best = np.empty(NEAR_RANKS)
+    side = np.empty(n)
     out = np.empty((nr, nd))
     guess = np.nan
     for r in range(nr):
         for d in range(nd):
             _gather(padded, r, d, guard_r, guard_d, train_r, train_d, buf)
-            guess = _kth_near(buf, n, k - 1, guess, best)
+            guess = _kth_near(buf, n, k - 1, guess, side)
             out[r, d] = guess
         guess = out[r, 0]                   # the next row starts beside this one's first
     return out
@@ -215,12 +221,12 @@ def os_kth_at(padded: np.ndarray, rows: np.ndarray, cols: np.ndarray, guard_r: i
     pr, pd = guard_r + train_r, guard_d + train_d
     n = (2 * pr + 1) * (2 * pd + 1) - (2 * guard_r + 1) * (2 * guard_d + 1)
     buf = np.empty(n)
-    best = np.empty(NEAR_RANKS)
+    side = np.empty(n)
     out = np.empty(len(rows))
     guess = np.nan                           # the previous cell's: often a neighbour
     for i in range(len(rows)):
         _gather(padded, rows[i], cols[i], guard_r, guard_d, train_r, train_d, buf)
-        guess = _kth_near(buf, n, k - 1, guess, best)
+        guess = _kth_near(buf, n, k - 1, guess, side)
         out[i] = guess
     return out
 
