@@ -2,7 +2,8 @@
 training cells, ``host.cfar._kernel``'s window), exact.
 
 The OS-CFAR's threshold of a cell is alpha x_(k), x_(k) the k-th smallest of its n training
-cells. Two kernels, both on the map padded by the window's half extent (``host.cfar._pad``):
+cells. Two ways to it, both on the map padded by the window's half extent (``host.cfar._pad``,
+C order: the kernels read rows):
 
 - :func:`os_kth`: x_(k) of every cell (``host.cfar.cfar_threshold``'s maps): per cell the
   training cells gathered and the k-th found from the previous cell's x_(k), which the

@@ -23,7 +23,8 @@ Windowed FFTs correlate neighbouring cells (periodic Hann: adjacent-bin power co
 4/9, next 1/36), which makes the training mean noisier; the factor uses the effective
 number of independent cells N_eff = N^2 / sum_ij rho_ij^2 (exact variance of the mean) so
 the configured Pfa holds with windows on. OS-CFAR uses the k-th smallest training cell;
-its factor solves Pfa = E[P(X > alpha * Y_(k))] numerically.
+its factor solves Pfa = E[P(X > alpha * Y_(k))] numerically; it is computed by the compiled
+backend ``host._cfar_os`` (:func:`cfar_detect` finds the k-th at the detected cells only).
 """
 
 from __future__ import annotations
