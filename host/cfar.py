@@ -23,7 +23,8 @@ Windowed FFTs correlate neighbouring cells (periodic Hann: adjacent-bin power co
 4/9, next 1/36), which makes the training mean noisier; the factor uses the effective
 number of independent cells N_eff = N^2 / sum_ij rho_ij^2 (exact variance of the mean) so
 the configured Pfa holds with windows on. OS-CFAR uses the k-th smallest training cell;
-its factor solves Pfa = E[P(X > alpha * Y_(k))] numerically.
+its factor solves Pfa = E[P(X > alpha * Y_(k))] numerically; it is computed by the compiled
+backend ``host._cfar_os`` (:func:`cfar_detect` finds the k-th at the detected cells only).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from functools import lru_cache
 import numpy as np
 from scipy import stats
 
+from host._cfar_os import os_detect, os_kth, os_kth_at, os_scaled
 from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
@@ -49,7 +51,8 @@ Windows = tuple[bool | FftAxis, bool | FftAxis]
 the chain's axes (``model.reference.fft_axes``)."""
 
 OS_MAX_ELEMENTS = 2 * 10**8
-"""OS-CFAR holds (cells x training cells) values at once: bound on that product."""
+"""Bound on an OS-CFAR's work, (cells x training cells) values selected from (``host.
+_cfar_os``): about a second at the bound."""
 MAX_WINDOW_CELLS = 2048
 """Largest guard or training extent per side (half the largest FFT the core supports)."""
 
@@ -216,25 +219,71 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     """
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
-    kernel = _kernel(params)
-    n_train = int(kernel.sum())
     mirrored = map_axes(windowed, power.shape)[0].real
+    (gr, gd), (tr, td) = params.guard, params.train
     if params.kind == "ca":
         check_window(params, power.shape)
-        (gr, gd), (tr, td) = params.guard, params.train
         sums = _training_sum(np.ascontiguousarray(power, np.float64), gr, gd, tr, td,
                              mirrored)
-        noise = np.maximum(sums, 0.0) / n_train
+        noise = np.maximum(sums, 0.0) / int(_kernel(params).sum())
         return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
-    padded = _pad(power.astype(np.float64), params, mirrored)
-    # ordered statistic over the training cells
-    win = np.lib.stride_tricks.sliding_window_view(padded, kernel.shape)
-    cells = win.reshape(*win.shape[:2], -1)[..., kernel.ravel() > 0]
-    k = max(1, min(n_train, int(round(params.os_rank * n_train))))
-    kth = np.partition(cells, k - 1, axis=-1)[..., k - 1]
-    alpha = os_factor(params.pfa, n_channels, n_train, k)
-    # E[k-th of c] ~ theta * ppf(k / (c + 1)); mean noise power per cell = L * theta
-    return alpha * kth, kth * n_channels / stats.gamma(n_channels).ppf(k / (n_train + 1))
+    padded = np.ascontiguousarray(_pad(power.astype(np.float64), params, mirrored))
+    kth = os_kth(padded, gr, gd, tr, td, _os_k(params))
+    return _os_alpha(params.pfa, n_channels, params) * kth, _os_noise(kth, n_channels, params)
+
+
+def _os_k(params: CfarParams) -> int:
+    """Rank (1-based) of the OS-CFAR's training cell: ``os_rank`` of the training cells."""
+    n_train = int(_kernel(params).sum())
+    return max(1, min(n_train, int(round(params.os_rank * n_train))))
+
+
+@lru_cache(maxsize=64)
+def _os_alpha(pfa: float, n_channels: int, params: CfarParams) -> float:
+    """OS-CFAR factor of ``params``' window (``os_factor``), once per configuration."""
+    return float(os_factor(pfa, n_channels, int(_kernel(params).sum()), _os_k(params)))
+
+
+def _os_noise(kth: np.ndarray, n_channels: int, params: CfarParams) -> np.ndarray:
+    """The OS-CFAR's mean noise power per cell from its ordered statistic ``kth`` (float,
+    any shape): E[k-th of n] ~ theta ppf(k / (n + 1)); the mean power of a cell is L theta."""
+    return kth * n_channels / _os_quantile(n_channels, params)
+
+
+@lru_cache(maxsize=64)
+def _os_quantile(n_channels: int, params: CfarParams) -> float:
+    """ppf(k / (n + 1)) of Gamma(``n_channels``), the OS-CFAR's k of n training cells."""
+    return stats.gamma(n_channels).ppf(_os_k(params) / (int(_kernel(params).sum()) + 1))
+
+
+def cfar_detect(power: np.ndarray, n_channels: int, params: CfarParams,
+                windowed: Windows = (True, True)) -> tuple[np.ndarray, np.ndarray]:
+    """The cells above :func:`cfar_threshold`'s threshold, and its noise estimate there.
+
+    power: float (n_range, n_doppler). Returns (mask bool: power > threshold, exactly as
+    :func:`cfar_threshold`'s; noise float: its noise estimate, the same values, at every
+    cell of ``mask``; elsewhere NaN for OS-CFAR, whose order statistic is found only at the
+    detected cells: ``host._cfar_os`` counts instead, the module docstring says why that
+    decides alike).
+    """
+    if params.kind == "ca":
+        threshold, noise = cfar_threshold(power, n_channels, params, windowed)
+        return power > threshold, noise
+    if power.ndim != 2:
+        raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
+    # C order throughout: the kernels read rows (a cube's map is often Fortran-ordered)
+    padded = np.ascontiguousarray(_pad(power.astype(np.float64), params,
+                                       map_axes(windowed, power.shape)[0].real))
+    (gr, gd), (tr, td) = params.guard, params.train
+    k = _os_k(params)
+    scaled = os_scaled(padded, _os_alpha(params.pfa, n_channels, params), np.empty(
+        padded.shape, np.float32 if power.dtype == np.float32 else np.float64))
+    mask = os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td, k)
+    rows, cols = np.nonzero(mask)
+    noise = np.full(power.shape, np.nan)
+    noise[rows, cols] = _os_noise(os_kth_at(padded, rows, cols, gr, gd, tr, td, k),
+                                  n_channels, params)
+    return mask, noise
 
 
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3),

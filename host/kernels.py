@@ -1,7 +1,8 @@
 """The compiler of the host's kernels (``host._angle_peaks``, ``host._angle_relax``,
-``host.cfar``, ``host.tdm``, ``host.record_points``): numba when it is installed, else the
-same Python functions run as they are (the same results, much slower: a fallback, not a mode callers
-choose).
+``host.cfar``, ``host._cfar_os``, ``host.dca1000``, ``host.pipeline``, ``host.tdm``,
+``host.record_points``):
+numba when it is installed, else the same Python functions run as they are (the same results,
+much slower: a fallback, not a mode callers choose).
 
 :func:`njit` registers every kernel; :func:`uncompiled_kernels` names those without a
 compiled cache on disk (their first call compiles them: 20-30 s in all on a fresh checkout;
@@ -78,5 +79,7 @@ def _load_kernels() -> None:
     of them)."""
     import host._angle_relax  # noqa: F401
     import host.cfar  # noqa: F401
+    import host.dca1000  # noqa: F401
+    import host.pipeline  # noqa: F401
     import host.record_points  # noqa: F401
     import host.tdm  # noqa: F401

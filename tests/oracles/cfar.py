@@ -1,12 +1,14 @@
-"""Oracle of ``host.cfar``'s compiled CA-CFAR training sums: the numpy implementation it
-replaced (the map padded by the window's half extent, then separable sums of shifted
-views), kept only to test the kernel against (``tests/test_cfar_training_sum.py``)."""
+"""Oracles of ``host.cfar``'s compiled kernels: the numpy implementations they replaced,
+kept only to test the kernels against: the CA-CFAR training sums (the map padded by the
+window's half extent, then separable sums of shifted views; ``tests/test_cfar_training_sum.py``)
+and the OS-CFAR (``host._cfar_os``; ``tests/test_cfar_os.py``)."""
 
 from __future__ import annotations
 
 import numpy as np
+from scipy import stats
 
-from host.cfar import CfarParams, _pad
+from host.cfar import CfarParams, _kernel, _pad, os_factor
 
 
 def _shifted_sum(x: np.ndarray, offsets: range | list[int], axis: int, pad: int,
@@ -40,3 +42,21 @@ def training_sum_reference(power: np.ndarray, params: CfarParams, mirrored: bool
     outer_r = [*range(-pr, -gr), *range(gr + 1, pr + 1)]
     return _shifted_sum(full, outer_r, 0, pr, nr) + _shifted_sum(side, range(-gr, gr + 1),
                                                                   0, pr, nr)
+
+
+def os_threshold_reference(power: np.ndarray, n_channels: int, params: CfarParams,
+                           mirrored: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``host.cfar.cfar_threshold``'s OS-CFAR (threshold, noise), float64 (n_range,
+    n_doppler) each, as numpy computed it before ``host._cfar_os``: every cell's training
+    cells as a strided view of the padded map, ``np.partition`` for the k-th smallest."""
+    kernel = _kernel(params)
+    n_train = int(kernel.sum())
+    padded = _pad(power.astype(np.float64), params, mirrored)
+    # ordered statistic over the training cells
+    win = np.lib.stride_tricks.sliding_window_view(padded, kernel.shape)
+    cells = win.reshape(*win.shape[:2], -1)[..., kernel.ravel() > 0]
+    k = max(1, min(n_train, int(round(params.os_rank * n_train))))
+    kth = np.partition(cells, k - 1, axis=-1)[..., k - 1]
+    alpha = os_factor(params.pfa, n_channels, n_train, k)
+    # E[k-th of c] ~ theta * ppf(k / (c + 1)); mean noise power per cell = L * theta
+    return alpha * kth, kth * n_channels / stats.gamma(n_channels).ppf(k / (n_train + 1))

@@ -1,0 +1,244 @@
+"""Private backend of ``host.cfar``: the compiled OS-CFAR (ordered statistic over each cell's
+training cells, ``host.cfar._kernel``'s window), exact.
+
+The OS-CFAR's threshold of a cell is alpha x_(k), x_(k) the k-th smallest of its n training
+cells. Two ways to it, both on the map padded by the window's half extent (``host.cfar._pad``,
+C order: the kernels read rows):
+
+- :func:`os_kth`: x_(k) of every cell (``host.cfar.cfar_threshold``'s maps): per cell the
+  training cells gathered and the k-th found from the previous cell's x_(k), which the
+  heavily overlapping windows of neighbours keep a few ranks away (:func:`_kth_near`: the
+  guess's rank counted, then the value that many ranks away found without data-dependent
+  branches; a quickselect, :func:`_select`, when it is far).
+- :func:`os_detect`: whether at least k training cells x of a cell have fl(alpha x) < the
+  cell's power p. Multiplying by a positive alpha in floating point is monotone (x <= y
+  gives fl(alpha x) <= fl(alpha y)), so p > fl(alpha x_(k)), the threshold test, holds
+  exactly when at least k training cells have fl(alpha x) < p: the detection without any
+  order statistic; x_(k) is then needed only at the detected cells (:func:`os_kth_at`,
+  ``host.cfar.cfar_detect``). For a float32 map the fl(alpha x) are rounded down to float32
+  first: for a float32 p, a < p exactly when a rounded down to float32 is < p (p is a
+  float32 and rounding down is monotone), and the comparisons run twice as wide.
+
+Both return exactly what sorting would (the oracle: the numpy implementation they replaced,
+``tests/oracles/cfar.py``; ``tests/test_cfar_os.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from host.kernels import njit, warm_up
+
+
+@njit()
+def _select(buf: np.ndarray, n: int, k: int, first_pivot: float) -> float:
+    """The k-th smallest (k 0-based) of buf[:n] (float64), rearranging buf[:n]: quickselect
+    with three-way (less / equal / greater) partitions, the first pivot ``first_pivot``
+    (any value: a guess of the answer; NaN for none), then the median of three."""
+    lo, hi = 0, n - 1
+    pivot = first_pivot
+    while lo < hi:
+        if pivot != pivot:                     # NaN: the median of the first, middle, last
+            a, b, c = buf[lo], buf[(lo + hi) // 2], buf[hi]
+            pivot = max(min(a, b), min(max(a, b), c))
+        lt, i, gt = lo, lo, hi
+        while i <= gt:
+            v = buf[i]
+            if v < pivot:
+                buf[i] = buf[lt]
+                buf[lt] = v
+                lt += 1
+                i += 1
+            elif v > pivot:
+                buf[i] = buf[gt]
+                buf[gt] = v
+                gt -= 1
+            else:
+                i += 1
+        if k < lt:
+            hi = lt - 1
+        elif k > gt:
+            lo = gt + 1
+        else:
+            return pivot
+        pivot = np.nan
+    return buf[lo]
+
+
+NEAR_RANKS = 32
+""":func:`_kth_near` finds the k-th by a scan when it is at most this many ranks from its
+guess (else it selects)."""
+
+
+@njit()
+def _kth_near(buf: np.ndarray, n: int, k: int, guess: float, side: np.ndarray) -> float:
+    """The k-th smallest (k 0-based) of buf[:n] (float64), near ``guess`` (NaN: none): the
+    ranks of ``guess`` counted (less, equal); when the k-th is j <= :data:`NEAR_RANKS`
+    ranks above (below) them, it is the j-th smallest value above (largest below) the
+    guess: those values gathered into ``side`` (float64 (n,), scratch; negated below) and
+    the minimum taken out j times, all without data-dependent branches (a scan that
+    inserts into a sorted list mispredicts on every other value); else :func:`_select`
+    (which may rearrange buf)."""
+    if guess == guess:
+        less, equal = 0, 0
+        for i in range(n):
+            v = buf[i]
+            less += v < guess
+            equal += v == guess
+        if less <= k < less + equal:
+            return guess
+        above = k >= less + equal
+        j = k - less - equal + 1 if above else less - k
+        if j <= NEAR_RANKS:
+            sign = 1.0 if above else -1.0          # below: the same on -v
+            g = sign * guess
+            m = 0
+            for i in range(n):
+                v = sign * buf[i]
+                side[m] = v
+                m += v > g
+            value = 0.0
+            for _ in range(j):
+                value = np.inf
+                at = 0
+                for i in range(m):
+                    v = side[i]
+                    at = i if v < value else at
+                    value = v if v < value else value
+                m -= 1
+                side[at] = side[m]
+            return sign * value
+    return _select(buf, n, k, guess)
+
+
+@njit()
+def _gather(padded: np.ndarray, r: int, d: int, guard_r: int, guard_d: int, train_r: int,
+            train_d: int, buf: np.ndarray) -> int:
+    """The training cells of cell (r, d) (``padded``: float64 (n_range + 2 pr, n_doppler +
+    2 pd), cell (r, d) at padded[r + pr, d + pd]) into ``buf``, row by row; returns their
+    number."""
+    pr, pd = guard_r + train_r, guard_d + train_d
+    m = 0
+    for i in range(2 * pr + 1):
+        row = padded[r + i]
+        if train_r <= i <= train_r + 2 * guard_r:          # a guard row: its two sides
+            for j in range(train_d):
+                buf[m] = row[d + j]
+                buf[m + train_d] = row[d + pd + guard_d + 1 + j]
+                m += 1
+            m += train_d
+        else:
+            for j in range(2 * pd + 1):
+                buf[m] = row[d + j]
+                m += 1
+    return m
+
+
+@njit()
+def os_kth(padded: np.ndarray, guard_r: int, guard_d: int, train_r: int, train_d: int,
+           k: int) -> np.ndarray:
+    """The k-th smallest (k 1-based) training cell of every cell, float64 (n_range,
+    n_doppler), of the padded map ``padded`` (float64 (n_range + 2 pr, n_doppler + 2 pd),
+    pr = guard_r + train_r, pd = guard_d + train_d)."""
+    pr, pd = guard_r + train_r, guard_d + train_d
+    nr, nd = padded.shape[0] - 2 * pr, padded.shape[1] - 2 * pd
+    n = (2 * pr + 1) * (2 * pd + 1) - (2 * guard_r + 1) * (2 * guard_d + 1)
+    buf = np.empty(n)
+    side = np.empty(n)
+    out = np.empty((nr, nd))
+    guess = np.nan
+    for r in range(nr):
+        for d in range(nd):
+            _gather(padded, r, d, guard_r, guard_d, train_r, train_d, buf)
+            guess = _kth_near(buf, n, k - 1, guess, side)
+            out[r, d] = guess
+        guess = out[r, 0]                   # the next row starts beside this one's first
+    return out
+
+
+@njit()
+def os_scaled(padded: np.ndarray, alpha: float, out: np.ndarray) -> np.ndarray:
+    """fl(``alpha`` x) of every x of ``padded`` (float64) into ``out`` (same shape, float64,
+    or float32: rounded down to float32, :func:`os_detect`); returns ``out``."""
+    for i in range(padded.shape[0]):
+        for j in range(padded.shape[1]):
+            a = alpha * padded[i, j]
+            f = out.dtype.type(a)
+            if f > a:
+                f = np.nextafter(f, out.dtype.type(-np.inf))
+            out[i, j] = f
+    return out
+
+
+@njit()
+def os_detect(scaled: np.ndarray, cut: np.ndarray, guard_r: int, guard_d: int,
+              train_r: int, train_d: int, k: int) -> np.ndarray:
+    """Whether at least ``k`` training cells x of each cell have ``scaled`` < ``cut`` (the
+    cell's power), bool (n_range, n_doppler); ``scaled``: fl(alpha x) of the padded map
+    (:func:`os_kth`'s layout), of ``cut``'s dtype (float32: fl(alpha x) rounded down to
+    float32, which compares with a float32 power exactly as fl(alpha x) does).
+
+    Counted in two passes over each map row: the first training rows, m >= 2 (n - k + 1)
+    cells of the n, for every cell at once (vectorised); a cell with fewer than k - (n - m)
+    of them below cannot reach k (the noise: nearly every cell); the others (cells near
+    targets) count the remaining rows one by one."""
+    pr, pd = guard_r + train_r, guard_d + train_d
+    nr, nd = cut.shape
+    width = 2 * pd + 1
+    n = (2 * pr + 1) * width - (2 * guard_r + 1) * (2 * guard_d + 1)
+    rows, m = 0, 0                              # the first pass: whole training rows
+    while rows < train_r and m < min(n, 2 * (n - k + 1)):
+        rows += 1
+        m += width
+    need = k - (n - m)
+    count = np.zeros(nd, np.int32)
+    out = np.zeros((nr, nd), np.bool_)
+    for r in range(nr):
+        p = cut[r]
+        count[:] = 0
+        for i in range(rows):
+            row = scaled[r + i]
+            for o in range(width):
+                for d in range(nd):
+                    count[d] += np.int32(1) if row[d + o] < p[d] else np.int32(0)
+        for d in range(nd):
+            if count[d] < need:
+                continue
+            c = count[d]
+            for i in range(rows, 2 * pr + 1):
+                row = scaled[r + i]
+                guard_row = train_r <= i <= train_r + 2 * guard_r
+                for o in range(width):
+                    if not (guard_row and train_d <= o <= train_d + 2 * guard_d):
+                        c += row[d + o] < p[d]
+            out[r, d] = c >= k
+    return out
+
+
+@njit()
+def os_kth_at(padded: np.ndarray, rows: np.ndarray, cols: np.ndarray, guard_r: int,
+              guard_d: int, train_r: int, train_d: int, k: int) -> np.ndarray:
+    """:func:`os_kth` at the cells (rows[i], cols[i]) only, float64 (len(rows),)."""
+    pr, pd = guard_r + train_r, guard_d + train_d
+    n = (2 * pr + 1) * (2 * pd + 1) - (2 * guard_r + 1) * (2 * guard_d + 1)
+    buf = np.empty(n)
+    side = np.empty(n)
+    out = np.empty(len(rows))
+    guess = np.nan                           # the previous cell's: often a neighbour
+    for i in range(len(rows)):
+        _gather(padded, rows[i], cols[i], guard_r, guard_d, train_r, train_d, buf)
+        guess = _kth_near(buf, n, k - 1, guess, side)
+        out[i] = guess
+    return out
+
+
+@warm_up
+def _compile() -> None:
+    """Compile the kernels for the argument types of ``host.cfar``'s calls (the FPGA
+    detector's runs never reach them)."""
+    padded = np.zeros((5, 5))
+    os_kth(padded, 0, 0, 1, 1, 4)
+    for dtype in (np.float32, np.float64):
+        scaled = os_scaled(padded, 1.0, np.empty(padded.shape, dtype))
+        os_detect(scaled, np.zeros((3, 3), dtype), 0, 0, 1, 1, 4)
+    os_kth_at(padded, np.zeros(1, np.int64), np.zeros(1, np.int64), 0, 0, 1, 1, 4)
