@@ -6,8 +6,9 @@
 - :mod:`rtlsim.axis`: :class:`~rtlsim.axis.AxisTB`, the AXI4-Stream testbench base every
   block's testbench builds on, and the pause/backpressure generators.
 - :mod:`rtlsim.pipeline`: :class:`~rtlsim.pipeline.PipelineTB`, the cocotb ``radar_pipeline``
-  driver (ADC frames in, DMA packets out) used by ``tb/radar_pipeline`` and
-  :mod:`rtlsim.pipeline_test`.
+  driver (ADC frames in, DMA packets out) used by :mod:`rtlsim.pipeline_test`, and the frame
+  flows of ``tb/radar_pipeline`` (frames under stalls, mid-frame reset, overload and
+  recovery), each compared with the bit-accurate model.
 - :mod:`rtlsim.pipeline_rtl`: :func:`~rtlsim.pipeline_rtl.run_pipeline_rtl`, ADC frames through
   the Verilated ``radar_pipeline`` from ordinary Python via cocotb (runs
   :mod:`rtlsim.pipeline_test`; the reference of the harness in ``tb/radar_pipeline``).

@@ -45,6 +45,14 @@ def bursty_pause(seed: int, max_run: int = 200, busy_fraction: float = 0.3) -> I
             yield paused
 
 
+def chirp_bursts(active: int, idle: int) -> Iterator[bool]:
+    """ADC timing: chirps at one sample per clock (``active`` clocks), then ``idle`` clocks
+    between chirps (the real chirp repetition leaves the ADC idle most of the time)."""
+    while True:
+        yield from [False] * active
+        yield from [True] * idle
+
+
 def unpack_frame(frame: AxiStreamFrame, lanes: int) -> tuple[np.ndarray, list[int]]:
     """A received AXI-Stream frame -> (uint32 words (beats, lanes), TUSER of each beat)."""
     words = bytes_to_words(bytes(frame.tdata), lanes)

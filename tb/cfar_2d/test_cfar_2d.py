@@ -139,12 +139,7 @@ async def test_throughput(dut):
     tb.start_meter()
     await tb.reset()
     c = tb.cfg
-    maps = [tb.random_map() for _ in range(3)]
-    rx = cocotb.start_soon(tb.recv_maps(3))
-    for m in maps:
-        await tb.send_map(m)
-    got = await rx
-    n_det = tb.check(got, maps)
+    n_det = await tb.run_maps([tb.random_map() for _ in range(3)])
     span = tb.out_last - tb.in_first + 1
     ideal = c.n_range * c.n_doppler + (c.n_range) * 2 * c.pd + (c.pr + 1) * c.n_doppler
     tb.log.info("%d cells/frame, %d detections in 3 frames; %d clocks for 3 frames "
@@ -250,12 +245,7 @@ async def test_reset_recovery(dut):
     tb.set_idle_generator(random_pause(0.2, 9))
     tb.set_backpressure_generator(no_pause())
     tb.set_kind(KIND_NAMES[-1], True)     # OS if built, else the default kind
-    maps = [tb.random_map() for _ in range(2)]
-    rx = cocotb.start_soon(tb.recv_maps(2))
-    for m in maps:
-        await tb.send_map(m)
-    got = await rx
-    tb.check(got, maps)
+    await tb.run_maps([tb.random_map() for _ in range(2)])
 
 
 # ------------------------------------------------------------------------------------------

@@ -66,6 +66,13 @@ class TB(AxisTB):
             maps.append(np.array(rows, dtype=np.int64))
         return maps
 
+    async def run_frames(self, frames: list[np.ndarray]) -> None:
+        """Send the frames while receiving as many power maps, then :meth:`check` them."""
+        rx = cocotb.start_soon(self.recv_frames(len(frames)))
+        for f in frames:
+            await self.send_frame(f)
+        self.check(await rx, frames)
+
     def check(self, got: list[np.ndarray], sent: list[np.ndarray]) -> None:
         for k, (g, f) in enumerate(zip(got, sent, strict=True)):
             exp = nci_model.nci(f, self.num_tx, self.n_range, self.n_doppler)
@@ -81,12 +88,7 @@ async def test_throughput(dut):
     tb = TB(dut)
     tb.start_meter()
     await tb.reset()
-    frames = [tb.random_frame() for _ in range(3)]
-    rx = cocotb.start_soon(tb.recv_frames(3))
-    for f in frames:
-        await tb.send_frame(f)
-    got = await rx
-    tb.check(got, frames)
+    await tb.run_frames([tb.random_frame() for _ in range(3)])
     span = tb.cycle - tb.in_first
     tb.log.info("%d input words in %d clocks", tb.in_beats, span)
     assert tb.in_beats == 3 * tb.frame_words
@@ -146,12 +148,7 @@ async def test_reset_recovery(dut):
     assert int(dut.frame_count.value) == 0 and int(dut.m_axis_tvalid.value) == 0
     tb.set_idle_generator(random_pause(0.2, 9))
     tb.set_backpressure_generator(no_pause())
-    frames = [tb.random_frame() for _ in range(2)]
-    rx = cocotb.start_soon(tb.recv_frames(2))
-    for fr in frames:
-        await tb.send_frame(fr)
-    got = await rx
-    tb.check(got, frames)
+    await tb.run_frames([tb.random_frame() for _ in range(2)])
 
 
 # ------------------------------------------------------------------------------------------

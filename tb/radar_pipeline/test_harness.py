@@ -18,11 +18,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from test_radar_pipeline import CONFIGS, adc_frames, assert_packets_equal
+from test_radar_pipeline import CONFIGS, adc_frames
 
 from model.radar_pipeline import dma_frames, dma_packets
 from rtlsim.harness import run_harness, run_pipeline
 from rtlsim.harness.soak import expected_status, payload_mismatches, status_mismatches
+from rtlsim.pipeline import assert_packets_equal
 from rtlsim.pipeline_rtl import run_pipeline_rtl
 from rtlsim.toolchain import RTL
 

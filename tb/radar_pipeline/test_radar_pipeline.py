@@ -18,7 +18,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import RisingEdge, SimTimeoutError, Timer
+from cocotb.triggers import RisingEdge
 
 from host.pipeline import process_cube
 from host.stream import StreamDecoder
@@ -33,8 +33,8 @@ from model.radar_pipeline import (
 )
 from model.scene import PointTarget, Scene, table1_scene
 from model.simulate import simulate_frame, simulate_scene
-from rtlsim.axis import random_pause
-from rtlsim.pipeline import PipelineTB
+from rtlsim.axis import chirp_bursts, random_pause
+from rtlsim.pipeline import PipelineTB, StallSwitch, assert_packets_equal
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import rtl_sources, run_cocotb
 
@@ -63,30 +63,39 @@ def adc_frames(name: str, cfg: RadarConfig, n: int, seed: int = 1) -> list[np.nd
             .samples for k in range(n)]
 
 
-def chirp_bursts(active: int, idle: int):
-    """ADC timing: chirps at one sample per clock (``active`` clocks), then ``idle`` clocks
-    between chirps (the real chirp repetition leaves the ADC idle most of the time)."""
-    while True:
-        yield from [False] * active
-        yield from [True] * idle
-
-
-def assert_packets_equal(got: list[np.ndarray], want: list[np.ndarray], what: str) -> None:
-    assert len(got) == len(want), f"{what}: {len(got)} packets, model {len(want)}"
-    for i, (g, w) in enumerate(zip(got, want, strict=True)):
-        assert g.shape == w.shape, f"{what}: packet {i} has {g.shape[0]} words, model " \
-                                   f"{w.shape[0]}"
-        if not np.array_equal(g, w):
-            bad = np.argwhere(g != w)[0]
-            raise AssertionError(f"{what}: packet {i} word {bad[0]} lane {bad[1]}: "
-                                 f"0x{int(g[tuple(bad)]):08x} != model "
-                                 f"0x{int(w[tuple(bad)]):08x}")
-
-
 def decode(cfg: RadarConfig, chain: PipelineParams, packets: list[np.ndarray]):
+    """The host's decoding of DMA packets (``host.stream``): frames by frame id."""
     dec = StreamDecoder(cfg, chain.packet_words)
     frames = [f for p in packets for f in dec.push_packet(words_to_bytes(p))] + dec.flush()
     return sorted(frames, key=lambda f: f.frame_id)
+
+
+def assert_model_detections(cube: np.ndarray, adc: np.ndarray, cfg: RadarConfig,
+                             chain: PipelineParams, min_points: int) -> int:
+    """The host's detections (``host.pipeline.process_cube``) on a decoded RTL ``cube``
+    (scaled back by the chain gain) equal those on the model's cube of ``adc``, field by
+    field, and number at least ``min_points``; returns how many."""
+    rtl_cloud = process_cube(cube / chain_gain(cfg, chain), cfg)
+    model_cloud = process_cube(scaled_cube(adc, cfg, chain), cfg)
+    assert len(rtl_cloud) == len(model_cloud) >= min_points
+    for field in ("range_m", "azimuth_deg", "radial_velocity_mps", "snr_db"):
+        assert np.array_equal(getattr(rtl_cloud, field), getattr(model_cloud, field))
+    return len(rtl_cloud)
+
+
+def assert_recovered(cfg: RadarConfig, chain: PipelineParams, frames: list[np.ndarray],
+                     got: list[np.ndarray], status: dict[str, int]) -> list:
+    """After an overload (:meth:`PipelineTB.stall_then_drain`): chirps dropped at the ADC
+    ping-pong (flagged), frames marked damaged, frame 0 and the last frame complete, the last
+    one bit-exact with the model and its header clean; returns the decoded frames."""
+    assert status["status_adc_overflow"] == 1 and status["adc_chirps_dropped"] > 0, status
+    assert status["frames_damaged"] >= 1, status
+    decoded = decode(cfg, chain, got)
+    assert decoded[0].complete and decoded[-1].complete, decoded[-1].problems
+    assert np.array_equal(decoded[-1].cube, run_chain(frames[-1], cfg, chain).cube())
+    hdr = parse_header(got[-1][0])
+    assert not hdr.damaged and not hdr.drop
+    return decoded
 
 
 @cocotb.test()
@@ -97,29 +106,17 @@ async def frames_back_to_back_with_dma_stalls(dut) -> None:
     tb = PipelineTB(dut)
     name, cfg, chain = config_of(tb)
     frames = adc_frames(name, cfg, 3)
-    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
-    tb.set_backpressure_generator(random_pause(0.3, 2))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.recv_frames(3, 2 * tb.frame_timeout_cycles())
-    assert_packets_equal(got, dma_packets(frames, cfg, chain), name)
+    got = await tb.stream_under_stalls(frames, cfg, chain, name,
+                                       idle=chirp_bursts(cfg.n_range, cfg.n_range),
+                                       backpressure=random_pause(0.3, 2))
     status = tb.status()
-    assert status["frames_out"] == 3 and status["chirps_in"] == 3 * cfg.n_chirps
-    for flag in ("status_adc_overflow", "status_dma_overflow", "status_fft_overflow",
-                 "status_framing_error"):
-        assert status[flag] == 0, (flag, status)
     decoded = decode(cfg, chain, got)
     assert [f.complete for f in decoded] == [True] * 3
-    gain = chain_gain(cfg, chain)
-    for f, adc in zip(decoded, frames, strict=True):
-        rtl_cloud = process_cube(f.cube / gain, cfg)
-        model_cloud = process_cube(scaled_cube(adc, cfg, chain), cfg)
-        assert len(rtl_cloud) == len(model_cloud) >= (3 if name == "paper-fpga" else 2)
-        for field in ("range_m", "azimuth_deg", "radial_velocity_mps", "snr_db"):
-            assert np.array_equal(getattr(rtl_cloud, field), getattr(model_cloud, field))
+    points = [assert_model_detections(f.cube, adc, cfg, chain,
+                                      3 if name == "paper-fpga" else 2)
+              for f, adc in zip(decoded, frames, strict=True)]
     tb.dut._log.info("%s: 3 frames bit-exact, %d points in frame 0, status %s", name,
-                     len(process_cube(decoded[0].cube / gain, cfg)), status)
+                     points[0], status)
 
 
 @cocotb.test()
@@ -129,14 +126,9 @@ async def adc_gaps_at_the_real_sample_rate(dut) -> None:
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
-    frames = adc_frames(name, cfg, 2, seed=5)
-    tb.set_idle_generator(random_pause(0.8, 3))
-    tb.set_backpressure_generator(random_pause(0.5, 4))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.recv_frames(2, 6 * tb.frame_timeout_cycles())
-    assert_packets_equal(got, dma_packets(frames, cfg, chain), "adc gaps")
+    await tb.stream_under_stalls(adc_frames(name, cfg, 2, seed=5), cfg, chain, "adc gaps",
+                                 idle=random_pause(0.8, 3), backpressure=random_pause(0.5, 4),
+                                 timeout_frames=6)
 
 
 @cocotb.test()
@@ -149,37 +141,16 @@ async def dma_overload_then_recovery(dut) -> None:
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
-    n_frames = 6
-    frames = adc_frames(name, cfg, n_frames, seed=7)
-    await tb.reset()
-    stall = {"on": False}
-    tb.set_backpressure_generator(iter(lambda: stall["on"], None))
-    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
-    for adc in frames:
-        await tb.send_frame(adc)
-    frame_clocks = 2 * cfg.n_chirps * cfg.n_range
-    got = [await tb.recv_packet(tb.frame_timeout_cycles())
-           for _ in range(tb.packets_per_frame)]  # frame 0 leaves normally
-    stall["on"] = True
-    await Timer(3 * frame_clocks * 10, unit="ns")
-    stall["on"] = False
-    while True:  # drain until the link is quiet
-        try:
-            got.append(await tb.recv_packet(3 * frame_clocks))
-        except SimTimeoutError:
-            break
+    frames = adc_frames(name, cfg, 6, seed=7)
+    stall = StallSwitch()
+    tb.set_backpressure_generator(stall.pauses())
+    got = await tb.stall_then_drain(frames, cfg, stall, tb.frame_timeout_cycles())
     status = tb.status()
-    assert status["status_adc_overflow"] == 1 and status["adc_chirps_dropped"] > 0, status
-    assert status["frames_damaged"] >= 1 and status["chirps_filled"] > 0, status
+    decoded = assert_recovered(cfg, chain, frames, got, status)
+    assert status["chirps_filled"] > 0, status
     assert status["status_dma_overflow"] == 0, status  # the DMA side never drops
-    decoded = decode(cfg, chain, got)
-    assert decoded[0].complete
     damaged = [f for f in decoded if any("damaged upstream" in p for p in f.problems)]
     assert len(damaged) == status["frames_damaged"]
-    assert decoded[-1].complete, decoded[-1].problems
-    assert np.array_equal(decoded[-1].cube, run_chain(frames[-1], cfg, chain).cube())
-    hdr = parse_header(got[-1][0])
-    assert not hdr.damaged and not hdr.drop
     tb.dut._log.info("overload: %d chirps dropped, %d filled, %d discarded, %d frames "
                      "damaged, %d frames out; last frame clean", status["adc_chirps_dropped"],
                      status["chirps_filled"], status["chirps_discarded"],
@@ -195,13 +166,7 @@ async def reset_mid_stream(dut) -> None:
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
-    frames = adc_frames(name, cfg, 3, seed=11)
-    await tb.reset()
-    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range))
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.reset_then_recv(cfg.n_chirps * cfg.n_range, 2)  # half way through frame 0
-    assert_packets_equal(got, dma_packets(frames[1:], cfg, chain), "after reset")
+    await tb.reset_mid_frame(adc_frames(name, cfg, 3, seed=11), cfg, chain, "after reset")
     status = tb.status()
     assert status["frames_out"] == 2 and status["frames_damaged"] == 0, status
     assert status["chirps_discarded"] > 0, status  # the rest of frame 0
@@ -256,13 +221,9 @@ async def fft_overflow_and_framing_counters(dut) -> None:
     want_ovf = [run_chain(f, cfg, chain) for f in frames]
     assert [(w.range_overflow, w.doppler_overflow) for w in want_ovf] == [(0, 4), (0, 0),
                                                                           (0, 2)]
-    tb.set_idle_generator(chirp_bursts(cfg.n_range, cfg.n_range // 2))
-    tb.set_backpressure_generator(random_pause(0.3, 9))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.recv_frames(3, 2 * tb.frame_timeout_cycles())
-    assert_packets_equal(got, dma_packets(frames, cfg, chain), "saturating frames")
+    await tb.stream_under_stalls(frames, cfg, chain, "saturating frames",
+                                 idle=chirp_bursts(cfg.n_range, cfg.n_range // 2),
+                                 backpressure=random_pause(0.3, 9), clean=False)
     st = tb.status()
     assert st["status_fft_overflow"] == 1 and st["fft_overflow_count"] == 6, st
     assert st["status_framing_error"] == 0 and st["framing_error_count"] == 0, st
@@ -277,11 +238,8 @@ async def fft_overflow_and_framing_counters(dut) -> None:
     assert st["status_fft_overflow"] == 1 and st["fft_overflow_count"] == 9, st
 
     # sticky through a clean frame (and the clean frame is unharmed)
-    clean = adc_frames(name, cfg, 1, seed=14)
-    await tb.send_frame(clean[0])
-    got = await tb.recv_frames(1, 2 * tb.frame_timeout_cycles())
-    assert_packets_equal(got, dma_packets(clean, cfg, chain, first_frame_id=3),
-                         "clean frame after events")
+    await tb.stream(adc_frames(name, cfg, 1, seed=14), cfg, chain, "clean frame after events",
+                    first_frame_id=3)
     st = tb.status()
     assert (st["status_framing_error"], st["framing_error_count"]) == (1, 6), st
     assert (st["status_fft_overflow"], st["fft_overflow_count"]) == (1, 9), st

@@ -8,23 +8,19 @@ later frames clean), never in a lost sample inside the store.
 
 from __future__ import annotations
 
-import logging
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
 
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import SimTimeoutError, Timer
-from cocotbext.axi import AxiBus, AxiRam
-from test_radar_pipeline import SMALL4, assert_packets_equal, chirp_bursts, decode
+from test_radar_pipeline import SMALL4, assert_recovered, decode
 from test_radar_pipeline import adc_frames as scene_frames
 
-from model.axis_packetizer import parse_header
-from model.frame_store_axi import StoreGeometry
-from model.radar_pipeline import PipelineParams, dma_packets, run_chain
-from rtlsim.axis import random_pause
-from rtlsim.pipeline import PipelineTB
+from model.radar_pipeline import PipelineParams
+from rtlsim.axis import chirp_bursts, random_pause
+from rtlsim.pipeline import PipelineTB, StallSwitch
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import rtl_sources, run_cocotb
 
@@ -37,35 +33,23 @@ def store_params(chain: PipelineParams) -> dict[str, int]:
             "MEM_BASE": MEM_BASE}
 
 
-def attach_ram(tb: PipelineTB) -> AxiRam:
-    g: StoreGeometry = CHAIN.store_geometry(SMALL4)
-    ram = AxiRam(AxiBus.from_prefix(tb.dut, "m_axi_mem"), tb.dut.clk, tb.dut.rst,
-                 size=MEM_BASE + g.memory_bytes)
-    for c in (ram.write_if, ram.read_if):
-        c.log.setLevel(logging.WARNING)
-    return ram
+def attach_ram(tb: PipelineTB, pauses: Callable[[int], Iterator[bool]]) -> None:
+    """The ``AxiRam`` of CHAIN's store on SMALL4 behind ``MEM_BASE``."""
+    tb.attach_memory(MEM_BASE + CHAIN.store_geometry(SMALL4).memory_bytes, pauses)
 
 
-def channels(ram: AxiRam) -> list:
-    w, r = ram.write_if, ram.read_if
-    return [w.aw_channel, w.w_channel, w.b_channel, r.ar_channel, r.r_channel]
-
-
-async def stalled_frames(tb: PipelineTB, external: bool) -> tuple[list[np.ndarray],
-                                                                  list[np.ndarray]]:
+async def stalled_frames(tb: PipelineTB, external: bool, chain: PipelineParams,
+                         what: str) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Three small4 scene frames in ADC chirp bursts with 30 % DMA stalls and, with the
-    ``external`` frame store, an ``AxiRam`` stalling all five channels at random: (the ADC
-    frames, the DMA packets received)."""
+    ``external`` frame store, an ``AxiRam`` stalling all five channels at random, compared
+    with ``chain``'s model packets, clean status: (the ADC frames, the DMA packets)."""
     if external:
-        for i, ch in enumerate(channels(attach_ram(tb))):
-            ch.set_pause_generator(random_pause(0.3, 20 + i))
+        attach_ram(tb, lambda i: random_pause(0.3, 20 + i))
     frames = scene_frames("small4", SMALL4, 3)
-    tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
-    tb.set_backpressure_generator(random_pause(0.3, 2))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    return frames, await tb.recv_frames(3, 4 * tb.frame_timeout_cycles())
+    got = await tb.stream_under_stalls(frames, SMALL4, chain, what,
+                                       idle=chirp_bursts(SMALL4.n_range, SMALL4.n_range),
+                                       backpressure=random_pause(0.3, 2), timeout_frames=4)
+    return frames, got
 
 
 @cocotb.test()
@@ -73,12 +57,8 @@ async def external_store_bit_exact_with_axi_stalls(dut) -> None:
     """Three frames, ADC chirp bursts, 30 % DMA stalls, random stalls on all five AXI
     channels: packets bit-exact with the model, clean status, no memory error."""
     tb = PipelineTB(dut)
-    frames, got = await stalled_frames(tb, external=True)
     # the on-chip corner turn's packets: FRAME_STORE changes nothing downstream
-    want = dma_packets(frames, SMALL4, replace(CHAIN, frame_store=False))
-    assert_packets_equal(got, want, "frame store")
-    st = tb.status()
-    assert st["frames_out"] == 3 and st["status_adc_overflow"] == 0, st
+    _, got = await stalled_frames(tb, True, replace(CHAIN, frame_store=False), "frame store")
     assert int(dut.status_mem_error.value) == 0 and int(dut.mem_error_count.value) == 0
     assert [f.complete for f in decode(SMALL4, CHAIN, got)] == [True] * 3
 
@@ -89,37 +69,13 @@ async def slow_memory_drops_whole_chirps(dut) -> None:
     the store back-pressures, the ping-pong drops whole chirps (flagged), frame_align marks
     the frames damaged; after the memory recovers the last frame is clean and bit-exact."""
     tb = PipelineTB(dut)
-    ram = attach_ram(tb)
-    slow = {"on": False}
-    rngs = [np.random.default_rng(40 + i) for i in range(5)]
-    for ch, rng in zip(channels(ram), rngs, strict=True):
-        ch.set_pause_generator(iter(lambda r=rng: slow["on"] and r.random() < 0.95, None))
-    n_frames = 6
-    frames = scene_frames("small4", SMALL4, n_frames, seed=7)
-    await tb.reset()
-    tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
-    for adc in frames:
-        await tb.send_frame(adc)
-    frame_clocks = 2 * SMALL4.n_chirps * SMALL4.n_range
-    got = [await tb.recv_packet(2 * tb.frame_timeout_cycles())
-           for _ in range(tb.packets_per_frame)]          # frame 0 leaves normally
-    slow["on"] = True
-    await Timer(3 * frame_clocks * 10, unit="ns")
-    slow["on"] = False
-    while True:
-        try:
-            got.append(await tb.recv_packet(3 * frame_clocks))
-        except SimTimeoutError:
-            break
+    slow = StallSwitch()
+    attach_ram(tb, lambda i: slow.pauses(0.95, 40 + i))
+    frames = scene_frames("small4", SMALL4, 6, seed=7)
+    got = await tb.stall_then_drain(frames, SMALL4, slow, 2 * tb.frame_timeout_cycles())
     st = tb.status()
-    assert st["status_adc_overflow"] == 1 and st["adc_chirps_dropped"] > 0, st
-    assert st["frames_damaged"] >= 1, st
     assert int(dut.mem_error_count.value) == 0
-    decoded = decode(SMALL4, CHAIN, got)
-    assert decoded[0].complete and decoded[-1].complete, decoded[-1].problems
-    assert np.array_equal(decoded[-1].cube, run_chain(frames[-1], SMALL4, CHAIN).cube())
-    hdr = parse_header(got[-1][0])
-    assert not hdr.damaged and not hdr.drop
+    decoded = assert_recovered(SMALL4, CHAIN, frames, got, st)
     tb.dut._log.info("slow memory: %d chirps dropped, %d frames damaged, %d frames out",
                      st["adc_chirps_dropped"], st["frames_damaged"], len(decoded))
 

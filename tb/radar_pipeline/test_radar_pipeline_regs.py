@@ -24,15 +24,15 @@ from pathlib import Path
 
 import cocotb
 import numpy as np
-from test_radar_pipeline import SMALL4, adc_frames, assert_packets_equal, chirp_bursts
+from test_radar_pipeline import SMALL4, adc_frames
 
 from host import regs
 from model.axis_packetizer import packets_per_frame
 from model.radar_ctrl import RadarCtrl
 from model.radar_pipeline import FrameSettings, PipelineParams, dma_packets
 from model.radar_regs_map import REGISTERS
-from rtlsim.axis import random_pause
-from rtlsim.pipeline import PipelineTB
+from rtlsim.axis import chirp_bursts, random_pause
+from rtlsim.pipeline import PipelineTB, assert_packets_equal
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import rtl_sources, run_cocotb, seed
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import SMALL4, assert_packets_equal, decode
+from test_radar_pipeline import SMALL4, decode
 from test_radar_pipeline_frame_store import CHAIN as FS_CHAIN
 from test_radar_pipeline_frame_store import stalled_frames, store_params
 
@@ -29,12 +29,8 @@ async def static_removal_bit_exact(dut) -> None:
     store): packets bit-exact with the model, clean status; without the removal the same
     frames' packets differ."""
     tb = PipelineTB(dut)
-    frames, got = await stalled_frames(tb, external=bool(param("FRAME_STORE", 0)))
-    assert_packets_equal(got, dma_packets(frames, SMALL4, CHAIN), "static removal")
-    st = tb.status()
-    assert st["frames_out"] == 3, st
-    for flag in ("status_adc_overflow", "status_fft_overflow", "status_framing_error"):
-        assert st[flag] == 0, (flag, st)
+    frames, got = await stalled_frames(tb, bool(param("FRAME_STORE", 0)), CHAIN,
+                                       "static removal")
     plain = dma_packets(frames, SMALL4, replace(CHAIN, static_removal=False))
     assert any(not np.array_equal(g, p) for g, p in zip(got, plain, strict=True))
     assert [f.complete for f in decode(SMALL4, CHAIN, got)] == [True] * 3

@@ -12,7 +12,6 @@ ADC gaps and DMA stalls, then a reset in the middle of a frame while the ADC kee
 
 from __future__ import annotations
 
-import logging
 import os
 from dataclasses import replace
 from pathlib import Path
@@ -20,14 +19,13 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotbext.axi import AxiBus, AxiRam
-from test_radar_pipeline import assert_packets_equal, chirp_bursts, decode
+from test_radar_pipeline import decode
 
 from model.axis_packetizer import depacketize
 from model.config import RadarConfig
 from model.detect_chain import DetectConfig
 from model.detect_records import decode_frame
-from model.radar_pipeline import PipelineParams, dma_packets, run_chain
+from model.radar_pipeline import PipelineParams, run_chain
 from model.scene import PointTarget, Scene
 from model.simulate import simulate_frame
 from rtlsim.axis import random_pause
@@ -67,14 +65,8 @@ def setup(dut) -> tuple[PipelineTB, PipelineParams]:
     if chain.output_mode == 1:
         tb.cfar_scales = chain.cfar_scales(TX3)
     if chain.frame_store:
-        ram = AxiRam(AxiBus.from_prefix(dut, "m_axi_mem"), dut.clk, dut.rst,
-                     size=MEM_BASE + chain.store_geometry(TX3).memory_bytes)
-        for c in (ram.write_if, ram.read_if):
-            c.log.setLevel(logging.WARNING)
-        w, r = ram.write_if, ram.read_if
-        for i, ch in enumerate([w.aw_channel, w.w_channel, w.b_channel, r.ar_channel,
-                                r.r_channel]):
-            ch.set_pause_generator(random_pause(0.3, 30 + i))
+        tb.attach_memory(MEM_BASE + chain.store_geometry(TX3).memory_bytes,
+                         lambda i: random_pause(0.3, 30 + i))
     return tb, chain
 
 
@@ -100,18 +92,9 @@ async def frames_bit_exact_with_stalls(dut) -> None:
     external store): packets bit-exact, clean status, the host decodes them."""
     tb, chain = setup(dut)
     frames = adc_frames(3, seed=1)
-    tb.set_idle_generator(random_pause(0.3, 3))
-    tb.set_backpressure_generator(random_pause(0.3, 4))
-    await tb.reset()
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.recv_frames(3, 4 * tb.frame_timeout_cycles())
-    assert_packets_equal(got, dma_packets(frames, TX3, chain), os.environ["RP_TX3_SET"])
-    st = tb.status()
-    assert st["frames_out"] == 3 and st["chirps_in"] == 3 * TX3.n_chirps, st
-    for flag in ("status_adc_overflow", "status_dma_overflow", "status_fft_overflow",
-                 "status_framing_error"):
-        assert st[flag] == 0, (flag, st)
+    got = await tb.stream_under_stalls(frames, TX3, chain, os.environ["RP_TX3_SET"],
+                                       idle=random_pause(0.3, 3),
+                                       backpressure=random_pause(0.3, 4), timeout_frames=4)
     check_decoded(chain, frames, got)
 
 
@@ -121,13 +104,7 @@ async def reset_mid_stream(dut) -> None:
     out bit-exact with frame ids from 0."""
     tb, chain = setup(dut)
     frames = adc_frames(3, seed=11)
-    await tb.reset()
-    tb.set_idle_generator(chirp_bursts(TX3.n_range, TX3.n_range))
-    tb.set_backpressure_generator(random_pause(0.2, 5))
-    for adc in frames:
-        await tb.send_frame(adc)
-    got = await tb.reset_then_recv(TX3.n_chirps * TX3.n_range, 2)
-    assert_packets_equal(got, dma_packets(frames[1:], TX3, chain), "after reset")
+    got = await tb.reset_mid_frame(frames, TX3, chain, "after reset", random_pause(0.2, 5))
     check_decoded(chain, frames[1:], got)
 
 
