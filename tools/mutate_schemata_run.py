@@ -21,11 +21,11 @@ from pathlib import Path
 
 from mutate_gen import Mutant, candidates
 from mutate_run import COPY_DIRS, OUT, apply, compiles, lint, run_mutant, run_stages
-from mutate_schemata import Schemata, schemata
+from mutate_schemata import MUT_VAR, Schemata, schemata
 from mutate_stages import REPO, TESTS
 
 ROOT = OUT / "schemata"
-_ERR = re.compile(r"%Error[-\w]*: (\S+?):(\d+):")
+_LOC = re.compile(r"(\S+?\.sv):(\d+):")
 
 
 def log(text: str) -> None:
@@ -77,8 +77,11 @@ def prepare(module: str, mutants: list[Mutant], root: Path
         proc = lint(root, path)
         if proc.returncode == 0:
             return sch, invalid
-        bad = {int(n) - 1 for f, n in _ERR.findall(proc.stdout + proc.stderr)
-               if Path(f).name == Path(path).name}
+        # every guarded line an error names (a constant function's guard is named as the
+        # "location of non-constant" line, the error itself at the function's call)
+        lines = sch.text.splitlines()
+        bad = {int(n) - 1 for f, n in _LOC.findall(proc.stdout + proc.stderr)
+               if Path(f).name == Path(path).name and MUT_VAR in lines[int(n) - 1]}
         if not bad - exclude:   # an error the guards did not cause: no schemata
             log(f"{module}: schemata do not lint:\n{proc.stderr[-2000:]}")
             (root / path).write_text(text)
