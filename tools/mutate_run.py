@@ -80,23 +80,30 @@ def ccache_env() -> dict[str, str]:
 
 
 def run_stages(root: Path, env: dict[str, str], stages: list[list[str]],
-               timeout: float) -> str:
+               timeout: float, budgets: list[float] | None = None,
+               times: list[float] | None = None) -> str:
     """Run the pytest ``stages`` in the tree at ``root`` until one fails: "killed" (a stage
     failed), "timeout" (a stage overran its budget: ``timeout`` seconds, times
-    :data:`SLOW_STAGE` for the slow testbenches) or "survived"."""
-    for stage in stages:
+    :data:`SLOW_STAGE` for the slow testbenches, or at least ``budgets[i]`` seconds for
+    stage ``i``) or "survived". The seconds of each stage run are appended to ``times``."""
+    for i, stage in enumerate(stages):
         slow = any(big in t for t in stage for big in SLOW_TBS)
+        limit = max(timeout * (SLOW_STAGE if slow else 1.0), budgets[i] if budgets else 0.0)
+        t0 = time.monotonic()
         cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
                "no:cacheprovider", *stage]
         # own process group: a timeout ends pytest and the simulator it started
         proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, start_new_session=True)
         try:
-            proc.wait(timeout=timeout * (SLOW_STAGE if slow else 1.0))
+            proc.wait(timeout=limit)
         except subprocess.TimeoutExpired:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
             return "timeout"
+        finally:
+            if times is not None:
+                times.append(time.monotonic() - t0)
         if proc.returncode != 0:
             return "killed"
     return "survived"

@@ -25,6 +25,8 @@ from mutate_schemata import MUT_VAR, Schemata, schemata
 from mutate_stages import REPO, TESTS
 
 ROOT = OUT / "schemata"
+BASE_TIMEOUT = 4 * 3600.0
+"""Seconds per stage of the original design's run (its builds included)."""
 _LOC = re.compile(r"(\S+?\.sv):(\d+):")
 
 
@@ -107,18 +109,21 @@ def run_schemata(mutants: list[Mutant], timeout: float, quick: bool
         stages = TESTS[module][:1] if quick else TESTS[module]
         held = [m for m in mine if m.ident in sch.ids]
         classic = list(sch.classic)
+        budgets: list[float] = []
         if held:
-            t0 = time.monotonic()
             base = run_stages(root, {**env, "RTLSIM_PLUSARGS": "+MUTANT=0"}, stages,
-                              timeout * 3)
-            log(f"{module}: original design through the schemata: {base} "
-                f"({time.monotonic() - t0:.0f} s, builds included)")
+                              BASE_TIMEOUT, times=budgets)
+            log(f"{module}: original design through the schemata: {base} (stages "
+                f"{', '.join(f'{t:.0f}' for t in budgets)} s, builds included)")
+            # a mutant's stage may take 3x the original's (builds included) before it is a
+            # hang: the --timeout budget alone is too short for whole testbench folders
+            budgets = [3 * t for t in budgets]
             if base != "survived":
                 classic, held = sorted(held + classic, key=mine.index), []
         for m in held:
             t0 = time.monotonic()
             verdict = run_stages(root, {**env, "RTLSIM_PLUSARGS": f"+MUTANT={sch.ids[m.ident]}"},
-                                 stages, timeout)
+                                 stages, timeout, budgets)
             yield m, verdict, time.monotonic() - t0
         for m in classic:
             yield m, *run_mutant(m, timeout, quick=quick)
