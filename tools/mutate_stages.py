@@ -152,6 +152,9 @@ EQUIVALENT: dict[str, str] = {
     "mark_fifo:tie:0": (
         "full = cnt_q >= DEPTH instead of ==: cnt_q never exceeds DEPTH (a push while full "
         "is refused unless a pop leaves in the same cycle), so the two agree"),
+    "frame_align:noreset:4": (
+        "discard_q left out of reset (as frame_align:const:8): it is read only in FILL, and "
+        "FILL is entered only from PASS through the arm that writes discard_q"),
     "frame_align:count:6": (
         "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
