@@ -84,11 +84,13 @@ def run_stages(root: Path, env: dict[str, str], stages: list[list[str]],
                times: list[float] | None = None) -> str:
     """Run the pytest ``stages`` in the tree at ``root`` until one fails: "killed" (a stage
     failed), "timeout" (a stage overran its budget: ``timeout`` seconds, times
-    :data:`SLOW_STAGE` for the slow testbenches, or at least ``budgets[i]`` seconds for
-    stage ``i``) or "survived". The seconds of each stage run are appended to ``times``."""
+    :data:`SLOW_STAGE` for the slow testbenches; with ``budgets``, the larger of
+    ``timeout`` and ``budgets[i]`` for stage ``i``) or "survived". The seconds of each
+    stage run are appended to ``times``."""
     for i, stage in enumerate(stages):
         slow = any(big in t for t in stage for big in SLOW_TBS)
-        limit = max(timeout * (SLOW_STAGE if slow else 1.0), budgets[i] if budgets else 0.0)
+        # with budgets (the schemata: builds done once, before) no allowance for builds
+        limit = max(timeout, budgets[i]) if budgets else timeout * (SLOW_STAGE if slow else 1)
         t0 = time.monotonic()
         cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
                "no:cacheprovider", *stage]

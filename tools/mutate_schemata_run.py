@@ -115,8 +115,8 @@ def run_schemata(mutants: list[Mutant], timeout: float, quick: bool
                               BASE_TIMEOUT, times=budgets)
             log(f"{module}: original design through the schemata: {base} (stages "
                 f"{', '.join(f'{t:.0f}' for t in budgets)} s, builds included)")
-            # a mutant's stage may take 3x the original's (builds included) before it is a
-            # hang: the --timeout budget alone is too short for whole testbench folders
+            # a mutant's stage may take 3x the original's (builds included), at least
+            # --timeout, before it is a hang (whole testbench folders overran a fixed budget)
             budgets = [3 * t for t in budgets]
             if base != "survived":
                 classic, held = sorted(held + classic, key=mine.index), []
