@@ -155,6 +155,12 @@ EQUIVALENT: dict[str, str] = {
     "frame_align:noreset:4": (
         "discard_q left out of reset (as frame_align:const:8): it is read only in FILL, and "
         "FILL is entered only from PASS through the arm that writes discard_q"),
+    "frame_align:tie:0": (
+        "chirp_end = smp_q >= N_RANGE - 1 instead of ==: smp_q never exceeds N_RANGE - 1 "
+        "(frame_align's proof asserts smp_q <= N_RANGE - 1), so the two agree"),
+    "chirp_pingpong:tie:0": (
+        "last_pos = pos_q >= N_RANGE - 1 instead of ==: pos_q never exceeds N_RANGE - 1 "
+        "(chirp_pingpong's proof asserts pos_q <= N_RANGE - 1), so the two agree"),
     "frame_align:count:6": (
         "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
