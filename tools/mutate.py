@@ -25,10 +25,12 @@ deterministic for a given ``--seed``.
     python tools/mutate.py -n 40 --seed 1              # 40 mutants spread over modules
     python tools/mutate.py --ci                        # the fixed CI subset
     python tools/mutate.py --all --ray --workers 2     # every candidate, as Ray tasks
+    python tools/mutate.py --all --schemata --resume   # every candidate, one build a module
 
 Modules: tools/mutate_stages.py (the testbench stages per module, the CI subset, the known
 equivalent mutants), tools/mutate_gen.py and tools/mutate_ops.py (the candidates),
-tools/mutate_run.py (running one mutant), tools/mutate_ray.py (on Ray); this file the
+tools/mutate_run.py (running one mutant), tools/mutate_ray.py (on Ray),
+tools/mutate_schemata.py and tools/mutate_schemata_run.py (mutant schemata); this file the
 report, the results file and the command line.
 """
 
@@ -128,6 +130,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ray", action="store_true",
                     help="run the mutants as Ray tasks (tools/mutate_ray.py): a local Ray "
                          "with --workers CPUs, or --ray-address / RAY_ADDRESS")
+    ap.add_argument("--schemata", action="store_true",
+                    help="one build per module with every mutant compiled in, each mutant a "
+                         "simulation run (tools/mutate_schemata.py); the lines it cannot "
+                         "guard go through per-mutant builds")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="with --ray: mutants in flight at once")
     ap.add_argument("--ray-address", default=None, metavar="ADDR",
@@ -188,10 +194,14 @@ def main(argv: list[str] | None = None) -> int:
         chosen = [m for m in chosen if m.ident not in done]
     if args.reverse:
         chosen = chosen[::-1]
-    if args.ray and args.formal:
-        print("error: --ray runs the testbenches; not with --formal", file=sys.stderr)
+    if (args.ray or args.schemata) and args.formal:
+        print("error: --ray / --schemata run the testbenches; not with --formal",
+              file=sys.stderr)
         return 2
-    if args.ray:
+    if args.schemata:
+        from mutate_schemata_run import run_schemata  # tools/ is on sys.path (the script's)
+        runs = run_schemata(chosen, args.timeout, args.quick or args.ci)
+    elif args.ray:
         from mutate_ray import run_on_ray  # tools/ is on sys.path as the script's folder
         runs = run_on_ray(chosen, args.timeout, args.quick or args.ci, args.workers,
                           args.ray_address)

@@ -40,9 +40,9 @@ def apply(mutant: Mutant, root: Path) -> None:
     p.write_text("".join(lines))
 
 
-def compiles(mutant: Mutant, root: Path) -> bool:
-    """Verilator lint of the mutated module (a mutant that does not compile is invalid,
-    not killed: it says nothing about the testbench)."""
+def lint(root: Path, path: str) -> subprocess.CompletedProcess[str]:
+    """Verilator lint of the module in file ``path`` (relative) of the tree at ``root``
+    (errors fail it, warnings do not)."""
     sys.path.insert(0, str(REPO))
     from rtlsim.toolchain import ensure_verilator_env
     ensure_verilator_env()
@@ -50,8 +50,14 @@ def compiles(mutant: Mutant, root: Path) -> bool:
             for a in ("-y", str(d))]
     pkgs = sorted(str(p) for p in (root / "rtl").rglob("*_pkg.sv"))
     cmd = ["verilator", "--lint-only", "-Wno-fatal", "--assert", *dirs, *pkgs,
-           str(root / mutant.path), "--top-module", Path(mutant.path).stem]
-    return subprocess.run(cmd, cwd=root, capture_output=True).returncode == 0
+           str(root / path), "--top-module", Path(path).stem]
+    return subprocess.run(cmd, cwd=root, capture_output=True, text=True)
+
+
+def compiles(mutant: Mutant, root: Path) -> bool:
+    """Verilator lint of the mutated module (a mutant that does not compile is invalid,
+    not killed: it says nothing about the testbench)."""
+    return lint(root, mutant.path).returncode == 0
 
 
 def ccache_env() -> dict[str, str]:
@@ -73,6 +79,38 @@ def ccache_env() -> dict[str, str]:
             "CCACHE_NOHASHDIR": "1"}
 
 
+def run_stages(root: Path, env: dict[str, str], stages: list[list[str]],
+               timeout: float, budgets: list[float] | None = None,
+               times: list[float] | None = None) -> str:
+    """Run the pytest ``stages`` in the tree at ``root`` until one fails: "killed" (a stage
+    failed), "timeout" (a stage overran its budget: ``timeout`` seconds, times
+    :data:`SLOW_STAGE` for the slow testbenches; with ``budgets``, the larger of
+    ``timeout`` and ``budgets[i]`` for stage ``i``) or "survived". The seconds of each
+    stage run are appended to ``times``."""
+    for i, stage in enumerate(stages):
+        slow = any(big in t for t in stage for big in SLOW_TBS)
+        # with budgets (the schemata: builds done once, before) no allowance for builds
+        limit = max(timeout, budgets[i]) if budgets else timeout * (SLOW_STAGE if slow else 1)
+        t0 = time.monotonic()
+        cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
+               "no:cacheprovider", *stage]
+        # own process group: a timeout ends pytest and the simulator it started
+        proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, start_new_session=True)
+        try:
+            proc.wait(timeout=limit)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            return "timeout"
+        finally:
+            if times is not None:
+                times.append(time.monotonic() - t0)
+        if proc.returncode != 0:
+            return "killed"
+    return "survived"
+
+
 def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
                quick: bool = False) -> tuple[str, float]:
     """Run the covering testbenches on a copy of the tree holding ``mutant``.
@@ -92,28 +130,7 @@ def run_mutant(mutant: Mutant, timeout: float, tests: list[str] | None = None,
         env["PYTHONPATH"] = f"{root}{os.pathsep}{env.get('PYTHONPATH', '')}"
         env.update(ccache_env())
         stages = [tests] if tests else TESTS[mutant.module]
-        if quick:
-            stages = stages[:1]
-        verdict = "survived"
-        for stage in stages:
-            # per stage: the whole-pipeline and full-FFT stages get a longer budget
-            slow = any(big in t for t in stage for big in SLOW_TBS)
-            t_stage = time.monotonic()
-            left = timeout * (SLOW_STAGE if slow else 1.0) - (time.monotonic() - t_stage)
-            cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
-                   "no:cacheprovider", *stage]
-            # own process group: a timeout ends pytest and the simulator it started
-            proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
-                                    stderr=subprocess.DEVNULL, start_new_session=True)
-            try:
-                proc.wait(timeout=max(left, 1.0))
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait()
-                return "timeout", time.monotonic() - t0
-            if proc.returncode != 0:
-                verdict = "killed"
-                break
+        verdict = run_stages(root, env, stages[:1] if quick else stages, timeout)
     return verdict, time.monotonic() - t0
 
 

@@ -139,6 +139,28 @@ EQUIVALENT: dict[str, str] = {
     "mark_fifo:const:8": (
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
+    "mark_fifo:arith:1": (
+        "the shift loop runs two steps further (i < DEPTH + 1): q[DEPTH-1] <= q[DEPTH] is "
+        "overridden by the next statement, q[DEPTH-1] <= '0, and q[DEPTH] <= q[DEPTH+1] "
+        "writes outside the array (no register; the simulator drops the write)"),
+    "mark_fifo:rel:2": (
+        "the reset loop runs one step further (i <= DEPTH): q[DEPTH] <= '0 writes outside "
+        "the array (no register; the simulator drops the write)"),
+    "mark_fifo:rel:4": (
+        "the shift loop runs one step further (i <= DEPTH - 1, as mark_fifo:const:8): "
+        "q[DEPTH-1] <= q[DEPTH] is overridden by the next statement, q[DEPTH-1] <= '0"),
+    "mark_fifo:tie:0": (
+        "full = cnt_q >= DEPTH instead of ==: cnt_q never exceeds DEPTH (a push while full "
+        "is refused unless a pop leaves in the same cycle), so the two agree"),
+    "frame_align:noreset:4": (
+        "discard_q left out of reset (as frame_align:const:8): it is read only in FILL, and "
+        "FILL is entered only from PASS through the arm that writes discard_q"),
+    "frame_align:tie:0": (
+        "chirp_end = smp_q >= N_RANGE - 1 instead of ==: smp_q never exceeds N_RANGE - 1 "
+        "(frame_align's proof asserts smp_q <= N_RANGE - 1), so the two agree"),
+    "chirp_pingpong:tie:0": (
+        "last_pos = pos_q >= N_RANGE - 1 instead of ==: pos_q never exceeds N_RANGE - 1 "
+        "(chirp_pingpong's proof asserts pos_q <= N_RANGE - 1), so the two agree"),
     "frame_align:count:6": (
         "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
