@@ -61,6 +61,7 @@ TESTS: dict[str, list[list[str]]] = {
     "cfar_2d": [[_Q_CFAR], [_Q_DC]],
     "cfar_vsum": [[_Q_CFAR], [_Q_DC]],
     "cfar_peak": [[_Q_CFAR], [_Q_DC]],
+    "cfar_ring": [[_Q_CFAR], [_Q_DC]],
     "cfar_sums": [[_Q_CFAR], [_Q_DC]],
     "cfar_os": [[_Q_CFAR]],
     "detect_records": [[_Q_REC], [_Q_DC]],

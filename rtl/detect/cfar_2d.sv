@@ -348,21 +348,8 @@ module cfar_2d #(
   );
   always_ff @(posedge clk) first4_q <= (s_q3 == '0);
 
-  // ---------------------------------------------------------------------------------------
-  // Shift register of the previous 2*PD columns' sums (index 0 = newest)
-  logic             ev4;         // a tested row's column arrives
-  logic [2*PD-1:0][SUM_W-1:0] sr_o, sr_i;
+  logic             ev4;         // a tested row's column arrives (the delay lines shift)
   assign ev4 = v_q[4] && test_q[4];
-  always_ff @(posedge clk) begin
-    if (ev4) begin
-      sr_o[0]  <= vo4_q;
-      sr_i[0]  <= vi4_q;
-      for (int k = 1; k < 2 * PD; k++) begin
-        sr_o[k] <= sr_o[k-1];
-        sr_i[k] <= sr_i[k-1];
-      end
-    end
-  end
 
   // Stages 4..6: the cell, its neighbours, the local-maximum test (cfar_peak.sv)
   logic [POW_W-1:0] cut5_q, nb_rm5_q, nb_rp5_q, nb_dm5_q, nb_dp5_q;
@@ -392,7 +379,7 @@ module cfar_2d #(
               .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
               .CA_ONLY(BUILT[2:1] == 2'b00)) u_sums (
     .clk(clk), .ev4(ev4), .first4(first4_q), .s3(s_q3), .vo4(vo4_q), .vi4(vi4_q),
-    .sr_o(sr_o), .sr_i(sr_i), .kind(kind_q), .cut5(cut5_q),
+    .kind(kind_q), .cut5(cut5_q),
     .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum10(sum10), .over10(over10)
   );
 

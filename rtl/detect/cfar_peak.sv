@@ -31,20 +31,16 @@ module cfar_peak #(
   output logic                               peak6
 );
 
-  logic [POW_W-1:0] sr_c [PD+1];
-  logic [POW_W-1:0] sr_rm [PD+1];
-  logic [POW_W-1:0] sr_rp [PD+1];
-  always_ff @(posedge clk)
-    if (ev4) begin
-      sr_c[0]  <= vcut4;
-      sr_rm[0] <= rm4;
-      sr_rp[0] <= rp4;
-      for (int k = 1; k <= PD; k++) begin
-        sr_c[k]  <= sr_c[k-1];
-        sr_rm[k] <= sr_rm[k-1];
-        sr_rp[k] <= sr_rp[k-1];
-      end
-    end
+  // the shift registers, read at PD-2 (PD > 1), PD-1 and PD: rings (cfar_ring.sv)
+  localparam logic [PD:0] USED = (PD > 1) ? (PD + 1)'(7) << ((PD > 1) ? PD - 2 : 0)
+                                           : (PD + 1)'(3);
+  logic [PD:0][POW_W-1:0] sr_c, sr_rm, sr_rp;
+  cfar_ring #(.W(POW_W), .N(PD + 1), .USED(USED)) u_ring_c (
+    .clk(clk), .en(ev4), .d(vcut4), .q(sr_c));
+  cfar_ring #(.W(POW_W), .N(PD + 1), .USED(USED)) u_ring_rm (
+    .clk(clk), .en(ev4), .d(rm4), .q(sr_rm));
+  cfar_ring #(.W(POW_W), .N(PD + 1), .USED(USED)) u_ring_rp (
+    .clk(clk), .en(ev4), .d(rp4), .q(sr_rp));
 
   // Doppler +1 neighbours (rows q, q-1, q+1): the arriving column when PD = 1
   logic [POW_W-1:0] nb_dp4, dg_mp4, dg_pp4;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // cfar_2d's training sums and threshold test (stages 4..10 of its pipeline, docs/detect.md):
-// the running window sums over the column shift register, the training sum S of the kind
+// the column delay lines (cfar_ring.sv), the running window sums over them, the training
+// sum S of the kind
 // chosen at run time (CA: all training cells; GO / SO: the greater / smaller of the two
 // Doppler halves, offsets < 0 and > 0; OS uses the CA sum as its noise estimate), the
 // product S * scale and the test CUT * 2^SCALE_FRAC > S * scale.
@@ -25,11 +26,9 @@ module cfar_sums #(
   input  wire logic                          first4,
   input  wire logic [S_W-1:0]                s3,
   // stage 4: the arriving column's vertical sums over the window rows (o) and guard rows
-  // (i); the shift register of the previous 2*PD columns' sums (index 0 = newest)
+  // (i)
   input  wire logic [SUM_W-1:0]              vo4,
   input  wire logic [SUM_W-1:0]              vi4,
-  input  wire logic [2*PD-1:0][SUM_W-1:0]    sr_o,
-  input  wire logic [2*PD-1:0][SUM_W-1:0]    sr_i,
   // quasi-static kind: 0 CA, 1 GO, 2 SO, 3 OS (S = the CA sum)
   input  wire logic [1:0]                    kind,
   // stage 5: the cell under test and its row's threshold scale
@@ -59,6 +58,24 @@ module cfar_sums #(
     else         win_b = (w == 0) ? 2 * PD - 1 : ((w == 1) ? PD - 1 + GUARD_D : PD - 2);
   endfunction
   localparam int NW = CA_ONLY ? 2 : 4;
+
+  // The previous 2*PD columns' sums (index 0 = newest), a shift register on ev4 read only
+  // at the positions the windows use (entering, leaving, the CUT's column): rings in
+  // distributed RAM (cfar_ring.sv)
+  function automatic logic [2*PD-1:0] taps(input bit o);
+    taps = '0;
+    for (int w = 0; w < NW; w++)
+      if ((w % 2 == 0) == o && win_b(w) >= win_a(w)) begin
+        if (win_a(w) > 0) taps[win_a(w) - 1] = 1'b1;
+        taps[win_b(w)] = 1'b1;
+      end
+    if (!CA_ONLY) taps[PD-1] = 1'b1;
+  endfunction
+  logic [2*PD-1:0][SUM_W-1:0] sr_o, sr_i;
+  cfar_ring #(.W(SUM_W), .N(2 * PD), .USED(taps(1'b1))) u_ring_o (
+    .clk(clk), .en(ev4), .d(vo4), .q(sr_o));
+  cfar_ring #(.W(SUM_W), .N(2 * PD), .USED(taps(1'b0))) u_ring_i (
+    .clk(clk), .en(ev4), .d(vi4), .q(sr_i));
   logic [SUM_W-1:0] wsum [4];
   for (genvar w = 0; w < 4; w++) begin : g_win
     localparam int A = win_a(w);

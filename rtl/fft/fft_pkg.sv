@@ -23,23 +23,22 @@ package fft_pkg;
     end
   endfunction
 
-  // True when v does not fit a w-bit two's complement number.
+  // True when v does not fit a w-bit two's complement number, i.e. v > 2^(w-1) - 1 or
+  // v < -2^(w-1): its bits w-1..63 are not all equal (bit tests, no magnitude comparator:
+  // a comparator against the limits would be a carry chain after the rounding's).
   function automatic logic sat_ov(input logic signed [63:0] v, input int unsigned w);
-    logic signed [63:0] hi, lo;
-    hi = (64'sd1 <<< (w - 1)) - 64'sd1;
-    lo = -(64'sd1 <<< (w - 1));
-    sat_ov = (v > hi) || (v < lo);
+    logic [63:0] top;
+    top = v >>> (w - 1);
+    sat_ov = (top != '0) && (top != '1);
   endfunction
 
-  // v clipped to the w-bit two's complement range (result in the low w bits).
+  // v clipped to the w-bit two's complement range (result in the low w bits): the limit of
+  // v's sign when it does not fit.
   function automatic logic signed [63:0] sat_val(input logic signed [63:0] v,
                                                  input int unsigned w);
-    logic signed [63:0] hi, lo;
-    hi = (64'sd1 <<< (w - 1)) - 64'sd1;
-    lo = -(64'sd1 <<< (w - 1));
-    if (v > hi) sat_val = hi;
-    else if (v < lo) sat_val = lo;
-    else sat_val = v;
+    if (!sat_ov(v, w)) sat_val = v;
+    else if (v[63]) sat_val = -(64'sd1 <<< (w - 1));
+    else sat_val = (64'sd1 <<< (w - 1)) - 64'sd1;
   endfunction
 endpackage
 
