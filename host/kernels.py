@@ -1,4 +1,5 @@
 """The compiler of the host's kernels (``host._angle_peaks``, ``host._angle_relax``,
+``host._angle_kept``,
 ``host.cfar``, ``host._cfar_os``, ``host.dca1000``, ``host.pipeline``, ``host.tdm``,
 ``host.record_points``):
 numba when it is installed, else the same Python functions run as they are (the same results,
@@ -77,6 +78,7 @@ def compile_data_dependent() -> None:
 def _load_kernels() -> None:
     """Import every kernel module of the host (so that :func:`uncompiled_kernels` knows all
     of them)."""
+    import host._angle_kept  # noqa: F401
     import host._angle_relax  # noqa: F401
     import host.cfar  # noqa: F401
     import host.dca1000  # noqa: F401
