@@ -90,6 +90,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from host._angle_array import ArrayGrid, array_grid, bartlett_peaks, relax_general, supported
+from host._angle_kept import kept_slots
 from host._angle_peaks import COARSE_FFT, class_peaks, peak_sins
 from host._angle_relax import (
     first_components,
@@ -330,27 +331,16 @@ def _kept_components(s_c: np.ndarray, a_c: np.ndarray, count: np.ndarray, noise:
     """The components found per row (sin s_c float (m, k), amplitude a_c complex (m, k), the
     first count int (m,) slots of each row valid; noise float (m,) per channel, n channels)
     strongest first (a stable sort), without those that collapsed onto a stronger one during
-    refinement (within 0.5 / n in sin(az)), as flat :class:`AngleArrays`. A general array:
+    refinement (within 0.5 / n in sin(az); ``host._angle_kept.kept_slots``), as flat
+    :class:`AngleArrays`. A general array:
     s_c holds the direction cosines u, w_c float (m, k) the w, span (H + 1, V + 1) its
     apertures (``host._angle_array.ArrayGrid``): collapsed within 0.5 / (H + 1) in u and
     0.5 / (V + 1) in w, the w kept as ``sin_el``."""
-    kmax = s_c.shape[1]
+    mag = np.abs(a_c)
     with np.errstate(divide="ignore"):
-        snr_c = 10 * np.log10(np.abs(a_c) ** 2 * n / noise[:, None])   # 0 in unused slots
-    valid = np.arange(kmax)[None, :] < count[:, None]
-    order = np.argsort(np.where(valid, -np.abs(a_c), np.inf), axis=1, kind="stable")
-    s_o = np.take_along_axis(s_c, order, axis=1)
-    w_o = None if w_c is None else np.take_along_axis(w_c, order, axis=1)
+        snr_c = 10 * np.log10(mag ** 2 * n / noise[:, None])   # 0 in unused slots
     tol_u, tol_w = (0.5 / n, np.inf) if span is None else (0.5 / span[0], 0.5 / span[1])
-    kept = np.take_along_axis(valid, order, axis=1)
-    for p in range(kmax):
-        for u in range(p):
-            apart = np.abs(s_o[:, p] - s_o[:, u]) > tol_u
-            if w_o is not None:
-                apart |= np.abs(w_o[:, p] - w_o[:, u]) > tol_w
-            kept[:, p] &= ~kept[:, u] | apart
-    rows, pos = np.nonzero(kept)
-    comp = order[rows, pos]
+    rows, comp = kept_slots(mag, count, s_c, w_c, tol_u, tol_w)
     return AngleArrays(rows.astype(np.int64), s_c[rows, comp], a_c[rows, comp],
                        snr_c[rows, comp], None if w_c is None else w_c[rows, comp])
 

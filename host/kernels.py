@@ -1,6 +1,4 @@
-"""The compiler of the host's kernels (``host._angle_peaks``, ``host._angle_relax``,
-``host.cfar``, ``host._cfar_os``, ``host.dca1000``, ``host.pipeline``, ``host.tdm``,
-``host.record_points``):
+"""The compiler of the host's kernels (the modules of :data:`KERNEL_MODULES`):
 numba when it is installed, else the same Python functions run as they are (the same results,
 much slower: a fallback, not a mode callers choose).
 
@@ -11,12 +9,27 @@ Some kernels run only on some data (RELAX: cells with several targets): a module
 a :func:`warm_up` that calls them on a tiny input, and :func:`compile_data_dependent` runs
 those, so that one run leaves every kernel cached (else the "compiling" note would come
 back on every run whose data never reached them).
+
+Stale caches. numba's disk cache of a kernel is keyed by its own source file (its
+modification time and size): a kernel that calls a kernel of another file (RELAX and the
+split in ``host._angle_relax`` call ``host._angle_peaks``' peak search, compiled into them)
+keeps running the callee's old compiled code after only the callee's file changed (an
+upgrade, a checkout), silently. So the caches are also keyed by the sources of all kernel
+modules: :func:`sources_hash` (SHA-256 of their files, about 0.3 ms) is kept in
+:data:`STAMP` beside the caches, and when it differs from the sources' (checked once per
+cache directory, when its first kernel is registered, before any is loaded) the cache files
+of those modules are deleted there (:func:`refresh_cache`); the next calls compile them
+afresh. A module that registers kernels must be named in :data:`KERNEL_MODULES` (:func:`njit`
+refuses others).
 """
 
 from __future__ import annotations
 
+import hashlib
+import importlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 try:
@@ -27,18 +40,78 @@ except ImportError:                      # pragma: no cover - numba is a pinned 
 COMPILED = numba is not None
 """Whether the kernels are compiled (numba importable)."""
 
+KERNEL_MODULES = ("host._angle_kept", "host._angle_peaks", "host._angle_relax",
+                  "host._cfar_os", "host.cfar", "host.dca1000", "host.pipeline",
+                  "host.record_points", "host.tdm")
+"""Every module that registers kernels (:func:`njit`): their sources key the caches."""
+STAMP = "host-kernels.sha256"
+"""The file, in a cache directory, holding the :func:`sources_hash` its caches were made
+from."""
+
 _KERNELS: dict[str, Any] = {}
 _WARM_UPS: list[Callable[[], None]] = []
+_CHECKED: set[str] = set()
 
 
 def njit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
     """``numba.njit(cache=True, **options)`` when numba is available, else the function
-    itself; the kernel is registered for :func:`uncompiled_kernels` under its name."""
+    itself; the kernel is registered for :func:`uncompiled_kernels` under its name, and its
+    cache directory's stale caches are dropped first (module docstring). ValueError for a
+    module not in :data:`KERNEL_MODULES`."""
     def wrap(fn: Callable[..., Any]) -> Any:
+        if fn.__module__ not in KERNEL_MODULES:
+            raise ValueError(f"host.kernels: {fn.__module__}.{fn.__name__}: a kernel module "
+                             f"must be listed in KERNEL_MODULES")
         kernel = numba.njit(cache=True, **options)(fn) if COMPILED else fn
+        if COMPILED:
+            path = getattr(getattr(kernel, "_cache", None), "_cache_path", None)
+            if isinstance(path, str) and path not in _CHECKED:
+                _CHECKED.add(path)
+                refresh_cache(Path(path), _module_files())
         _KERNELS[fn.__name__] = kernel
         return kernel
     return wrap
+
+
+def _module_files() -> list[Path]:
+    """The source files of :data:`KERNEL_MODULES`."""
+    here = Path(__file__).resolve().parent
+    return [here / f"{name.rsplit('.', 1)[1]}.py" for name in KERNEL_MODULES]
+
+
+def sources_hash(sources: Sequence[Path]) -> str:
+    """SHA-256 (hex) of the files ``sources``, names and contents, in the order given."""
+    h = hashlib.sha256()
+    for path in sources:
+        h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def refresh_cache(cache_dir: Path, sources: Sequence[Path]) -> bool:
+    """Drop the numba cache files (``<module>.<function>-<line>.*.nbi`` and ``.nbc``) of the
+    modules ``sources`` (their files) in ``cache_dir`` unless its :data:`STAMP` holds the
+    :func:`sources_hash` of ``sources``, then write that hash there. Whether caches were
+    dropped. A directory that cannot be read or written is left as it is (numba then
+    compiles or loads as it would)."""
+    digest = sources_hash(sources)
+    stamp = cache_dir / STAMP
+    try:
+        if stamp.exists() and stamp.read_text().strip() == digest:
+            return False
+        stems = {p.stem for p in sources}
+        dropped = False
+        if cache_dir.is_dir():
+            for f in cache_dir.iterdir():
+                if f.suffix in (".nbi", ".nbc") and f.name.split(".", 1)[0] in stems:
+                    f.unlink(missing_ok=True)
+                    dropped = True
+        cache_dir.mkdir(parents=True, exist_ok=True)
+        tmp = cache_dir / f"{STAMP}.{os.getpid()}"
+        tmp.write_text(digest + "\n")
+        os.replace(tmp, stamp)              # atomic: a concurrent reader sees old or new
+        return dropped
+    except OSError:
+        return False
 
 
 def uncompiled_kernels() -> list[str]:
@@ -77,9 +150,5 @@ def compile_data_dependent() -> None:
 def _load_kernels() -> None:
     """Import every kernel module of the host (so that :func:`uncompiled_kernels` knows all
     of them)."""
-    import host._angle_relax  # noqa: F401
-    import host.cfar  # noqa: F401
-    import host.dca1000  # noqa: F401
-    import host.pipeline  # noqa: F401
-    import host.record_points  # noqa: F401
-    import host.tdm  # noqa: F401
+    for name in KERNEL_MODULES:
+        importlib.import_module(name)

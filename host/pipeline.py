@@ -51,7 +51,7 @@ from host.cfar import (
     sidelobe_masked,
 )
 from host.cube import frame_cube
-from host.kernels import njit
+from host.kernels import njit, warm_up
 from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
 from host.points import points_from_cells
@@ -169,6 +169,17 @@ def _asymmetry_sums(y: np.ndarray) -> tuple[float, float]:
             diff += dr * dr + di * di
             energy += np.float64(a.real) ** 2 + np.float64(a.imag) ** 2
     return diff, energy
+
+
+@warm_up
+def _warm_up() -> None:
+    """The real-only check's sums (reached only by cubes) on a tiny channel: complex64
+    (``radar process``) and complex128 (the float sources), a cube's strided view and a
+    contiguous one."""
+    for dtype in (np.complex64, np.complex128):
+        y = np.zeros((2, 4), dtype)
+        _asymmetry_sums(y)
+        _asymmetry_sums(y[:, ::2])
 
 
 def real_only(cube: np.ndarray) -> bool:

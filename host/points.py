@@ -17,6 +17,8 @@ FPGA's records (``host.record_points``) take (``host.pipeline`` module docstring
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from host.angle import estimate_angles, peak_powers
@@ -44,10 +46,10 @@ def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
     if x.shape != (n, nv):
         raise ValueError(f"cells: snapshots {x.shape}, expected ({n}, {nv}) for {cfg.name}")
     noise = np.asarray(cells.noise, dtype=float)
-    sb = signed_bins(nd)[np.asarray(cells.doppler_bin)].astype(np.int64)
+    sb = _signed_bins(nd)[np.asarray(cells.doppler_bin)]
     snr_db = cell_snr_db(np.asarray(cells.power, dtype=float), noise, nv)
     measured = (sb + cells.offsets[:, 1]) * cfg.velocity_bin_mps
-    positions = None if cfg.uniform_linear_array else cfg.virtual_positions_hw
+    positions = _positions(cfg)
     first_sin = None
     if ntx > 1 and params.unfold_velocity:
         # (cell, class) pairs of the classes that hold a hypothesis: only these enter the
@@ -72,6 +74,25 @@ def points_from_cells(cells: Cells, cfg: RadarConfig, params: DetectionParams,
     return cloud(cfg, params, np.asarray(cells.range_bin), cells.offsets, k, ambiguous,
                  ang.cell, ang.azimuth_deg, ang.amplitude, ang.snr_db, frame,
                  ang.elevation_deg, cells.range_bias_m)
+
+
+@lru_cache(maxsize=16)
+def _signed_bins(n: int) -> np.ndarray:
+    """``model.reference.signed_bins(n)`` as int64, read-only, computed once per length."""
+    sb = signed_bins(n).astype(np.int64)
+    sb.flags.writeable = False
+    return sb
+
+
+@lru_cache(maxsize=16)
+def _positions(cfg: RadarConfig) -> np.ndarray | None:
+    """The virtual array the angle estimator is given: None for the contiguous lambda/2 ULA
+    (its FFT path), else ``cfg.virtual_positions_hw`` (read-only); once per radar."""
+    if cfg.uniform_linear_array:
+        return None
+    p = cfg.virtual_positions_hw
+    p.flags.writeable = False
+    return p
 
 
 def cell_snr_db(power: np.ndarray, noise: np.ndarray, n_virtual: int) -> np.ndarray:

@@ -42,6 +42,14 @@ def _unit_circle(n: int) -> np.ndarray:
     return w
 
 
+@lru_cache(maxsize=16)
+def _slots(cfg: RadarConfig) -> np.ndarray:
+    """``model.array.tx_slots(cfg)``, read-only, once per radar."""
+    q = tx_slots(cfg)
+    q.flags.writeable = False
+    return q
+
+
 def tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     """TDM compensation phasors per TX, complex (..., num_tx), for the *unfolded* signed
     Doppler bins k (any integers, int (...)): TX t's channels are multiplied by
@@ -53,7 +61,7 @@ def tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
     k = signed_bin(k, cfg.n_doppler)
     n = cfg.n_doppler * cfg.num_tx
-    m = np.multiply.outer(k, tx_slots(cfg))
+    m = np.multiply.outer(k, _slots(cfg))
     return _unit_circle(n)[m & (n - 1) if n & (n - 1) == 0 else m % n]   # & : mod 2^b
 
 
