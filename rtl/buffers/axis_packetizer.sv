@@ -160,6 +160,10 @@ module axis_packetizer #(
   logic [SEQ_W-1:0] seq_q;
   logic [FWC_W-1:0] fw_q;        // input word position within the frame
   logic [LEN_W-1:0] pw_q, pw;    // the frame's packet length (pw: also for its first word)
+  // Look-ahead flags, each updated with fw_q/pos_q/pw_q (timing: no counter compare ahead
+  // of the packet end): fw_zero_q = (fw_q == 0), frame_end_q = (fw_q == FRAME_WORDS - 1),
+  // pos_hit_q = (pos_q == pw_q - 1) (the packet's last position; used from its second word)
+  logic             fw_zero_q, frame_end_q, pos_hit_q, pos_hit_next;
   logic [31:0]      frame_q;
   logic [TLP_W-1:0] tl_pos_q;
   logic             ovf_q, framing_q;
@@ -168,14 +172,19 @@ module axis_packetizer #(
   logic             beat, space, store, frame_end, pkt_end, tlast_err, npkt_ok;
   logic [LEN_W-1:0] cnt_next, drop_next;
 
-  assign pw            = (fw_q == '0) ? LEN_W'(cfg_packet_words) : pw_q;
+  assign pw            = fw_zero_q ? LEN_W'(cfg_packet_words) : pw_q;
   assign space         = !full_q[wr_bank_q];
   // a packet closes only once its frame's packet count is known
   assign s_axis_tready = INPUT_BACKPRESSURE ? space && (npkt_ok || !pkt_end) : 1'b1;
   assign beat          = s_axis_tvalid && s_axis_tready;
   assign store         = beat && space;
-  assign frame_end     = (fw_q == FWC_W'(FRAME_WORDS - 1));
-  assign pkt_end       = (LEN_W'(pos_q) == pw - 1'b1) || frame_end;
+  assign frame_end     = frame_end_q;
+  // (a frame's first word is at position 0: a packet end there only for a length of 1)
+  assign pkt_end       = (fw_zero_q ? (LEN_W'(cfg_packet_words) == LEN_W'(1)) : pos_hit_q) ||
+                         frame_end;
+  // pos_hit_q after this beat: position 0 (packet end) or pos_q + 1 against the length pw
+  assign pos_hit_next  = pkt_end ? (pw == LEN_W'(1))
+                                 : (LEN_W'(POS_W'(pos_q + 1'b1)) + 1'b1 == pw);
   assign cnt_next      = wr_cnt_q + LEN_W'(store);
   assign drop_next     = wr_drop_q + LEN_W'(beat && !space);
   assign tlast_err     = (TLAST_PERIOD > 0) && beat &&
@@ -315,7 +324,7 @@ module axis_packetizer #(
     p2_last_q     <= p_last_q;
     p2_hdr_word_q <= p_hdr_word_q;
     if (p2_hdr_q || p2_data_q) crc_q <= crc_next;
-    if (beat && pkt_end && cnt_next != '0) desc_q[wr_bank_q] <= new_desc;
+    if (beat && pkt_end && (wr_cnt_q != '0 || store)) desc_q[wr_bank_q] <= new_desc;
   end
 
   always_ff @(posedge clk) begin
@@ -328,6 +337,9 @@ module axis_packetizer #(
       wr_dmg_q      <= 1'b0;
       seq_q         <= '0;
       fw_q          <= '0;
+      fw_zero_q     <= 1'b1;
+      frame_end_q   <= (FRAME_WORDS == 1);
+      pos_hit_q     <= 1'b0;  // (pw_q = PACKET_WORDS >= 2)
       pw_q          <= LEN_W'(PACKET_WORDS);
       frame_q       <= '0;
       tl_pos_q      <= '0;
@@ -346,7 +358,10 @@ module axis_packetizer #(
       if (beat) begin
         tl_pos_q <= (tl_pos_q == TLP_W'(TLP - 1) || frame_end) ? '0 : tl_pos_q + 1'b1;
         fw_q     <= frame_end ? '0 : fw_q + 1'b1;
-        if (fw_q == '0) pw_q <= pw;
+        fw_zero_q   <= frame_end;
+        frame_end_q <= frame_end ? (FRAME_WORDS == 1) : (fw_q == FWC_W'(FRAME_WORDS - 2));
+        pos_hit_q   <= pos_hit_next;
+        if (fw_zero_q) pw_q <= pw;
         if (!space) begin
           ovf_q <= 1'b1;
           if (drop_cnt_q != '1) drop_cnt_q <= drop_cnt_q + 1'b1;
@@ -365,7 +380,7 @@ module axis_packetizer #(
             frame_q     <= frame_q + 1'b1;
             frame_cnt_q <= frame_cnt_q + 1'b1;
           end
-          if (cnt_next != '0) begin
+          if (wr_cnt_q != '0 || store) begin  // (cnt_next != 0)
             full_q[wr_bank_q] <= 1'b1;
             wr_bank_q         <= wr_bank_q + 1'b1;
           end
@@ -456,6 +471,10 @@ module axis_packetizer #(
       assert (pw_q == LEN_W'(PACKET_WORDS) && dv_op_q == LEN_W'(PACKET_WORDS));
       assert (!dv_busy_q && dv_np_q == NP_W'(NPKT));
       assert (32'(fw_q) == 32'(seq_q) * PACKET_WORDS + 32'(pos_q));
+      assert (fw_zero_q == (fw_q == '0) && frame_end_q == (fw_q == FWC_W'(FRAME_WORDS - 1)));
+      if (fw_zero_q) assert (pos_q == '0);
+      else assert (pos_hit_q == (LEN_W'(pos_q) == pw_q - 1'b1));
+      assert (32'(wr_cnt_q) <= 32'(pos_q));
       assert (seq_q <= SEQ_W'(NPKT - 1));
       assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
       if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));
