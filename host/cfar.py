@@ -219,17 +219,22 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     """
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
-    mirrored = map_axes(windowed, power.shape)[0].real
     (gr, gd), (tr, td) = params.guard, params.train
     if params.kind == "ca":
         check_window(params, power.shape)
         sums = _training_sum(np.ascontiguousarray(power, np.float64), gr, gd, tr, td,
-                             mirrored)
+                             map_axes(windowed, power.shape)[0].real)
         noise = np.maximum(sums, 0.0) / int(_kernel(params).sum())
         return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
-    padded = np.ascontiguousarray(_pad(power.astype(np.float64), params, mirrored))
-    kth = os_kth(padded, gr, gd, tr, td, _os_k(params))
+    kth = os_kth(_os_padded(power, params, windowed), gr, gd, tr, td, _os_k(params))
     return _os_alpha(params.pfa, n_channels, params) * kth, _os_noise(kth, n_channels, params)
+
+
+def _os_padded(power: np.ndarray, params: CfarParams, windowed: Windows) -> np.ndarray:
+    """``power`` (float (n_range, n_doppler)) as float64 padded by the window's reach
+    (``_pad``), in C order: the OS kernels read rows (a cube's map is often Fortran-ordered)."""
+    return np.ascontiguousarray(_pad(power.astype(np.float64), params,
+                                     map_axes(windowed, power.shape)[0].real))
 
 
 def _os_k(params: CfarParams) -> int:
@@ -271,9 +276,7 @@ def cfar_detect(power: np.ndarray, n_channels: int, params: CfarParams,
         return power > threshold, noise
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
-    # C order throughout: the kernels read rows (a cube's map is often Fortran-ordered)
-    padded = np.ascontiguousarray(_pad(power.astype(np.float64), params,
-                                       map_axes(windowed, power.shape)[0].real))
+    padded = _os_padded(power, params, windowed)
     (gr, gd), (tr, td) = params.guard, params.train
     k = _os_k(params)
     scaled = os_scaled(padded, _os_alpha(params.pfa, n_channels, params), np.empty(
