@@ -24,7 +24,7 @@ module fft_window_props #(
   input wire logic [2:0] in_pos
 );
   localparam int DATA_W = 4, GUARD_W = 1, W = 5, LOG2N = 3;
-  localparam int LAT = WINDOW ? 2 : 1;
+  localparam int LAT = WINDOW ? 4 : 1;
   logic [2*W-1:0]   out_data;
   logic             out_vld;
   logic [LOG2N-1:0] out_pos;

@@ -2,7 +2,11 @@
 // Input stage of the streaming FFT: widens each I/Q sample to the internal format
 // (GUARD_W fraction bits) and, with WINDOW = 1, multiplies it by the periodic Hann window
 // of N_IN points from fft_win_rom (the quarter-wave fft_hann_rom when N_IN is a power of two;
-// registered operands and product, convergent rounding).
+// convergent rounding). The multiplier is registered on both sides the way a DSP48E2 (AREG/BREG,
+// MREG) or an ECP5 MULT18X18D wants it: operands registered twice (the first register beside the
+// ROM and the input select, the second beside the multiplier: a long route to a free multiplier
+// column is a whole clock), the exact product registered, then rounded into the output register.
+// Four register stages with the window: operands; operands at the multiplier; product; rounded.
 `default_nettype none
 
 module fft_window #(
@@ -16,7 +20,7 @@ module fft_window #(
   parameter int W = 21,
   // log2 of the transform length, 4..12.
   parameter int LOG2N = 6,
-  // 0: no window (1 advance of latency); 1: periodic Hann (2 advances).
+  // 0: no window (1 advance of latency); 1: periodic Hann (4 advances).
   parameter bit WINDOW = 0,
   // Window length: the samples of a vector (positions 0..N_IN-1), 2..2^LOG2N; the zero fill
   // behind them is zero whatever it is multiplied by.
@@ -47,11 +51,13 @@ module fft_window #(
   end
 
   if (WINDOW) begin : g_win
-    logic [NUM_CH*2*DATA_W-1:0] d1_q;
-    logic [LOG2N-1:0]           pos1_q, pos2_q;
-    logic                       vld1_q, vld2_q;
-    logic signed [COEF_W-1:0]   w1_q;
-    logic [DW-1:0]              y_d, y2_q;
+    localparam int PW = DATA_W + COEF_W;   // exact product width
+    logic [NUM_CH*2*DATA_W-1:0] d1_q, d2_q;
+    logic [LOG2N-1:0]           pos_q [4];
+    logic [3:0]                 vld_q;
+    logic signed [COEF_W-1:0]   w1_q, w2_q;
+    logic signed [PW-1:0]       p3_q [2*NUM_CH];
+    logic [DW-1:0]              y_d, y4_q;
     logic [ROM_LOG2-1:0]        rom_idx;
     logic [COEF_W-1:0]          rom_hann;
 
@@ -60,38 +66,39 @@ module fft_window #(
     fft_win_rom #(.N(N_IN)) u_rom (.k(rom_idx), .w_o(rom_hann));
 
     always_comb begin
-      logic signed [63:0] p;
       y_d = '0;
       for (int c = 0; c < 2 * NUM_CH; c++) begin
-        p = 64'(signed'(d1_q[c*DATA_W +: DATA_W])) * 64'(w1_q);
         // |x * w| <= |x| so the result always fits: no saturation needed.
-        y_d[c*W +: W] = W'(fft_pkg::round_conv(p, COEF_FRAC - GUARD_W));
+        y_d[c*W +: W] = W'(fft_pkg::round_conv(64'(p3_q[c]), COEF_FRAC - GUARD_W));
       end
     end
 
     always_ff @(posedge clk) begin
       if (en) begin
-        d1_q   <= in_data;
-        w1_q   <= signed'(rom_hann);
-        pos1_q <= in_pos;
-        y2_q   <= y_d;
-        pos2_q <= pos1_q;
+        d1_q     <= in_data;
+        w1_q     <= signed'(rom_hann);
+        d2_q     <= d1_q;
+        w2_q     <= w1_q;
+        for (int c = 0; c < 2 * NUM_CH; c++) begin
+          p3_q[c] <= PW'(signed'(d2_q[c*DATA_W +: DATA_W])) * PW'(w2_q);
+        end
+        y4_q     <= y_d;
+        pos_q[0] <= in_pos;
+        for (int k = 1; k < 4; k++) pos_q[k] <= pos_q[k-1];
       end
     end
 
     always_ff @(posedge clk) begin
       if (rst) begin
-        vld1_q <= 1'b0;
-        vld2_q <= 1'b0;
+        vld_q <= '0;
       end else if (en) begin
-        vld1_q <= in_vld;
-        vld2_q <= vld1_q;
+        vld_q <= {vld_q[2:0], in_vld};
       end
     end
 
-    assign out_data = y2_q;
-    assign out_vld  = vld2_q;
-    assign out_pos  = pos2_q;
+    assign out_data = y4_q;
+    assign out_vld  = vld_q[3];
+    assign out_pos  = pos_q[3];
   end else begin : g_nowin
     logic [DW-1:0]    y_d, y1_q;
     logic [LOG2N-1:0] pos1_q;
