@@ -48,6 +48,8 @@ def test_compare_counts_finds_angles_and_clusters():
     a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
     assert a.peer_moving == 5                          # the zero-Doppler one is not counted
     assert a.missed == [(80, 5)]
+    # (60, 7) of ours is near two of its detections, (60, 7) and (62, 8): one of them once
+    assert a.one_to_one == 3
     # strongest per cell, each against its nearest peer detection: same cell, fewest bins
     assert sorted(np.round(a.angle_strongest, 2).tolist()) == [0.2, 0.5, 2.3]
     assert sorted(np.round(a.angle_all, 2).tolist()) == [0.2, 0.5, 2.3, 46.5]
@@ -81,6 +83,7 @@ def test_table_reports_against_the_goals():
     default, matched = text.split("ours default (no options) vs the peer's 15 dB")[1].split(
         "ours peer-ca (--grouping doppler --min-snr-db 15) vs the peer's 15 dB")
     assert "4 of 5  goal all: MISSED" in default
+    assert "  ... each cell of ours counted once        3 of 5\n" in default
     assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in default
     assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in default
     assert "0.22  goal <= 1/3: met" in default
