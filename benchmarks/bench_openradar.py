@@ -366,10 +366,12 @@ BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
-             threshold_db: float, repeat: int, threads: int = 1) -> dict[str, Any]:
+             threshold_db: float, repeat: int, threads: int = 1,
+             map_out: Path | None = None) -> dict[str, Any]:
     """The peer runner's JSON, run by ``python`` (OpenRadar's virtualenv) in a clean
     environment; ``shape`` = (chirps, rx, samples, tx); ``threads``: its BLAS threads (0:
-    its default, one per core)."""
+    its default, one per core); ``map_out``: the runner's ``--map`` (its map and
+    thresholds, .npz)."""
     env = {k: v for k, v in os.environ.items()
            if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", *BLAS_THREADS)}
     if threads:
@@ -380,7 +382,8 @@ def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
         subprocess.run([str(python), str(PEER_RUNNER), "--capture", str(capture),
                         "--chirps", str(chirps), "--rx", str(rx), "--samples", str(samples),
                         "--tx", str(tx), "--threshold-db", f"{threshold_db:g}",
-                        "--repeat", str(repeat), "--out", str(out)], check=True, env=env)
+                        "--repeat", str(repeat), "--out", str(out),
+                        *(["--map", str(map_out)] if map_out else [])], check=True, env=env)
         return json.loads(out.read_text())
 
 

@@ -48,6 +48,7 @@ from host.cfar import (
     CfarParams,
     Windows,
     cfar_detect,
+    cfar_threshold,
     detection_mask,
     local_peaks,
     paper_threshold,
@@ -78,23 +79,25 @@ def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
 
 
 def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
-             static_removed: bool) -> tuple[np.ndarray, np.ndarray]:
+             static_removed: bool, thresholds: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """``host.cfar.cfar_detect`` of the map ``nci`` (float (n_range_bins, n_doppler)):
-    (mask bool, noise float), both of its shape. ``static_removed``: the cube's static
-    clutter was removed, so the CFAR runs on the map without its empty zero-Doppler bin and
-    with the bins the removal lowered divided by their noise gain (``host.cube.
-    static_noise_gain``: plain noise again), the noise estimate scaled back; bin 0 is never
-    detected."""
+    (mask bool, noise float), both of its shape; ``thresholds``: ``host.cfar.
+    cfar_threshold``'s (threshold float, noise float) of every cell instead. ``static_removed``:
+    the cube's static clutter was removed, so the CFAR runs on the map without its empty
+    zero-Doppler bin and with the bins the removal lowered divided by their noise gain
+    (``host.cube.static_noise_gain``: plain noise again), threshold and noise estimate scaled
+    back; bin 0 is never detected (threshold inf, noise NaN)."""
+    run = cfar_threshold if thresholds else cfar_detect
     if not static_removed:
-        return cfar_detect(nci, cfg.n_virtual, cf, windowed)
+        return run(nci, cfg.n_virtual, cf, windowed)
     gain = static_noise_gain(cfg, windowed[1].hann)
     keep = np.flatnonzero(gain > 0.0)
-    detected, noise = cfar_detect(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed)
-    mask = np.zeros(nci.shape, bool)
-    mask[:, keep] = detected
+    first, noise = run(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed)
+    out = np.full(nci.shape, np.inf) if thresholds else np.zeros(nci.shape, bool)
+    out[:, keep] = first * gain[keep] if thresholds else first
     noise_map = np.full(nci.shape, np.nan)
     noise_map[:, keep] = noise * gain[keep]
-    return mask, noise_map
+    return out, noise_map
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams

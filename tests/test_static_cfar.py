@@ -81,7 +81,8 @@ def test_false_alarm_rate_beside_zero_doppler(kind: str) -> None:
 def test_noise_estimate_scaled_back() -> None:
     """Without the removal the corrected CFAR is the plain one; with it, the noise estimate
     of the bins +-1 is their lowered noise (gain 7/12 of the rescaled map's estimate): a
-    cell's SNR over it (``--min-snr-db``) is over the noise that is there."""
+    cell's SNR over it (``--min-snr-db``) is over the noise that is there. The thresholds
+    of every cell (``thresholds=True``) detect the same cells."""
     cfg = PROFILE.config
     windowed = fft_axes(cfg, True, True)
     cf = CfarParams(pfa=PFA)
@@ -93,6 +94,12 @@ def test_noise_estimate_scaled_back() -> None:
     gain = static_noise_gain(cfg, True)
     scaled = nci.copy()
     scaled[:, 1:] /= gain[1:]
-    _, noise = map_cfar(nci, cfg, cf, windowed, True)
+    mask, noise = map_cfar(nci, cfg, cf, windowed, True)
     ref = cfar_detect(scaled[:, 1:], cfg.n_virtual, cf, windowed)[1]
     assert np.allclose(noise[:, 1:], ref * gain[1:], rtol=1e-12)
+    for kind in ("ca", "os"):       # the thresholds of every cell decide as the detection
+        c = CfarParams(pfa=0.05, kind=kind)
+        mask = map_cfar(nci, cfg, c, windowed, True)[0]
+        threshold, _ = map_cfar(nci, cfg, c, windowed, True, thresholds=True)
+        assert mask.sum() > 100 and np.array_equal(mask, nci > threshold)
+        assert np.isinf(threshold[:, 0]).all()
