@@ -25,17 +25,19 @@ on our CA-CFAR and on our OS-CFAR.
 
 Printed: detections of each; agreement of each of ours with the peer's 15 dB detections (a
 match is within 2 range and 2 Doppler bins; moving = Doppler bin not 0): the moving returns
-it finds that ours also finds, the angle difference to its Bartlett angle (the strongest of
-our points in a cell, and every point), our points that are not part of a cluster it finds
-(no peer detection within the bins, or none also within the array's angle resolution); host
-time per frame of each, timed in the same run (``--repeat`` runs after a warm-up, in
-``--rounds`` rounds that alternate between the chains, so a change of the machine's load
-falls on all; median) with the load average, and each process' CPU time per frame (on a
-machine loaded by other jobs the wall time is mostly waiting for a core). Both run one
-thread: ours does, and the peer's numpy is held to one BLAS thread (``--peer-threads``; with
-its default, one per core, it ran 2-3 times slower on the machine loaded by other jobs: a
-median of 52 ms against 24 ms at load 16, a loss that is no speed of ours). Each goal of
-issue 29 is reported, met or missed, for each setting of ours; none is asserted in tests.
+it finds that ours also finds (and how many when each cell of ours counts for one only: it
+reports a return spread over range bins once per range bin), the angle difference to its
+Bartlett angle (the strongest of our points in a cell, and every point), our points that are
+not part of a cluster it finds (no peer detection within the bins, or none also within the
+array's angle resolution); host time per frame of each, timed in the same run (``--repeat``
+runs after a warm-up, in ``--rounds`` rounds that alternate between the chains, so a change
+of the machine's load falls on all; median) with the load average, and each process' CPU
+time per frame (on a machine loaded by other jobs the wall time is mostly waiting for a
+core). Both run one thread: ours does, and the peer's numpy is held to one BLAS thread
+(``--peer-threads``; with its default, one per core, it ran 2-3 times slower on the machine
+loaded by other jobs: a median of 52 ms against 24 ms at load 16, a loss that is no speed of
+ours). Each goal of issue 29 is reported, met or missed, for each setting of ours; none is
+asserted in tests.
 Last, the CFAR's CPU time on the frame's map: the OS-CFAR (compiled, ``host._cfar_os``) against
 the numpy implementation it replaced, and the CA-CFAR; and how far a mean of log powers sits
 below a mean of powers over the frame's noise (:func:`log_power_gap`: what makes the peer's
@@ -57,6 +59,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import maximum_bipartite_matching
 
 from host.adc_capture import open_capture
 from host.allocator import keep_freed_memory
@@ -114,7 +118,10 @@ class Agreement:
     """Ours against the peer's detections (:func:`compare`).
 
     ``peer_moving``: the peer's detections off zero Doppler; ``missed``: their (range bin,
-    Doppler bin) that no point of ours is near; ``angle_strongest``: float |our azimuth -
+    Doppler bin) that no point of ours is near; ``one_to_one``: how many of them are found
+    when each cell of ours may count for one only (a maximum matching: a point of ours near
+    several, a return the peer reports in several range bins, finds them all otherwise);
+    ``angle_strongest``: float |our azimuth -
     the peer's|, deg, for the strongest point of ours in each cell near a peer detection,
     ``angle_all`` for every such point; ``ours``: our points; ``outside_cells``: ours with no
     peer detection near; ``outside``: (range bin, Doppler bin, azimuth deg) of ours with none
@@ -122,6 +129,7 @@ class Agreement:
 
     peer_moving: int
     missed: list[tuple[int, int]]
+    one_to_one: int
     angle_strongest: np.ndarray
     angle_all: np.ndarray
     ours: int
@@ -168,8 +176,12 @@ def compare(ours: Detections, peer: Detections, n_doppler: int,
     out = ~in_angle.any(axis=1)
     outside = [(int(r), int(d), round(float(az), 1)) for r, d, az in zip(
         ours.range_bin[out], ours.doppler_bin[out], ours.azimuth_deg[out], strict=True)]
-    return Agreement(int(moving.sum()), missed, diff[has & strongest], diff[has], len(ours),
-                     int((~has).sum()), outside, angle_tol_deg)
+    first = np.flatnonzero(strongest)                       # one row per cell of ours
+    pairs = csr_matrix(m[np.ix_(first, np.flatnonzero(moving))].astype(np.int8))
+    one = int((maximum_bipartite_matching(pairs, perm_type="column") >= 0).sum()) \
+        if pairs.shape[0] and pairs.shape[1] else 0
+    return Agreement(int(moving.sum()), missed, one, diff[has & strongest], diff[has],
+                     len(ours), int((~has).sum()), outside, angle_tol_deg)
 
 
 def median_ms(times_s: list[float] | np.ndarray) -> float:
@@ -224,6 +236,7 @@ def _goals(run: Run, t_peer_ms: float, threshold_db: float,
         f"{threshold_db:g} dB",
         f"{'  moving returns of the peer ours finds':<44}{found} of {a.peer_moving}"
         f"  goal all: {verdict(not a.missed)}",
+        f"{'  ... each cell of ours counted once':<44}{a.one_to_one} of {a.peer_moving}",
         f"{'  angle - its Bartlett, strongest per cell':<44}{spread(a.angle_strongest)}"
         f"  goal <= {GOAL_ANGLE_DEG:g} deg: {verdict(angle_ok)}",
         f"{'  angle - its Bartlett, every point':<44}{spread(a.angle_all)}",
@@ -353,10 +366,12 @@ BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
-             threshold_db: float, repeat: int, threads: int = 1) -> dict[str, Any]:
+             threshold_db: float, repeat: int, threads: int = 1,
+             map_out: Path | None = None) -> dict[str, Any]:
     """The peer runner's JSON, run by ``python`` (OpenRadar's virtualenv) in a clean
     environment; ``shape`` = (chirps, rx, samples, tx); ``threads``: its BLAS threads (0:
-    its default, one per core)."""
+    its default, one per core); ``map_out``: the runner's ``--map`` (its map and
+    thresholds, .npz)."""
     env = {k: v for k, v in os.environ.items()
            if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", *BLAS_THREADS)}
     if threads:
@@ -367,7 +382,8 @@ def run_peer(python: Path, capture: Path, shape: tuple[int, int, int, int],
         subprocess.run([str(python), str(PEER_RUNNER), "--capture", str(capture),
                         "--chirps", str(chirps), "--rx", str(rx), "--samples", str(samples),
                         "--tx", str(tx), "--threshold-db", f"{threshold_db:g}",
-                        "--repeat", str(repeat), "--out", str(out)], check=True, env=env)
+                        "--repeat", str(repeat), "--out", str(out),
+                        *(["--map", str(map_out)] if map_out else [])], check=True, env=env)
         return json.loads(out.read_text())
 
 

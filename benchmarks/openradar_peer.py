@@ -30,12 +30,13 @@ imports nothing of the project: the peer's chain as its visualizer demo
     python benchmarks/openradar_peer.py --capture F.bin --chirps 256 --rx 4 --samples 128
         --tx 2 --out peer.json [--threshold-db 15] [--repeat 20]
 
-Writes JSON: ``versions``; ``tdm_compensation_error`` (what ``add_doppler_compensation``
-raises when called as its docstring shows); ``settings``: ``demo`` and ``<dB> dB``, each with
-``cfar_cells`` (cells over both thresholds), ``detections`` (after the peak pruning and
-grouping: ``range_bin``, ``doppler_bin`` signed, ``azimuth_deg``, ``det_value`` the map's
-value) and ``times_s`` / ``cpu_s`` (wall / this process' CPU time of the whole chain per
-frame, steps 1-4, ``repeat`` runs after one
+Writes JSON (and with ``--map F.npz`` the frame's ``det_matrix`` and its two thresholds at
+``--threshold-db``, float (range, Doppler) each): ``versions``; ``tdm_compensation_error``
+(what ``add_doppler_compensation`` raises when called as its docstring shows); ``settings``:
+``demo`` and ``<dB> dB``, each with ``cfar_cells`` (cells over both thresholds),
+``detections`` (after the peak pruning and grouping: ``range_bin``, ``doppler_bin`` signed,
+``azimuth_deg``, ``det_value`` the map's value) and ``times_s`` / ``cpu_s`` (wall / this
+process' CPU time of the whole chain per frame, steps 1-4, ``repeat`` runs after one
 warm-up).
 """
 
@@ -68,14 +69,22 @@ def read_frame(path: str, chirps: int, rx: int, samples: int) -> np.ndarray:
     return DCA1000.organize(raw, num_chirps=chirps, num_rx=rx, num_samples=samples)
 
 
-def cfar_cells(det: np.ndarray, bound_doppler: float, bound_range: float) -> np.ndarray:
-    """The demo's two 1-D CA-CFARs on ``det`` (range, Doppler): int (n, 2) cells over both."""
+def thresholds(det: np.ndarray, bound_doppler: float, bound_range: float
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The demo's two 1-D CA-CFAR thresholds of every cell of ``det`` (range, Doppler):
+    (along Doppler, along range), both of its shape."""
     det_int = det.astype(np.int64)
     thr_d, _ = np.apply_along_axis(dsp.ca_, 0, det_int.T, l_bound=bound_doppler,
                                    guard_len=GUARD, noise_len=NOISE)
     thr_r, _ = np.apply_along_axis(dsp.ca_, 0, det_int, l_bound=bound_range,
                                    guard_len=GUARD, noise_len=NOISE)
-    return np.argwhere((det > thr_d.T) & (det > thr_r))
+    return thr_d.T, thr_r
+
+
+def cfar_cells(det: np.ndarray, bound_doppler: float, bound_range: float) -> np.ndarray:
+    """Cells of ``det`` (range, Doppler) over both :func:`thresholds`: int (n, 2)."""
+    thr_d, thr_r = thresholds(det, bound_doppler, bound_range)
+    return np.argwhere((det > thr_d) & (det > thr_r))
 
 
 def grouped(cells: np.ndarray, det: np.ndarray) -> np.ndarray:
@@ -95,15 +104,23 @@ def signed(doppler: np.ndarray, n_doppler: int) -> np.ndarray:
     return np.where(doppler >= n_doppler // 2, doppler - n_doppler, doppler)
 
 
+def frame_map(path: str, shape: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Steps 1-2 of the module docstring on frame 0 of ``path`` (``shape`` = (chirps, rx,
+    samples, tx)): ``det_matrix`` float (range, Doppler) and the cube complex (range,
+    virtual, Doppler)."""
+    chirps, rx, samples, tx = shape
+    frame = read_frame(path, chirps, rx, samples)
+    cube = dsp.range_processing(frame, window_type_1d=Window.BLACKMAN)
+    return dsp.doppler_processing(cube, num_tx_antennas=tx, clutter_removal_enabled=True,
+                                  window_type_2d=Window.HAMMING)
+
+
 def chain(path: str, shape: tuple[int, int, int, int], bounds: tuple[float, float],
           steering: np.ndarray, grid_deg: np.ndarray) -> dict[str, Any]:
     """Steps 1-4 of the module docstring on frame 0 of ``path``; ``shape`` = (chirps, rx,
     samples, tx)."""
-    chirps, rx, samples, tx = shape
-    frame = read_frame(path, chirps, rx, samples)
-    cube = dsp.range_processing(frame, window_type_1d=Window.BLACKMAN)
-    det, aoa = dsp.doppler_processing(cube, num_tx_antennas=tx, clutter_removal_enabled=True,
-                                      window_type_2d=Window.HAMMING)
+    _, rx, _, tx = shape
+    det, aoa = frame_map(path, shape)
     cells = cfar_cells(det, *bounds)
     peaks = grouped(cells, det)
     n_doppler = det.shape[1]
@@ -141,6 +158,8 @@ def main() -> None:
     ap.add_argument("--threshold-db", type=float, default=15.0)
     ap.add_argument("--repeat", type=int, default=20, help="timed runs per setting")
     ap.add_argument("--out", required=True, help="output .json")
+    ap.add_argument("--map", default=None, help="also write the frame's det_matrix and the "
+                    "threshold setting's thresholds (along Doppler, along range) to this .npz")
     args = ap.parse_args()
     shape = (args.chirps, args.rx, args.samples, args.tx)
     n_virtual = args.rx * args.tx
@@ -165,6 +184,10 @@ def main() -> None:
            "settings": settings}
     with open(args.out, "w") as f:
         json.dump(doc, f)
+    if args.map:
+        det, _ = frame_map(args.capture, shape)
+        thr_d, thr_r = thresholds(det, bound, bound)
+        np.savez(args.map, det=det, thr_doppler=thr_d, thr_range=thr_r)
 
 
 if __name__ == "__main__":

@@ -71,6 +71,24 @@ def _static_response(cfg: RadarConfig, doppler_window: bool) -> tuple[np.ndarray
     return out
 
 
+@lru_cache(maxsize=16)
+def static_noise_gain(cfg: RadarConfig, doppler_window: bool) -> np.ndarray:
+    """float (n_doppler,): the noise power of each Doppler bin after static-clutter removal
+    (``frame_cube(remove_static_clutter=True)``) over its power without, for white noise:
+    0 at bin 0, 1 - 2 Re(r* V[k]) / V[0] + |r|^2 at the bins :func:`_static_response`
+    touches (r = W[k] / W[0], V the DFT of the squared window; 7/12 for a periodic Hann's
+    bins 1 and n_doppler - 1), 1 elsewhere. A CFAR on such a cube must not take the touched
+    bins for plain noise (``host.pipeline.detect_cells``)."""
+    w = fft_axes(cfg, True, doppler_window)[1].window()
+    v = np.fft.fft(w * w, cfg.n_doppler)
+    bins, ratio = _static_response(cfg, doppler_window)
+    gain = np.ones(cfg.n_doppler)
+    gain[0] = 0.0
+    gain[bins] = 1.0 - 2.0 * np.real(np.conj(ratio) * v[bins]) / v[0].real + np.abs(ratio) ** 2
+    gain.flags.writeable = False
+    return gain
+
+
 def frame_cube(adc: np.ndarray, cfg: RadarConfig, range_window: bool = True,
                doppler_window: bool = True, remove_static_clutter: bool = False,
                single: bool = False) -> np.ndarray:

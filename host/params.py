@@ -73,6 +73,12 @@ class DetectionParams:
     estimate (the map's cell power over the mean noise power per cell: the mean SNR per
     channel, which a threshold in dB such as OpenRadar's tests); None: the detector's
     threshold alone (a CFAR's: its Pfa).
+    ``static_removed``: the cube's static clutter was removed (``radar process|detect
+    --remove-static``): its zero-Doppler bin is empty and its neighbours' noise lowered
+    (``host.cube.static_noise_gain``), so the CFAR leaves bin 0 out and rescales the
+    touched bins to plain noise, or their training cells would pull the noise estimate of
+    the cells beside zero Doppler down (there 2.6 times the configured Pfa of 1e-3 and 3.7
+    times 1e-4 on noise, CA; ``tests/test_static_cfar.py``).
     """
 
     detector: str = "ca"
@@ -92,6 +98,7 @@ class DetectionParams:
     refine_floor: float = FLOAT_FLOOR
     grouping: str = "peak"
     min_snr_db: float | None = None
+    static_removed: bool = False
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:

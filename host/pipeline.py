@@ -8,7 +8,9 @@ Steps (docs/design.md section 1, host side):
    local maxima (of the 3 x 3 neighbourhood, or along Doppler only:
    ``DetectionParams.grouping``); only ``RadarConfig.detection_bins`` are reported (the top
    range bins are negative beat frequencies), and cells within ``sidelobe_margin_db`` of a
-   stronger cell's window sidelobes are dropped.
+   stronger cell's window sidelobes are dropped. After static-clutter removal
+   (``DetectionParams.static_removed``) the CFAR leaves out the emptied zero-Doppler bin and
+   rescales the bins the removal lowered (:func:`map_cfar`).
 2. Range and Doppler refined by interpolation around each peak over the three integrated
    powers along each axis, matched to the axis' window and padding (``host.cells``); with
    ``DetectionParams.refine``, then by maximising the whole frame's periodogram
@@ -44,13 +46,15 @@ import numpy as np
 from host.cells import Cells, peak_offsets
 from host.cfar import (
     CfarParams,
+    Windows,
     cfar_detect,
+    cfar_threshold,
     detection_mask,
     local_peaks,
     paper_threshold,
     sidelobe_masked,
 )
-from host.cube import frame_cube
+from host.cube import frame_cube, static_noise_gain
 from host.kernels import njit, warm_up
 from host.params import DetectionParams, params_for
 from host.pointcloud import PointCloud
@@ -72,6 +76,28 @@ def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
     if params.min_snr_db is None:
         return mask
     return mask & (power > noise * 10.0 ** (params.min_snr_db / 10.0))
+
+
+def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
+             static_removed: bool, thresholds: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``host.cfar.cfar_detect`` of the map ``nci`` (float (n_range_bins, n_doppler)):
+    (mask bool, noise float), both of its shape; ``thresholds``: ``host.cfar.
+    cfar_threshold``'s (threshold float, noise float) of every cell instead. ``static_removed``:
+    the cube's static clutter was removed, so the CFAR runs on the map without its empty
+    zero-Doppler bin and with the bins the removal lowered divided by their noise gain
+    (``host.cube.static_noise_gain``: plain noise again), threshold and noise estimate scaled
+    back; bin 0 is never detected (threshold inf, noise NaN)."""
+    run = cfar_threshold if thresholds else cfar_detect
+    if not static_removed:
+        return run(nci, cfg.n_virtual, cf, windowed)
+    gain = static_noise_gain(cfg, windowed[1].hann)
+    keep = np.flatnonzero(gain > 0.0)
+    first, noise = run(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed)
+    out = np.full(nci.shape, np.inf) if thresholds else np.zeros(nci.shape, bool)
+    out[:, keep] = first * gain[keep] if thresholds else first
+    noise_map = np.full(nci.shape, np.nan)
+    noise_map[:, keep] = noise * gain[keep]
+    return out, noise_map
 
 
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
@@ -96,7 +122,7 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     else:
         if params.detector == "ca":
             cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
-        detected, noise_map = cfar_detect(nci, cfg.n_virtual, cf, windowed)
+        detected, noise_map = map_cfar(nci, cfg, cf, windowed, params.static_removed)
         cells = local_peaks(nci, _min_snr(detected, nci, noise_map, params), size, mirrored)
     ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
     cells = cells[ok[cells[:, 0], cells[:, 1]]]

@@ -48,6 +48,8 @@ def test_compare_counts_finds_angles_and_clusters():
     a = compare(ours(), peer, N_DOPPLER, angle_tol_deg=14.3)
     assert a.peer_moving == 5                          # the zero-Doppler one is not counted
     assert a.missed == [(80, 5)]
+    # (60, 7) of ours is near two of its detections, (60, 7) and (62, 8): one of them once
+    assert a.one_to_one == 3
     # strongest per cell, each against its nearest peer detection: same cell, fewest bins
     assert sorted(np.round(a.angle_strongest, 2).tolist()) == [0.2, 0.5, 2.3]
     assert sorted(np.round(a.angle_all, 2).tolist()) == [0.2, 0.5, 2.3, 46.5]
@@ -81,6 +83,7 @@ def test_table_reports_against_the_goals():
     default, matched = text.split("ours default (no options) vs the peer's 15 dB")[1].split(
         "ours peer-ca (--grouping doppler --min-snr-db 15) vs the peer's 15 dB")
     assert "4 of 5  goal all: MISSED" in default
+    assert "  ... each cell of ours counted once        3 of 5\n" in default
     assert "max 2.30 deg (n=3)  goal <= 2 deg: MISSED" in default
     assert "2 of 5 (40 %)  goal <= 10 %: MISSED" in default
     assert "0.22  goal <= 1/3: met" in default
@@ -114,3 +117,25 @@ def test_table_without_angles(missing):
     run = Run("default", (), far, [0.01], compare(far, peer, N_DOPPLER, 14.3))
     text = table(doc, [run], 15.0, (0.0, 0.0, 0.0))
     assert "every point" in text and "-  goal <= 2 deg: MISSED" in text
+
+
+def test_cells_cause_names_the_step_that_lost_a_cell():
+    """``benchmarks/openradar_cells.py``: a cell of the peer's that a setting of ours misses
+    is under its CFAR's threshold (CA: with the Pfa it would need), under --min-snr-db, or
+    detected but grouped into a peak more than 2 bins away; found cells give ''."""
+    from benchmarks.openradar_cells import cause, markdown
+
+    row = {"r": 64, "d": 5, "az": -8.5, "peer_margin": 17.0, "peer_floor": 35.0,
+           "ours_floor": 32.9, "ca_snr": 3.2, "ca_margin": -2.5, "ca_pfa": 0.008,
+           "os_snr": 12.9, "os_margin": 7.2, "peak": True,
+           "default": "", "peer-ca": "", "peer-os": "", "os-peak": "(64,5)"}
+    assert cause(row, "default", 15.0) == "CA-CFAR: -2.5 dB under its threshold, needs " \
+                                           "Pfa 0.008"
+    assert cause(row, "peer-os", 15.0) == "--min-snr-db 15: 12.9 dB over the OS noise"
+    assert cause({**row, "os_snr": 16.0}, "peer-os", 15.0) == \
+        "detected, grouped into a peak > 2 bins away"
+    assert cause(row, "os-peak", 15.0) == ""
+    text = markdown([row], ["default", "os-peak"], 15.0)
+    assert "| 64 | 5 | -8.5 | +17.0 |" in text and "| (64,5) |" in text
+    assert "- os-peak: 1 of 1 found" in text and "- default: 0 of 1 found; missed: (64,5)" \
+        in text

@@ -11,19 +11,24 @@ import numpy as np
 import pytest
 
 from host.capture import frame_packets
+from host.cube import frame_cube
 from host.pointcloud import PointCloud
 from host.receiver import Receiver
 from host.stream import StreamDecoder
 from model.axis_packetizer import cube_to_payload, packetize, words_to_bytes
 from model.config import get_preset
+from model.profile import profile_from_toml
 from model.reference import cube_to_dma_order, range_doppler_power
+from model.scene import Scatterers
+from model.simulate import simulate_frame
 from radar.view.feed import Feed, ViewFrame
 from radar.view.health import LinkHealth, missing_packets
 from radar.view.ingest import packet_ingest
-from radar.view.processor import Processor, channel_power_sum
+from radar.view.processor import Job, Processor, channel_power_sum
 from radar.view.render import MAX_AXIS, box_outline, frame_message, heatmap, pool_max
 from radar.view.server import STATIC_DIR, plotly_js_path
 from radar.view.sources import replay_loop
+from tests.test_cli_radar_option import THREE_TX
 
 CFG = get_preset("paper-fpga")
 PACKET_WORDS = 1023
@@ -318,3 +323,28 @@ def test_page_assets_reference_no_external_url():
         name = r.removeprefix("/static/")
         assert (STATIC_DIR / name).is_file() or name == "plotly.min.js"
     assert plotly_js_path().stat().st_size > 1_000_000
+
+
+
+def test_frame_message_carries_elevation_of_a_2d_array():
+    """A 3-TX profile with the middle TX raised (xWR1843, ``tests.test_cli_radar_option.
+    THREE_TX``) through the view's processor: the browser's points carry z and elevation,
+    the values the point JSON writes (``PointCloud.to_json_dict``); a planar preset's carry
+    neither."""
+    cfg = profile_from_toml(THREE_TX).config
+    sc = Scatterers(np.array([10.0]), np.array([10.0]), np.array([1.0]), np.array([10.0]),
+                    np.array([-1]), np.array([20.0]))
+    adc = simulate_frame(cfg, sc, rng=np.random.default_rng(1)).samples
+    feed = Feed()
+    Processor(cfg, feed, LinkHealth()).process(Job(0, frame_cube(adc, cfg), cfg))
+    frame = feed.latest()
+    assert frame is not None and len(frame.cloud) >= 1
+    msg = frame_message(frame, channel=0, health={})
+    points = frame.cloud.to_json_dict(cfg, 1)["points"]
+    assert msg["points"]["z"] == pytest.approx([p["z_m"] for p in points], abs=1e-3)
+    assert msg["points"]["el"] == pytest.approx([p["elevation_deg"] for p in points], abs=0.01)
+    strongest = int(np.argmax(frame.cloud.snr_db))
+    assert msg["points"]["el"][strongest] == pytest.approx(20.0, abs=3.0)
+    planar = frame_message(ViewFrame(seq=1, frame_id=0, cfg=CFG, cloud=frame.cloud),
+                           channel=0, health={})
+    assert "z" not in planar["points"] and "el" not in planar["points"]

@@ -14,6 +14,7 @@ import argparse
 import json
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -108,7 +109,8 @@ def cmd_detect(args: argparse.Namespace) -> int:
     out = out_file(args.json, ".json", "--json")
     count(args.frames, "--frames", MAX_DETECT_FRAMES)
     plots = out_folder(args.plots, "--plots") if args.plots else None
-    params = detection_params(args, scene.tx_beamforming, cfg)
+    params = replace(detection_params(args, scene.tx_beamforming, cfg),
+                     static_removed=args.remove_static)
     clouds, per_frame, objects = [], [], []
     last_cube = None
     ego = ego_speed_mps(args, scene)

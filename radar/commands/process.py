@@ -135,14 +135,15 @@ def capture_of(args: argparse.Namespace, profile: Profile, command: str
 def process_params(args: argparse.Namespace, profile: Profile) -> tuple[DetectionParams, str]:
     """``radar process``'s detection settings from its options (``radar.common.
     detection_params``: the profile's maximum speed and guard by default; ``--grouping``,
-    ``--min-snr-db``) with the calibration applied before angle estimation
-    (:func:`calibration_of`), and that calibration's name for the output; CliError if they
-    do not fit."""
+    ``--min-snr-db``; ``--remove-static``: the CFAR told, ``DetectionParams.static_removed``)
+    with the calibration applied before angle estimation (:func:`calibration_of`), and that
+    calibration's name for the output; CliError if they do not fit."""
     params = detection_params(args, cfg=profile.config)
     calibration, cal_name = calibration_of(args.calibration, profile)
     try:
         return replace(params, calibration=calibration, grouping=args.grouping,
-                       min_snr_db=args.min_snr_db), cal_name
+                       min_snr_db=args.min_snr_db, static_removed=args.remove_static), \
+            cal_name
     except ValueError as exc:
         raise CliError(f"--{str(exc).replace('_', '-')}") from None
 

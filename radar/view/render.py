@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from host.records import RecordArrays
+from model.array import has_vertical_extent
 from model.config import RadarConfig
 from model.reference import signed_bins
 from radar.view.feed import ViewFrame
@@ -124,7 +125,10 @@ def record_cells(rec: RecordArrays, cfg: RadarConfig) -> dict[str, list[float]]:
 
 
 def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dict[str, Any]:
-    """The message for one frame with virtual channel ``channel`` (clamped to the array)."""
+    """The message for one frame with virtual channel ``channel`` (clamped to the array);
+    its ``points`` (lists of n): x, y m, v m/s, snr dB, range m, and, when the radar's array
+    has vertical extent (``model.array.has_vertical_extent``, as the point JSON), z m and
+    el (elevation) deg."""
     cfg = frame.cfg
     ch = min(max(int(channel), 0), cfg.n_virtual - 1)
     cloud = frame.cloud
@@ -140,6 +144,8 @@ def frame_message(frame: ViewFrame, channel: int, health: dict[str, Any]) -> dic
         "boxes": [],
         "health": health,
     }
+    if has_vertical_extent(cfg.virtual_positions_hw):   # as the point JSON (PointCloud)
+        msg["points"].update(z=_r(cloud.z_m), el=_r(cloud.elevation_deg, 2))
     if frame.cube is not None:
         p = frame.cube[ch].real.astype(np.float32) ** 2 + frame.cube[ch].imag.astype(
             np.float32) ** 2

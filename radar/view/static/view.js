@@ -220,7 +220,8 @@ function pointCloud(div, msg) {
     marker: { size: 8, color: p.v, cmin: -vmax, cmax: vmax, colorscale: "Jet",
               line: { width: 1, color: "#222" },
               colorbar: { title: { text: "m/s" }, ticklabeloverflow: "allow" } },
-    text: p.snr.map((s, i) => `v ${p.v[i]} m/s, SNR ${s} dB`),
+    text: p.snr.map((s, i) => `v ${p.v[i]} m/s, SNR ${s} dB` +
+                    (p.z ? `<br>z ${p.z[i]} m, elevation ${p.el[i]} deg` : "")),
     hovertemplate: "x %{y:.1f} m, y %{x:.1f} m<br>%{text}<extra></extra>",
   }];
   for (const b of msg.boxes) {
