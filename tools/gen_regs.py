@@ -71,8 +71,11 @@ def gen_sv(root, dest: Path) -> list[Path]:
     out = dest / SV_DIR
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
+        # the requests to the external registers and memories (radar_ctrl) registered: the
+        # AXI4-Lite decode and radar_ctrl's checks are then a clock each (issue 30)
         RegblockExporter().export(root, tmp, cpuif_cls=AXI4Lite_Cpuif_flattened,
-                                  reuse_hwif_typedefs=False)
+                                  reuse_hwif_typedefs=False, retime_external_reg=True,
+                                  retime_external_mem=True)
         paths = []
         for name in ("radar_regs_pkg.sv", "radar_regs.sv"):
             path = out / name

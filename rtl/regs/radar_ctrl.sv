@@ -140,7 +140,7 @@ module radar_ctrl #(
   endfunction
 
   settings_t         pend_q, active_q, cand;
-  logic [SC_W-1:0]   pend_sc_q, active_sc_q, cand_sc;
+  logic [SC_W-1:0]   pend_sc_q, active_sc_q;
   logic              sc_wr, sc_bad;
   // byte-lane and unused address bits of the scale memories: accesses are whole words
   wire unused_sc = ^{hwif_out.CFAR_SCALE.addr[1:0], hwif_out.ACTIVE_CFAR_SCALE.addr[1:0],
@@ -177,26 +177,32 @@ module radar_ctrl #(
   // entry e < N_SCALES holds a scale; a write from N_SCALES on is refused
   wire [5:0]  sc_entry = hwif_out.CFAR_SCALE.addr[7:2];
   wire        sc_exists = 32'(sc_entry) < 32'(N_SCALES);
-  wire [31:0] sc_old = sc_exists ? pend_sc_q[32'(sc_entry) % N_SCALES * 32 +: 32] : '0;
+  // (entry selects by comparison, not an index modulo N_SCALES: a 13-entry modulo is a
+  // divider's carry chains on the write path)
+  logic [31:0] sc_old;
+  always_comb begin
+    sc_old = '0;
+    for (int e = 0; e < N_SCALES; e++)
+      if (sc_entry == 6'(e)) sc_old = pend_sc_q[e * 32 +: 32];
+  end
   wire [31:0] sc_new = (sc_old & ~hwif_out.CFAR_SCALE.wr_biten)
                      | (hwif_out.CFAR_SCALE.wr_data & hwif_out.CFAR_SCALE.wr_biten);
   assign sc_wr  = hwif_out.CFAR_SCALE.req && hwif_out.CFAR_SCALE.req_is_wr;
   assign sc_bad = !sc_exists || !scale_ok(sc_new);
-  always_comb begin
-    cand_sc = pend_sc_q;
-    if (sc_wr && sc_exists) cand_sc[32'(sc_entry) % N_SCALES * 32 +: 32] = sc_new;
-  end
-  wire refused = ((set_wr || pkt_wr) && !legal(cand.cfar_kind, cand.max_detections,
-                                               cand.packet_words))
-               || (sc_wr && sc_bad);
+  wire sc_take = sc_wr && !sc_bad;
+  wire set_bad = (set_wr || pkt_wr) && !legal(cand.cfar_kind, cand.max_detections,
+                                              cand.packet_words);
+  wire refused = set_bad || (sc_wr && sc_bad);
 
+  // each entry loads on its own decode (no table-wide enable)
   always_ff @(posedge clk) begin
     if (rst) begin
       pend_q    <= RESET_SET;
       pend_sc_q <= {N_SCALES{32'(CFAR_SCALE)}};
-    end else if (!refused) begin
-      pend_q    <= cand;
-      pend_sc_q <= cand_sc;
+    end else begin
+      if ((set_wr || pkt_wr) && !set_bad) pend_q <= cand;
+      for (int e = 0; e < N_SCALES; e++)
+        if (sc_take && sc_entry == 6'(e)) pend_sc_q[e * 32 +: 32] <= sc_new;
     end
   end
 
@@ -226,7 +232,8 @@ module radar_ctrl #(
       cfg_cfar_scale[e * SCALE_W +: SCALE_W] = active_sc_q[e * 32 +: SCALE_W];
   end
 
-  // external registers answer in the cycle of the request
+  // external registers and memories: the regblock registers each request (retime_external,
+  // tools/gen_regs.py); they answer in the cycle it arrives
   wire [5:0] act_entry = hwif_out.ACTIVE_CFAR_SCALE.addr[7:2];
   always_comb begin
     hwif_in.SETTINGS.wr_ack   = set_wr;
@@ -246,8 +253,9 @@ module radar_ctrl #(
     // read only: the block decodes reads there only
     hwif_in.ACTIVE_CFAR_SCALE.wr_ack  = 1'b0;
     hwif_in.ACTIVE_CFAR_SCALE.rd_ack  = hwif_out.ACTIVE_CFAR_SCALE.req;
-    hwif_in.ACTIVE_CFAR_SCALE.rd_data = (32'(act_entry) < 32'(N_SCALES))
-                                      ? active_sc_q[32'(act_entry) % N_SCALES * 32 +: 32] : '0;
+    hwif_in.ACTIVE_CFAR_SCALE.rd_data = '0;
+    for (int e = 0; e < N_SCALES; e++)
+      if (act_entry == 6'(e)) hwif_in.ACTIVE_CFAR_SCALE.rd_data = active_sc_q[e * 32 +: 32];
   end
 
   // refused writes never reach the pending set, so it is always legal (and so the active set)

@@ -455,15 +455,33 @@ module radar_regs (
     field_storage_t field_storage;
 
     // External register: radar_regs.SETTINGS
-    assign hwif_out.SETTINGS.req = decoded_reg_strb.SETTINGS;
-    assign hwif_out.SETTINGS.req_is_wr = decoded_req_is_wr;
-    assign hwif_out.SETTINGS.wr_data = decoded_wr_data;
-    assign hwif_out.SETTINGS.wr_biten = decoded_wr_biten;
+    always_ff @(posedge clk) begin
+        if(rst) begin
+            hwif_out.SETTINGS.req <= '0;
+            hwif_out.SETTINGS.req_is_wr <= '0;
+            hwif_out.SETTINGS.wr_data <= '0;
+            hwif_out.SETTINGS.wr_biten <= '0;
+        end else begin
+            hwif_out.SETTINGS.req <= decoded_reg_strb.SETTINGS;
+            hwif_out.SETTINGS.req_is_wr <= decoded_req_is_wr;
+            hwif_out.SETTINGS.wr_data <= decoded_wr_data;
+            hwif_out.SETTINGS.wr_biten <= decoded_wr_biten;
+        end
+    end
     // External register: radar_regs.PACKET
-    assign hwif_out.PACKET.req = decoded_reg_strb.PACKET;
-    assign hwif_out.PACKET.req_is_wr = decoded_req_is_wr;
-    assign hwif_out.PACKET.wr_data = decoded_wr_data;
-    assign hwif_out.PACKET.wr_biten = decoded_wr_biten;
+    always_ff @(posedge clk) begin
+        if(rst) begin
+            hwif_out.PACKET.req <= '0;
+            hwif_out.PACKET.req_is_wr <= '0;
+            hwif_out.PACKET.wr_data <= '0;
+            hwif_out.PACKET.wr_biten <= '0;
+        end else begin
+            hwif_out.PACKET.req <= decoded_reg_strb.PACKET;
+            hwif_out.PACKET.req_is_wr <= decoded_req_is_wr;
+            hwif_out.PACKET.wr_data <= decoded_wr_data;
+            hwif_out.PACKET.wr_biten <= decoded_wr_biten;
+        end
+    end
     // Field: radar_regs.STATUS.frame_done
     always_comb begin
         automatic logic [0:0] next_c;
@@ -806,17 +824,37 @@ module radar_regs (
         end
     end
     // External region: radar_regs.CFAR_SCALE
-    assign hwif_out.CFAR_SCALE.req = decoded_reg_strb.CFAR_SCALE;
-    assign hwif_out.CFAR_SCALE.addr = decoded_addr[7:0];
-    assign hwif_out.CFAR_SCALE.req_is_wr = decoded_req_is_wr;
-    assign hwif_out.CFAR_SCALE.wr_data = decoded_wr_data;
-    assign hwif_out.CFAR_SCALE.wr_biten = decoded_wr_biten;
+    always_ff @(posedge clk) begin
+        if(rst) begin
+            hwif_out.CFAR_SCALE.req <= '0;
+            hwif_out.CFAR_SCALE.addr <= '0;
+            hwif_out.CFAR_SCALE.req_is_wr <= '0;
+            hwif_out.CFAR_SCALE.wr_data <= '0;
+            hwif_out.CFAR_SCALE.wr_biten <= '0;
+        end else begin
+            hwif_out.CFAR_SCALE.req <= decoded_reg_strb.CFAR_SCALE;
+            hwif_out.CFAR_SCALE.addr <= decoded_addr[7:0];
+            hwif_out.CFAR_SCALE.req_is_wr <= decoded_req_is_wr;
+            hwif_out.CFAR_SCALE.wr_data <= decoded_wr_data;
+            hwif_out.CFAR_SCALE.wr_biten <= decoded_wr_biten;
+        end
+    end
     // External region: radar_regs.ACTIVE_CFAR_SCALE
-    assign hwif_out.ACTIVE_CFAR_SCALE.req = decoded_reg_strb.ACTIVE_CFAR_SCALE;
-    assign hwif_out.ACTIVE_CFAR_SCALE.addr = decoded_addr[7:0];
-    assign hwif_out.ACTIVE_CFAR_SCALE.req_is_wr = decoded_req_is_wr;
-    assign hwif_out.ACTIVE_CFAR_SCALE.wr_data = decoded_wr_data;
-    assign hwif_out.ACTIVE_CFAR_SCALE.wr_biten = decoded_wr_biten;
+    always_ff @(posedge clk) begin
+        if(rst) begin
+            hwif_out.ACTIVE_CFAR_SCALE.req <= '0;
+            hwif_out.ACTIVE_CFAR_SCALE.addr <= '0;
+            hwif_out.ACTIVE_CFAR_SCALE.req_is_wr <= '0;
+            hwif_out.ACTIVE_CFAR_SCALE.wr_data <= '0;
+            hwif_out.ACTIVE_CFAR_SCALE.wr_biten <= '0;
+        end else begin
+            hwif_out.ACTIVE_CFAR_SCALE.req <= decoded_reg_strb.ACTIVE_CFAR_SCALE;
+            hwif_out.ACTIVE_CFAR_SCALE.addr <= decoded_addr[7:0];
+            hwif_out.ACTIVE_CFAR_SCALE.req_is_wr <= decoded_req_is_wr;
+            hwif_out.ACTIVE_CFAR_SCALE.wr_data <= decoded_wr_data;
+            hwif_out.ACTIVE_CFAR_SCALE.wr_biten <= decoded_wr_biten;
+        end
+    end
 
     //--------------------------------------------------------------------------
     // Write response
