@@ -353,12 +353,12 @@ module cfar_2d #(
   assign ev4 = v_q[4] && test_q[4];
 
   // Stages 4..6: the cell, its neighbours, the local-maximum test (cfar_peak.sv)
-  logic [POW_W-1:0] cut5_q, nb_rm5_q, nb_rp5_q, nb_dm5_q, nb_dp5_q;
+  logic [POW_W-1:0] cut5, nb_rm5, nb_rp5, nb_dm5, nb_dp5;
   logic             peak6;
   cfar_peak #(.PD(PD), .POW_W(POW_W)) u_peak (
     .clk(clk), .ev4(ev4), .vcut4(vcut4_q), .rm4(rm4_q), .rp4(rp4_q), .rm_ok4(rm_ok_q[4]),
-    .rp_ok4(rp_ok_q[4]), .cut5(cut5_q), .nb_rm5(nb_rm5_q), .nb_rp5(nb_rp5_q),
-    .nb_dm5(nb_dm5_q), .nb_dp5(nb_dp5_q), .peak6(peak6)
+    .rp_ok4(rp_ok_q[4]), .cut5(cut5), .nb_rm5(nb_rm5), .nb_rp5(nb_rp5),
+    .nb_dm5(nb_dm5), .nb_dp5(nb_dp5), .peak6(peak6)
   );
 
   logic last5_q, ok5_q;
@@ -381,7 +381,7 @@ module cfar_2d #(
               .S_W(S_W), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
               .CA_ONLY(BUILT[2:1] == 2'b00)) u_sums (
     .clk(clk), .ev4(ev4), .first4(first4_q), .s3(s_q3), .vo4(vo4_q), .vi4(vi4_q),
-    .kind(kind_q), .cut5(cut5_q),
+    .kind(kind_q), .cut5(cut5),
     .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum5(sum5), .over10(over10)
   );
 
@@ -462,8 +462,8 @@ module cfar_2d #(
     .rst           (rst),
     .can_issue     (e_can_issue),
     .issue         (issue),
-    .in_data       ({last5_q, r_q[5], d_q[5], nb_dp5_q, nb_dm5_q, nb_rp5_q, nb_rm5_q,
-                     cnt_q[5], sum5, cut5_q}),
+    .in_data       ({last5_q, r_q[5], d_q[5], nb_dp5, nb_dm5, nb_rp5, nb_rm5,
+                     cnt_q[5], sum5, cut5}),
     .m_axis_tdata  (fe_data),
     .m_axis_tvalid (e_valid),
     .m_axis_tready (m_axis_tvalid && m_axis_tready)
