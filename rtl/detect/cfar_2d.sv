@@ -110,6 +110,7 @@ module cfar_2d #(
   localparam logic [3:0] BUILT = {OS_BUILD, RUN_KINDS} | (4'b0001 << KIND);
   localparam bit ONE_KIND = (BUILT == (4'b0001 << KIND));
   localparam int CW_W  = ROWS * POW_W;               // column word
+  localparam int VS_W  = POW_W + $clog2(NE);         // a column's vertical sum (NE odd)
 
   // Parameter checks: stop elaboration on illegal values.
   if (N_RANGE < 4 || N_RANGE > 4096 || (1 << BR) != N_RANGE) begin : g_bad_n_range
@@ -183,10 +184,11 @@ module cfar_2d #(
   //  1 column store read (the RAM's own register), the row geometry; 2 read data registered
   //  again, written back with the input cell, slot masks; 3-4 vertical sums (cfar_vsum.sv):
   //  the column arrives, shifts into the column shift register; 5 window sums; the cell,
-  //  its neighbours, count, {r, d}, TLAST -> early output FIFO; 6 training sum of the kind,
-  //  local maximum (cfar_peak.sv); 7-9 S * scale (17 x 17-bit partial products, one
-  //  DSP48E2 each; cfar_sums.sv); OS (cfar_os.sv) comparators 5, popcount 6-8, count >= k 9;
-  //  10 the decision of the kind -> late output FIFO with S
+  //  its neighbours, count, training sum S of the kind, {r, d}, TLAST -> early output FIFO;
+  //  6 S registered for the multiplier, local maximum (cfar_peak.sv); 7-9 S * scale
+  //  (17 x 17-bit partial products, one DSP48E2 each; cfar_sums.sv); OS (cfar_os.sv)
+  //  comparators 5, popcount 6-8, count >= k 9; 10 the decision of the kind -> late output
+  //  FIFO
   localparam int LAT_E = 5;     // step -> early FIFO entry
   localparam int LAT_L = 10;    // step -> late FIFO entry (the output's valid)
 
@@ -279,7 +281,7 @@ module cfar_2d #(
   logic [4:1]        v_q;        // a step's data is in stage k (reset)
   logic [4:1]        test_q, out_q, last_q, cut_ok_q, rm_ok_q, rp_ok_q;
   logic [BR-1:0]     r_q [5:1];
-  logic [BD-1:0]     d_q [5:1];
+  logic [BD-1:0]     d_q [5:4];  // centre column (mod N_DOPPLER), from s_q3
   logic [E_W-1:0]    e_q [5:1];
   logic [S_W-1:0]    s_q1, s_q2, s_q3;
   logic [NE-1:0]     rowv1_q;
@@ -308,7 +310,6 @@ module cfar_2d #(
     out_q[1]    <= testing && (s_q >= S_W'(2 * PD));
     last_q[1]   <= pass_end;
     {cut_ok_q[1], rm_ok_q[1], rp_ok_q[1], r_q[1], e_q[1], rowv1_q} <= geo_q;
-    d_q[1]      <= BD'(s_q - S_W'(PD));      // centre column (mod N_DOPPLER)
     s_q1        <= s_q;
     n_out1_q    <= nout_q;
     n_in1_q     <= nin_q;
@@ -322,11 +323,12 @@ module cfar_2d #(
     end
     for (int k = 2; k <= 5; k++) begin
       r_q[k] <= r_q[k-1];
-      d_q[k] <= d_q[k-1];
       e_q[k] <= e_q[k-1];
     end
-    s_q2 <= s_q1;
-    s_q3 <= s_q2;
+    s_q2   <= s_q1;
+    s_q3   <= s_q2;
+    d_q[4] <= BD'(s_q3 - S_W'(PD));
+    d_q[5] <= d_q[4];
     if (kind_q == 2'd1 || kind_q == 2'd2)
       cnt_q[2] <= CNT_W'(n_out1_q * PD - n_in1_q * GUARD_D);
     else
@@ -338,11 +340,10 @@ module cfar_2d #(
   always_ff @(posedge clk)
     for (int s = 0; s < ROWS; s++) wsel2_q[s] <= (st_slot1_q == SLOT_W'(s));
   logic [ROWS-1:0]  mo2_q, mi2_q;
-  logic [SUM_W-1:0] vo4_q, vi4_q;
+  logic [VS_W-1:0]  vo4_q, vi4_q;
   logic [POW_W-1:0] vcut4_q, rm4_q, rp4_q;
   logic             first4_q;    // column step 0 of the pass (the running sums restart)
-  cfar_vsum #(.ROWS(ROWS), .NE(NE), .PR(PR), .GUARD_R(GUARD_R), .POW_W(POW_W),
-              .SUM_W(SUM_W)) u_vsum (
+  cfar_vsum #(.ROWS(ROWS), .NE(NE), .PR(PR), .GUARD_R(GUARD_R), .POW_W(POW_W)) u_vsum (
     .clk(clk), .slot1(st_slot1_q), .rowv1(rowv1_q), .cw2(cw2_q), .mo2(mo2_q), .mi2(mi2_q),
     .vo4(vo4_q), .vi4(vi4_q), .vcut4(vcut4_q), .rm4(rm4_q), .rp4(rp4_q)
   );
@@ -352,12 +353,12 @@ module cfar_2d #(
   assign ev4 = v_q[4] && test_q[4];
 
   // Stages 4..6: the cell, its neighbours, the local-maximum test (cfar_peak.sv)
-  logic [POW_W-1:0] cut5_q, nb_rm5_q, nb_rp5_q, nb_dm5_q, nb_dp5_q;
+  logic [POW_W-1:0] cut5, nb_rm5, nb_rp5, nb_dm5, nb_dp5;
   logic             peak6;
   cfar_peak #(.PD(PD), .POW_W(POW_W)) u_peak (
     .clk(clk), .ev4(ev4), .vcut4(vcut4_q), .rm4(rm4_q), .rp4(rp4_q), .rm_ok4(rm_ok_q[4]),
-    .rp_ok4(rp_ok_q[4]), .cut5(cut5_q), .nb_rm5(nb_rm5_q), .nb_rp5(nb_rp5_q),
-    .nb_dm5(nb_dm5_q), .nb_dp5(nb_dp5_q), .peak6(peak6)
+    .rp_ok4(rp_ok_q[4]), .cut5(cut5), .nb_rm5(nb_rm5), .nb_rp5(nb_rp5),
+    .nb_dm5(nb_dm5), .nb_dp5(nb_dp5), .peak6(peak6)
   );
 
   logic last5_q, ok5_q;
@@ -372,15 +373,16 @@ module cfar_2d #(
     for (int k = 8; k <= 10; k++) peak_q[k] <= peak_q[k-1];
   end
 
-  // Stages 4..10: window sums, training sum of the kind, CUT * 2^SCALE_FRAC > S * scale
-  logic [SUM_W-1:0] sum10;
+  // Stages 4..10: window sums, training sum of the kind (stage 5), CUT * 2^SCALE_FRAC >
+  // S * scale (stage 10)
+  logic [SUM_W-1:0] sum5;
   logic             over10;
-  cfar_sums #(.PD(PD), .GUARD_D(GUARD_D), .POW_W(POW_W), .SUM_W(SUM_W), .S_W(S_W),
-              .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
+  cfar_sums #(.PD(PD), .GUARD_D(GUARD_D), .POW_W(POW_W), .SUM_W(SUM_W), .VS_W(VS_W),
+              .S_W(S_W), .SCALE_W(SCALE_W), .SCALE_FRAC(SCALE_FRAC),
               .CA_ONLY(BUILT[2:1] == 2'b00)) u_sums (
     .clk(clk), .ev4(ev4), .first4(first4_q), .s3(s_q3), .vo4(vo4_q), .vi4(vi4_q),
-    .kind(kind_q), .cut5(cut5_q),
-    .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum10(sum10), .over10(over10)
+    .kind(kind_q), .cut5(cut5),
+    .scale5(cfg_scale[e_q[5] * SCALE_W +: SCALE_W]), .sum5(sum5), .over10(over10)
   );
 
   // OS: stages 2..9 (the window's column words, comparators, popcount, count >= k)
@@ -447,14 +449,12 @@ module cfar_2d #(
   // ---------------------------------------------------------------------------------------
   // Output FIFOs: one entry per tested cell, issued with the step that reads its last
   // column. Two FIFOs in lockstep (same issues, same pops): the early one takes the cell's
-  // data at stage LAT_E, the late one its sum and decision at LAT_L and gives the port its
-  // valid, so the cell data need not travel down the multiplier's stages. DEPTH >= LAT_L + 2
-  // keeps one cell per clock.
-  localparam int FE = 1 + BR + BD + 4 * POW_W + CNT_W + POW_W;
-  localparam int FL = 1 + SUM_W;
-  logic          issue, e_can_issue, e_valid;
+  // data and training sum at stage LAT_E, the late one its decision at LAT_L and gives the
+  // port its valid, so neither the cell data nor the sum travel down the multiplier's
+  // stages. DEPTH >= LAT_L + 2 keeps one cell per clock.
+  localparam int FE = 1 + BR + BD + 4 * POW_W + CNT_W + SUM_W + POW_W;
+  logic          issue, e_can_issue, e_valid, fl_det;
   logic [FE-1:0] fe_data;
-  logic [FL-1:0] fl_data;
   assign issue = step && testing && (s_q >= S_W'(2 * PD));
 
   buf_out_fifo #(.WIDTH(FE), .DEPTH(16), .LATENCY(LAT_E)) u_out_early (
@@ -462,26 +462,25 @@ module cfar_2d #(
     .rst           (rst),
     .can_issue     (e_can_issue),
     .issue         (issue),
-    .in_data       ({last5_q, r_q[5], d_q[5], nb_dp5_q, nb_dm5_q, nb_rp5_q, nb_rm5_q,
-                     cnt_q[5], cut5_q}),
+    .in_data       ({last5_q, r_q[5], d_q[5], nb_dp5, nb_dm5, nb_rp5, nb_rm5,
+                     cnt_q[5], sum5, cut5}),
     .m_axis_tdata  (fe_data),
     .m_axis_tvalid (e_valid),
     .m_axis_tready (m_axis_tvalid && m_axis_tready)
   );
-  buf_out_fifo #(.WIDTH(FL), .DEPTH(16), .LATENCY(LAT_L)) u_out (
+  buf_out_fifo #(.WIDTH(1), .DEPTH(16), .LATENCY(LAT_L)) u_out (
     .clk           (clk),
     .rst           (rst),
     .can_issue     (can_issue),
     .issue         (issue),
-    .in_data       ({det10, sum10}),
-    .m_axis_tdata  (fl_data),
+    .in_data       (det10),
+    .m_axis_tdata  (fl_det),
     .m_axis_tvalid (m_axis_tvalid),
     .m_axis_tready (m_axis_tready)
   );
   // {pow(r, d+1), pow(r, d-1), pow(r+1, d), pow(r-1, d), detect, count, sum, power}
-  assign m_axis_tdata = OUT_W'({fe_data[POW_W + CNT_W +: 4 * POW_W], fl_data[SUM_W],
-                                fe_data[POW_W +: CNT_W], fl_data[SUM_W-1:0],
-                                fe_data[POW_W-1:0]});
+  assign m_axis_tdata = OUT_W'({fe_data[POW_W + SUM_W + CNT_W +: 4 * POW_W], fl_det,
+                                fe_data[POW_W + SUM_W + CNT_W - 1:0]});
   assign m_axis_tuser = fe_data[FE-2 -: BR + BD];
   assign m_axis_tlast = fe_data[FE-1];
 

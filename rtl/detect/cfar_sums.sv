@@ -12,6 +12,7 @@ module cfar_sums #(
   parameter int GUARD_D = 2,
   parameter int POW_W = 34,
   parameter int SUM_W = 43,
+  parameter int VS_W = 38,        // vertical sums (cfar_vsum.sv): POW_W + clog2(2*PR+1)
   parameter int S_W = 9,          // column step counter width
   parameter int SCALE_W = 32,
   parameter int SCALE_FRAC = 20,
@@ -27,15 +28,16 @@ module cfar_sums #(
   input  wire logic [S_W-1:0]                s3,
   // stage 4: the arriving column's vertical sums over the window rows (o) and guard rows
   // (i)
-  input  wire logic [SUM_W-1:0]              vo4,
-  input  wire logic [SUM_W-1:0]              vi4,
+  input  wire logic [VS_W-1:0]               vo4,
+  input  wire logic [VS_W-1:0]               vi4,
   // quasi-static kind: 0 CA, 1 GO, 2 SO, 3 OS (S = the CA sum)
   input  wire logic [1:0]                    kind,
   // stage 5: the cell under test and its row's threshold scale
   input  wire logic [POW_W-1:0]              cut5,
   input  wire logic [SCALE_W-1:0]            scale5,
-  // stage 10: training sum S, CUT * 2^SCALE_FRAC > S * scale
-  output logic      [SUM_W-1:0]              sum10,
+  // stage 5: training sum S of the kind (from stage-5 registers); stage 10:
+  // CUT * 2^SCALE_FRAC > S * scale
+  output logic      [SUM_W-1:0]              sum5,
   output logic                               over10
 );
 
@@ -61,7 +63,7 @@ module cfar_sums #(
 
   // The previous 2*PD columns' sums (index 0 = newest), a shift register on ev4 read only
   // at the positions the windows use (entering, leaving, the CUT's column): rings in
-  // distributed RAM (cfar_ring.sv)
+  // distributed RAM (cfar_ring.sv), VS_W bits wide (a column sum's width)
   function automatic logic [2*PD-1:0] taps(input bit o);
     taps = '0;
     for (int w = 0; w < NW; w++)
@@ -71,10 +73,10 @@ module cfar_sums #(
       end
     if (!CA_ONLY) taps[PD-1] = 1'b1;
   endfunction
-  logic [2*PD-1:0][SUM_W-1:0] sr_o, sr_i;
-  cfar_ring #(.W(SUM_W), .N(2 * PD), .USED(taps(1'b1))) u_ring_o (
+  logic [2*PD-1:0][VS_W-1:0] sr_o, sr_i;
+  cfar_ring #(.W(VS_W), .N(2 * PD), .USED(taps(1'b1))) u_ring_o (
     .clk(clk), .en(ev4), .d(vo4), .q(sr_o));
-  cfar_ring #(.W(SUM_W), .N(2 * PD), .USED(taps(1'b0))) u_ring_i (
+  cfar_ring #(.W(VS_W), .N(2 * PD), .USED(taps(1'b0))) u_ring_i (
     .clk(clk), .en(ev4), .d(vi4), .q(sr_i));
   logic [SUM_W-1:0] wsum [4];
   for (genvar w = 0; w < 4; w++) begin : g_win
@@ -84,7 +86,8 @@ module cfar_sums #(
     if (w >= NW || B < A) begin : g_empty
       assign wsum[w] = '0;
     end else begin : g_run
-      logic [SUM_W-1:0] w_q, enter, leave;
+      logic [SUM_W-1:0] w_q;
+      logic [VS_W-1:0]  enter, leave;
       logic             en_q, lv_q;
       if (A == 0) begin : g_arriving
         assign enter = IS_O ? vo4 : vi4;
@@ -97,45 +100,47 @@ module cfar_sums #(
       assign wsum[w] = first4 ? '0 : w_q;
       always_ff @(posedge clk) begin
         lv_q <= (s3 >= S_W'(B + 1));
-        if (ev4) w_q <= wsum[w] + (en_q ? enter : '0) - (lv_q ? leave : '0);
+        if (ev4) w_q <= wsum[w] + SUM_W'(en_q ? enter : '0) - SUM_W'(lv_q ? leave : '0);
       end
     end
   end
 
-  // Stage 5: the two halves and the CUT's column (CA_ONLY: the CA sum)
-  logic [SUM_W-1:0] sa5_q, s5;   // s5: the training sum of the kind
+  // Stage 5: the two halves and the CUT's column (CA_ONLY: the CA sum); s5 the training sum
+  // of the kind (cfar_2d's early output FIFO takes it at stage 5)
+  logic [SUM_W-1:0] sa5_q, s5;
   if (CA_ONLY) begin : g_ca_sum
-    always_ff @(posedge clk) sa5_q <= wsum[0] + vo4 - wsum[1];
+    always_ff @(posedge clk) sa5_q <= wsum[0] + SUM_W'(vo4) - wsum[1];
     assign s5 = sa5_q;
     logic unused_kind;            // the kind is CA or OS (the CA sum) by construction
     assign unused_kind = ^kind;
   end else begin : g_half_sums
-    logic [SUM_W-1:0] sb5_q, sc5_q;
+    logic [SUM_W-1:0] sb5_q;
+    logic [VS_W-1:0]  sc5_q;     // the CUT's column: window rows minus guard rows, >= 0
     always_ff @(posedge clk) begin
       sa5_q <= wsum[0] - wsum[1];
-      sb5_q <= wsum[2] + vo4 - wsum[3];
+      sb5_q <= wsum[2] + SUM_W'(vo4) - wsum[3];
       sc5_q <= sr_o[PD-1] - sr_i[PD-1];
     end
     always_comb
       unique case (kind)
         2'd1:    s5 = (sa5_q > sb5_q) ? sa5_q : sb5_q;
         2'd2:    s5 = (sa5_q < sb5_q) ? sa5_q : sb5_q;
-        default: s5 = sa5_q + sb5_q + sc5_q;
+        default: s5 = sa5_q + sb5_q + SUM_W'(sc5_q);
       endcase
   end
 
+  assign sum5 = s5;
+
   // Stage 6: training sum S of the kind, the row's threshold scale (multiplier inputs)
-  logic [SUM_W-1:0]   sum_q [10:6];
+  logic [SUM_W-1:0]   sum6_q;
   logic [SCALE_W-1:0] scale6_q;
   logic [POW_W-1:0]   cut_q [9:6];
   always_ff @(posedge clk) begin
-    sum_q[6] <= s5;
+    sum6_q   <= s5;
     scale6_q <= scale5;
     cut_q[6] <= cut5;
-    for (int k = 7; k <= 10; k++) sum_q[k] <= sum_q[k-1];
     for (int k = 7; k <= 9; k++) cut_q[k] <= cut_q[k-1];
   end
-  assign sum10 = sum_q[10];
 
   // Stages 7-9: S * scale from CH-bit chunks, S = sum_i S_i 2^(CH i), scale likewise:
   // products registered (7), then per scale chunk j the even-i and odd-i products, each a
@@ -148,7 +153,7 @@ module cfar_sums #(
   logic [2*CH-1:0]    pp7_q [NA][NB];
   logic [(NA+1)*CH:0] col8_q [NB];
   logic [PROD_W-1:SCALE_FRAC] prod9_q;   // the product's bits that the decision uses
-  assign a6 = (NA * CH)'(sum_q[6]);
+  assign a6 = (NA * CH)'(sum6_q);
   assign b6 = (NB * CH)'(scale6_q);
   always_ff @(posedge clk) begin
     logic [(NA+1)*CH-1:0] ev, od;

@@ -11,7 +11,10 @@ module cfar_vsum #(
   parameter int PR = 6,
   parameter int GUARD_R = 2,
   parameter int POW_W = 34,
-  parameter int SUM_W = 43
+  // Derived, do not override: the vertical sums' width (at most NE cells of POW_W bits,
+  // NE odd) and the width of the stage-3 partial sums (at most 4 cells)
+  parameter int VS_W = POW_W + $clog2(NE),
+  parameter int P3_W = (VS_W < POW_W + 2) ? VS_W : POW_W + 2
 ) (
   input  wire logic                          clk,
   // stage 1: the slot written by the pass, window row k (row q-PR+k) exists
@@ -24,14 +27,19 @@ module cfar_vsum #(
   output logic      [ROWS-1:0]               mi2,
   // stage 4: vertical sums over the window rows (o) and guard rows (i), the cells of the
   // CUT's row and of rows q-1 (rm) and q+1 (rp)
-  output logic      [SUM_W-1:0]              vo4,
-  output logic      [SUM_W-1:0]              vi4,
+  output logic      [VS_W-1:0]               vo4,
+  output logic      [VS_W-1:0]               vi4,
   output logic      [POW_W-1:0]              vcut4,
   output logic      [POW_W-1:0]              rm4,
   output logic      [POW_W-1:0]              rp4
 );
 
   localparam int SLOT_W = $clog2(ROWS);
+
+  if (VS_W != POW_W + $clog2(NE) || P3_W != ((VS_W < POW_W + 2) ? VS_W : POW_W + 2) ||
+      NE % 2 != 1) begin : g_bad_derived
+    $fatal(1, "%m: VS_W/P3_W are derived, do not override (NE=%0d odd)", NE);
+  end
 
   // Stage 2: slot masks. Window row k of the tested row sits in slot (slot+1+k) mod ROWS.
   logic [ROWS-1:0] mc2_q, mrm2_q, mrp2_q;
@@ -53,12 +61,14 @@ module cfar_vsum #(
     end
   end
 
-  // Stage 3: masked slots summed in two adder levels (64 -> 16 terms; slots beyond ROWS
-  // are constant zero), the CUT-row and range-neighbour cells selected (AND-OR over slots)
-  logic [SUM_W-1:0] po3_q [16], pi3_q [16];
+  // Stage 3: masked slots summed in two adder levels (64 -> 16 terms of at most 4 cells;
+  // slots beyond ROWS are constant zero), the CUT-row and range-neighbour cells selected
+  // (AND-OR over slots). Every partial sum is one of masked cells, so no wider than the
+  // whole sum (VS_W) nor than 4 cells (P3_W).
+  logic [P3_W-1:0] po3_q [16], pi3_q [16];
   logic [POW_W-1:0] c3_q, rm3_q, rp3_q;
   always_ff @(posedge clk) begin
-    logic [SUM_W-1:0] xo [64], xi [64];
+    logic [P3_W-1:0]  xo [64], xi [64];
     logic [POW_W-1:0] c, m, p, w;
     c = '0;
     m = '0;
@@ -68,8 +78,8 @@ module cfar_vsum #(
       xi[s] = '0;
       if (s < ROWS) begin
         w = cw2[(s % ROWS) * POW_W +: POW_W];
-        if (mo2[s % ROWS]) xo[s] = SUM_W'(w);
-        if (mi2[s % ROWS]) xi[s] = SUM_W'(w);
+        if (mo2[s % ROWS]) xo[s] = P3_W'(w);
+        if (mi2[s % ROWS]) xi[s] = P3_W'(w);
         if (mc2_q[s % ROWS]) c = c | w;
         if (mrm2_q[s % ROWS]) m = m | w;
         if (mrp2_q[s % ROWS]) p = p | w;
@@ -90,10 +100,10 @@ module cfar_vsum #(
 
   // Stage 4: vertical sums complete (the remaining adder levels)
   always_ff @(posedge clk) begin
-    logic [SUM_W-1:0] xo [16], xi [16];
+    logic [VS_W-1:0] xo [16], xi [16];
     for (int i = 0; i < 16; i++) begin
-      xo[i] = po3_q[i];
-      xi[i] = pi3_q[i];
+      xo[i] = VS_W'(po3_q[i]);
+      xi[i] = VS_W'(pi3_q[i]);
     end
     for (int w = 8; w >= 1; w = w / 2)
       for (int i = 0; i < w; i++) begin

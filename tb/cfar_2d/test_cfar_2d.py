@@ -211,6 +211,24 @@ async def test_run_time_kind_and_local_max(dut):
 
 
 @cocotb.test()
+async def test_full_scale(dut):
+    """Every sum at its widest: a map of full-scale cells and one with about half its cells
+    at full scale, under every cfg_kind code (the vertical, window and training sums and
+    the product at their largest values)."""
+    tb = TB(dut)
+    await tb.reset()
+    c = tb.cfg
+    top = (1 << c.pow_w) - 1
+    full = np.full((c.n_range, c.n_doppler), top, dtype=np.int64)
+    half = np.where(tb.rng.random(full.shape) < 0.5, full, tb.random_map())
+    for kind in KIND_NAMES:
+        tb.set_kind(kind, False)
+        await tb.cycles(4)
+        await tb.run_maps([full, half])
+        await tb.cycles(4)
+
+
+@cocotb.test()
 async def test_framing_error(dut):
     """A misplaced TLAST is flagged (sticky); cells are still placed by count."""
     tb = TB(dut)
