@@ -41,7 +41,7 @@ COMPILED = numba is not None
 """Whether the kernels are compiled (numba importable)."""
 
 KERNEL_MODULES = ("host._angle_kept", "host._angle_peaks", "host._angle_relax",
-                  "host._cfar_os", "host.cfar", "host.dca1000", "host.pipeline",
+                  "host._cfar_os", "host.cells", "host.cfar", "host.dca1000", "host.pipeline",
                   "host.record_points", "host.tdm")
 """Every module that registers kernels (:func:`njit`): their sources key the caches."""
 STAMP = "host-kernels.sha256"
