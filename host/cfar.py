@@ -36,6 +36,7 @@ import numpy as np
 from scipy import stats
 
 from host._cfar_os import os_detect, os_kth, os_kth_at, os_scaled
+from host._grouping import local_peak_cells, sidelobe_cells
 from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
@@ -296,21 +297,7 @@ def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3,
     reflected at its ends, a real ADC's; the neighbourhood of ``scipy.ndimage``'s filters:
     offsets -(s // 2) .. s - s // 2 - 1). Only the cells of ``mask`` are compared with
     their neighbours. Returns int (n, 2) of (range_bin, doppler_bin), row-major order."""
-    cells = np.argwhere(mask)
-    (nr, nd), (r0, d0) = power.shape, cells.T
-    p = power[r0, d0]
-    keep = np.ones(len(cells), bool)
-    for dr in range(-(size[0] // 2), size[0] - size[0] // 2):
-        r = r0 + dr
-        if mirrored:                      # reflect without repeating the edge cell
-            r = np.clip(np.where(np.abs(r) > nr - 1, 2 * (nr - 1) - np.abs(r), np.abs(r)),
-                        0, nr - 1)
-        else:
-            r %= nr
-        for dd in range(-(size[1] // 2), size[1] - size[1] // 2):
-            if dr or dd:
-                keep &= power[r, (d0 + dd) % nd] <= p
-    return cells[keep]
+    return local_peak_cells(power, mask, size[0], size[1], mirrored)
 
 
 def detection_mask(n_range: int, n_doppler: int, bins: tuple[int, int]) -> np.ndarray:
@@ -374,18 +361,4 @@ def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: Windows,
     env_r = sidelobe_envelope(ax_r.n_fft, ax_r.hann, ax_r.n_samples) * scale
     env_d = sidelobe_envelope(ax_d.n_fft, ax_d.hann, ax_d.n_samples) * scale
     cells = np.asarray(cells).reshape(-1, 2)
-    out = np.zeros(len(cells), bool)
-    nr, nd = power.shape
-    fr, fd = ax_r.n_fft, ax_d.n_fft
-    # all cells at once, in chunks that keep the (n_range, chunk) gathers small:
-    # column sidelobes env_r[(r - r') mod n_fft] * power[r', d] over r', rows likewise
-    for lo in range(0, len(cells), 512):
-        r, d = cells[lo:lo + 512, 0], cells[lo:lo + 512, 1]
-        col = power[:, d] * env_r[(r[None, :] - np.arange(nr)[:, None]) % fr]
-        if ax_r.real:              # the mirror image at -r' throws sidelobes too
-            col = np.maximum(col, power[:, d] * env_r[(r[None, :] + np.arange(nr)[:, None])
-                                                      % fr])
-        row = power[r, :] * env_d[(d[:, None] - np.arange(nd)[None, :]) % fd]
-        p = power[r, d]
-        out[lo:lo + 512] = (col.max(axis=0) > p) | (row.max(axis=1) > p)
-    return out
+    return sidelobe_cells(power, cells, env_r, env_d, ax_r.real)
