@@ -29,6 +29,7 @@ backend ``host._cfar_os`` (:func:`cfar_detect` finds the k-th at the detected ce
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -275,19 +276,51 @@ def cfar_detect(power: np.ndarray, n_channels: int, params: CfarParams,
     if params.kind == "ca":
         threshold, noise = cfar_threshold(power, n_channels, params, windowed)
         return power > threshold, noise
+    mask, padded = _os_mask(power, n_channels, params, windowed)
+    rows, cols = np.nonzero(mask)
+    noise = np.full(power.shape, np.nan)
+    noise[rows, cols] = _os_noise_at(padded, rows, cols, n_channels, params)
+    return mask, noise
+
+
+def cfar_cells(power: np.ndarray, n_channels: int, params: CfarParams, windowed: Windows,
+               select: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The detected cells ``select`` keeps and :func:`cfar_detect`'s noise estimate at them:
+    (cells int (n, 2) of (range_bin, doppler_bin), noise float (n,)). ``select`` maps the
+    detection mask (bool (n_range, n_doppler), :func:`cfar_detect`'s) to the cells kept
+    (int (n, 2); a host's peak grouping and reported range bins): the OS-CFAR then finds
+    its order statistic at those cells only."""
+    if params.kind == "ca":
+        mask, noise_map = cfar_detect(power, n_channels, params, windowed)
+        cells = select(mask)
+        return cells, noise_map[cells[:, 0], cells[:, 1]]
+    mask, padded = _os_mask(power, n_channels, params, windowed)
+    cells = select(mask)
+    return cells, _os_noise_at(padded, np.ascontiguousarray(cells[:, 0]),
+                               np.ascontiguousarray(cells[:, 1]), n_channels, params)
+
+
+def _os_mask(power: np.ndarray, n_channels: int, params: CfarParams, windowed: Windows
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The OS-CFAR's detection mask (bool (n_range, n_doppler), :func:`cfar_detect`) of
+    ``power`` and its padded map (:func:`_os_padded`, for :func:`_os_noise_at`)."""
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     padded = _os_padded(power, params, windowed)
     (gr, gd), (tr, td) = params.guard, params.train
-    k = _os_k(params)
     scaled = os_scaled(padded, _os_alpha(params.pfa, n_channels, params), np.empty(
         padded.shape, np.float32 if power.dtype == np.float32 else np.float64))
-    mask = os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td, k)
-    rows, cols = np.nonzero(mask)
-    noise = np.full(power.shape, np.nan)
-    noise[rows, cols] = _os_noise(os_kth_at(padded, rows, cols, gr, gd, tr, td, k),
-                                  n_channels, params)
-    return mask, noise
+    return os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td,
+                     _os_k(params)), padded
+
+
+def _os_noise_at(padded: np.ndarray, rows: np.ndarray, cols: np.ndarray, n_channels: int,
+                 params: CfarParams) -> np.ndarray:
+    """The OS-CFAR's noise estimate (:func:`_os_noise`) at the cells (rows[i], cols[i]) of
+    the padded map ``padded`` (:func:`_os_padded`), float (n,)."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    return _os_noise(os_kth_at(padded, rows, cols, gr, gd, tr, td, _os_k(params)),
+                     n_channels, params)
 
 
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3),
