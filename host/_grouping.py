@@ -64,15 +64,20 @@ def sidelobe_cells(power: np.ndarray, cells: np.ndarray, env_r: np.ndarray,
         r, d = cells[i, 0], cells[i, 1]
         p = np.float64(power[r, d])
         col = -np.inf
+        k, km = r % fr, r % fr          # (r - q) and (r + q) mod fr, stepped without a division
         for q in range(nr):
-            v = np.float64(power[q, d]) * env_r[(r - q) % fr]
+            v = np.float64(power[q, d]) * env_r[k]
             if mirrored:
-                w = np.float64(power[q, d]) * env_r[(r + q) % fr]
+                w = np.float64(power[q, d]) * env_r[km]
                 v = w if (w > v or w != w) and v == v else v
             col = v if (v > col or v != v) and col == col else col
+            k = k - 1 if k else fr - 1
+            km = km + 1 if km < fr - 1 else 0
         row = -np.inf
+        k = d % fd
         for q in range(nd):
-            v = np.float64(power[r, q]) * env_d[(d - q) % fd]
+            v = np.float64(power[r, q]) * env_d[k]
             row = v if (v > row or v != v) and row == row else row
+            k = k - 1 if k else fd - 1
         out[i] = col > p or row > p
     return out

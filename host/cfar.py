@@ -164,8 +164,9 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             r = -r if r < 0 else (2 * (nr - 1) - r if r > nr - 1 else r)
         else:
             r = (r + nr) % nr
-        for j in range(nd + 2 * pd):
-            row[j] = power[r, (j - pd + nd) % nd]
+        for j in range(nd + 2 * pd):        # column (j - pd) mod nd, without a division
+            c = j - pd
+            row[j] = power[r, c + nd if c < 0 else (c - nd if c >= nd else c)]
         # every cell's sums at once, offset by offset (the same additions per cell, in
         # offset order; independent across cells, so they vectorise)
         s = side[i]
