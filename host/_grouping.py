@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from host.kernels import njit
+from host.kernels import njit, warm_up
 
 
 @njit()
@@ -81,3 +81,12 @@ def sidelobe_cells(power: np.ndarray, cells: np.ndarray, env_r: np.ndarray,
             k = k - 1 if k else fd - 1
         out[i] = col > p or row > p
     return out
+
+
+@warm_up
+def _warm_up() -> None:
+    """Both kernels (reached only by a cube's detections, not by the FPGA detector's
+    records) on a tiny map: float32 in Fortran order (a cube's map) and float64."""
+    for power in (np.zeros((4, 4), np.float32, order="F"), np.zeros((4, 4))):
+        cells = local_peak_cells(power, np.ones((4, 4), np.bool_), 3, 3, False)
+        sidelobe_cells(power, cells, np.zeros(4), np.zeros(4), False)

@@ -11,7 +11,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from host.kernels import njit
+from host.kernels import njit, warm_up
 from model.reference import FftAxis
 
 
@@ -246,3 +246,17 @@ def _map_offsets(power: np.ndarray, cells: np.ndarray,
                             inv_r) if 0 < r < nr - 1 else 0.0
         out[i, 1] = _offset(np.float64(power[r, (d + nd - 1) % nd]), c,
                             np.float64(power[r, (d + 1) % nd]), inv_d)
+
+
+@warm_up
+def _warm_up() -> None:
+    """The offsets off a map (a cube's, float32 in Fortran order, and float64), of
+    neighbours (the records') and along one axis (a calibration's): each path reaches only
+    some of them."""
+    inv = _inversion(FftAxis(8, 8))
+    cells = np.ones((1, 2), np.int64)
+    for power in (np.ones((4, 4), np.float32, order="F"), np.ones((4, 4))):
+        _map_offsets(power, cells, inv, inv, np.empty((1, 2)))
+    one = np.ones(1)
+    _neighbour_offsets(one, np.ones((1, 4)), np.ones(1, np.bool_), inv, inv, np.empty((1, 2)))
+    _axis_offsets(one, one, one, inv, np.empty(1))

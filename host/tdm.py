@@ -19,7 +19,7 @@ from typing import Protocol
 
 import numpy as np
 
-from host.kernels import njit
+from host.kernels import njit, warm_up
 from model.array import tx_slots
 from model.config import RadarConfig
 
@@ -227,3 +227,9 @@ def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, lo: np.ndarr
                     kbest = k
         fold[i] = ms[kbest]
         ambiguous[i] = count > 1 or ms[kbest] != 0
+
+
+@warm_up
+def _warm_up() -> None:
+    """The alias classes (reached only by radars of several TX) on one cell."""
+    _classes(np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty((1, 2), np.bool_))
