@@ -306,8 +306,9 @@ def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
 def cfar_rows(nci: np.ndarray, cfg: RadarConfig, params: DetectionParams,
               repeat: int = 5) -> str:
     """CPU time (ms, median of ``repeat``) of the CFAR on the frame's map ``nci`` (float
-    (n_range, n_doppler)) at ``params``' window: the OS-CFAR's detection as the chain runs
-    it (``host.cfar.cfar_detect``), its thresholds of every cell (``cfar_threshold``), the
+    (n_range, n_doppler)) at ``params``' window: the OS-CFAR's detection with its noise at
+    every detected cell (``host.cfar.cfar_detect``; the chain finds the noise at the cells it
+    keeps only, ``host.cfar.cfar_cells``), its thresholds of every cell (``cfar_threshold``), the
     numpy OS-CFAR they replaced (``tests/oracles/cfar.py``), and the CA-CFAR's detection."""
     windowed = fft_axes(cfg, params.range_window, params.doppler_window)
     c = params.cfar
@@ -330,7 +331,7 @@ def cfar_rows(nci: np.ndarray, cfg: RadarConfig, params: DetectionParams,
     ca_ms = cpu_ms(lambda: cfar_detect(nci, cfg.n_virtual, ca, windowed))
     return textwrap.fill(
         f"CFAR on the frame's {nci.shape[0]} x {nci.shape[1]} map, CPU ms (median of "
-        f"{repeat}): OS-CFAR detection (compiled, as the chain runs it) {det:.2f}, its "
+        f"{repeat}): OS-CFAR detection (compiled, its noise at every detection) {det:.2f}, its "
         f"thresholds of every cell {full:.2f}, the numpy OS-CFAR they replaced {ref:.1f}; "
         f"CA-CFAR detection {ca_ms:.2f}", WIDTH, subsequent_indent="    ")
 

@@ -52,7 +52,9 @@ def zoom_tables(n: int, n_fft: int, half: int) -> tuple[np.ndarray, np.ndarray]:
 _BLOCK = 32
 """(cell, class) pairs per coarse-FFT block: 2 x 128 x 32 float32, 32 KiB, the L1 data cache
 of a core (measured on Zen 1: 16 pairs 19 % slower, 64 5 %, 8 29 %; on Zen 4, 64 is 5-8 %
-faster, the same outputs bit for bit)."""
+faster, the same outputs bit for bit). Fewer pairs than this take a block of their number
+(a column's transform is the same whatever the block's width): RELAX and the split search
+a few rows at a time, where a full block's FFT was most of the work."""
 
 
 @njit(fastmath=True)
@@ -143,8 +145,8 @@ def _interpolated_sin(k0: int, a: float, b: float, c: float, n_fft: int) -> floa
 @njit(fastmath=True)
 def _block_fft(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray) -> None:
     """In-place FFT (kernel exp(+2 pi j n k / N), unscaled) of the columns of a block,
-    float32 re, im (N, _BLOCK), N a power of two, the columns innermost (vectorised over
-    them): radix-4 decimation-in-frequency stages, a radix-2 one last when N is not a power
+    float32 re, im (N, b), b <= _BLOCK, N a power of two, the columns innermost (vectorised
+    over them): radix-4 decimation-in-frequency stages, a radix-2 one last when N is not a power
     of 4; natural order in, digit-reversed order out (:func:`_coarse_tables`). wr, wi:
     float32 (N,) exp(2 pi j k / N)."""
     _fft_stages(re, im, wr, wi, re.shape[0], True)
@@ -157,8 +159,7 @@ def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, 
     = N: all of them; N / 4 after :func:`_padded_first_stage`); ``radix2`` False: without
     the final radix-2 stage (N not a power of 4; the caller fuses it with its next pass,
     :func:`_squares_fused`)."""
-    n = re.shape[0]
-    nb = _BLOCK                     # a compile-time trip count: the loops vectorise
+    n, nb = re.shape
     while size >= 4:
         q = size // 4
         stride = n // size
@@ -215,11 +216,10 @@ def _fft_stages(re: np.ndarray, im: np.ndarray, wr: np.ndarray, wi: np.ndarray, 
 def _padded_first_stage(xr: np.ndarray, xi: np.ndarray, re: np.ndarray, im: np.ndarray,
                         wr: np.ndarray, wi: np.ndarray) -> None:
     """The first radix-4 stage of :func:`_block_fft` on columns zero-padded to N: xr, xi
-    float64 (N / 2, _BLOCK) in (rows past the data 0), float32 re, im (N, _BLOCK) out (the
+    float64 (N / 2, b) in (rows past the data 0), float32 re, im (N, b) out (the
     inputs N / 2 .. N - 1 are 0, so each butterfly reads two values, rounded to single
     precision as the FFT input)."""
-    n = re.shape[0]
-    nb = _BLOCK
+    n, nb = re.shape
     q = n // 4
     for k in range(q):
         w1r = wr[k]
@@ -252,10 +252,10 @@ def _padded_first_stage(xr: np.ndarray, xi: np.ndarray, re: np.ndarray, im: np.n
 @njit(fastmath=True)
 def _squares_fused(re: np.ndarray, im: np.ndarray, rank: np.ndarray, sq: np.ndarray) -> None:
     """|X|^2 of a block transformed by ``_fft_stages(..., radix2=False)`` into sq (float32
-    (_BLOCK, N), bin k of column j at sq[j, k]): the final radix-2 stage first when N is
+    (b, N), bin k of column j at sq[j, k]): the final radix-2 stage first when N is
     not a power of 4 (rows 2 i, 2 i + 1 are the inputs of one butterfly). re, im float32
-    (N * _BLOCK,) flat; rank int (N,): the bin in each row after the full transform."""
-    nb = _BLOCK
+    (N * b,) flat; rank int (N,): the bin in each row after the full transform."""
+    nb = sq.shape[0]
     n = rank.shape[0]
     if n & 0x55555555:                          # a power of 4: no radix-2 stage
         for q in range(n):
@@ -307,7 +307,7 @@ def _class_peaks(x: np.ndarray, cell: np.ndarray, ph: np.ndarray, n_fft: int,
     ntx = ph.shape[1]
     nrx = nv // ntx
     coarse = rank.shape[0]
-    nb_ = _BLOCK
+    nb_ = min(_BLOCK, max(m, 1))
     re2 = np.zeros((coarse, nb_), np.float32)
     im2 = np.zeros((coarse, nb_), np.float32)
     re = re2.ravel()                   # the same block, flat: (bin, column) at bin * nb_ + column

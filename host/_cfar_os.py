@@ -181,7 +181,7 @@ def os_detect(scaled: np.ndarray, cut: np.ndarray, guard_r: int, guard_d: int,
     Counted in two passes over each map row: the first training rows, m >= 2 (n - k + 1)
     cells of the n, for every cell at once (vectorised); a cell with fewer than k - (n - m)
     of them below cannot reach k (the noise: nearly every cell); the others (cells near
-    targets) count the remaining rows one by one."""
+    targets) count the remaining rows one by one until the count reaches k or cannot."""
     pr, pd = guard_r + train_r, guard_d + train_d
     nr, nd = cut.shape
     width = 2 * pd + 1
@@ -205,12 +205,21 @@ def os_detect(scaled: np.ndarray, cut: np.ndarray, guard_r: int, guard_d: int,
             if count[d] < need:
                 continue
             c = count[d]
+            left = n - m                        # training cells not counted yet
             for i in range(rows, 2 * pr + 1):
+                if c >= k or c + left < k:      # decided: the rest cannot change it
+                    break
                 row = scaled[r + i]
-                guard_row = train_r <= i <= train_r + 2 * guard_r
-                for o in range(width):
-                    if not (guard_row and train_d <= o <= train_d + 2 * guard_d):
+                if train_r <= i <= train_r + 2 * guard_r:      # a guard row: its two sides
+                    for o in range(train_d):
                         c += row[d + o] < p[d]
+                    for o in range(width - train_d, width):
+                        c += row[d + o] < p[d]
+                    left -= 2 * train_d
+                else:
+                    for o in range(width):
+                        c += row[d + o] < p[d]
+                    left -= width
             out[r, d] = c >= k
     return out
 

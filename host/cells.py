@@ -11,6 +11,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from host.kernels import njit, warm_up
 from model.reference import FftAxis
 
 
@@ -65,21 +66,38 @@ def offset_statistic(lo: np.ndarray, c: np.ndarray, hi: np.ndarray, two: bool
     of the three cells (docs/curves.md). Two bins (``two`` True, a rectangular unpadded
     axis): t = +-m / (m_c + m) with m the larger neighbour's magnitude sqrt(power), sign
     toward it (Rife and Vincent's ratio; exact, t = offset, for an unpadded rectangular
-    window when N is large)."""
-    lo, c, hi = (np.asarray(v, dtype=float) for v in (lo, c, hi))
+    window when N is large). Compiled (:func:`_statistic`, one value at a time)."""
+    lo, c, hi = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (lo, c, hi)))
+    out = np.empty(c.shape)
+    _statistics(lo.ravel(), c.ravel(), hi.ravel(), bool(two), out.reshape(-1))
+    return out
+
+
+@njit()
+def _statistic(lo: float, c: float, hi: float, two: bool) -> float:
+    """:func:`offset_statistic` of one cell (float64 powers)."""
     if two:
         m_lo, m_c, m_hi = np.sqrt(lo), np.sqrt(c), np.sqrt(hi)
         up = m_hi >= m_lo
-        m = np.where(up, m_hi, m_lo)
+        m = m_hi if up else m_lo
         den = m_c + m
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.where(up, 1.0, -1.0) * np.where(den > 0, m / np.where(den > 0, den, 1.0),
-                                                   0.0)
-        return np.clip(t, -0.5, 0.5)
-    den = lo - 2 * c + hi
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.clip(0.5 * (lo - hi) / np.where(den < 0, den, -1.0), -0.5, 0.5)
-    return np.where(den < 0, t, 0.0)
+        t = (1.0 if up else -1.0) * (m / den if den > 0 else 0.0)
+    else:
+        den = lo - 2 * c + hi
+        if not den < 0:
+            return 0.0
+        t = 0.5 * (lo - hi) / den
+    if t < -0.5:                # np.clip's, NaN kept
+        return -0.5
+    return 0.5 if t > 0.5 else t
+
+
+@njit()
+def _statistics(lo: np.ndarray, c: np.ndarray, hi: np.ndarray, two: bool,
+                out: np.ndarray) -> None:
+    """:func:`_statistic` of every cell of the float64 (m,) powers into out (m,)."""
+    for i in range(c.shape[0]):
+        out[i] = _statistic(lo[i], c[i], hi[i], two)
 
 
 def tone_power(axis: FftAxis, offset: np.ndarray) -> np.ndarray:
@@ -114,9 +132,65 @@ def axis_offsets(lo: np.ndarray, c: np.ndarray, hi: np.ndarray, axis: FftAxis
     like ``c``: :func:`offset_statistic` of the powers lo, c, hi (non-coherent sums over
     channels keep each channel's tone shape) inverted through :func:`offset_table`. Unbiased
     for a noise-free tone (to about 1e-7 bin) at any offset, window and padding."""
-    t = offset_statistic(lo, c, hi, two_bin(axis))
-    tab, off = offset_table(axis)
-    return np.sign(t) * np.interp(np.abs(t), tab, off)
+    lo, c, hi = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (lo, c, hi)))
+    out = np.empty(c.shape)
+    _axis_offsets(lo.ravel(), c.ravel(), hi.ravel(), _inversion(axis), out.reshape(-1))
+    return out[()]
+
+
+def _inversion(axis: FftAxis) -> tuple[bool, np.ndarray, np.ndarray]:
+    """What the kernels need of ``axis`` to turn three powers into an offset: (whether it
+    takes the two-bin statistic, :func:`offset_table`'s t and offsets)."""
+    return (two_bin(axis), *offset_table(axis))
+
+
+@njit()
+def _interp(x: float, xp: np.ndarray, fp: np.ndarray) -> float:
+    """``np.interp(x, xp, fp)`` of one value (xp rising), the same arithmetic: the segment
+    xp[j] <= x < xp[j + 1] by bisection, fp[j] at a sample, the slope formula between,
+    the end values outside, NaN for NaN."""
+    n = xp.shape[0]
+    if x != x:
+        return x
+    if x < xp[0]:
+        return fp[0]
+    if x > xp[n - 1]:
+        return fp[n - 1]
+    lo, hi = 0, n - 1                   # xp[lo] <= x, and x < xp[hi] unless x == xp[-1]
+    if x >= xp[hi]:
+        return fp[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if x >= xp[mid]:
+            lo = mid
+        else:
+            hi = mid
+    if xp[lo] == x:
+        return fp[lo]
+    slope = (fp[lo + 1] - fp[lo]) / (xp[lo + 1] - xp[lo])
+    y = slope * (x - xp[lo]) + fp[lo]
+    if y != y:
+        y = slope * (x - xp[lo + 1]) + fp[lo + 1]
+        if y != y and fp[lo] == fp[lo + 1]:
+            y = fp[lo]
+    return y
+
+
+@njit()
+def _offset(lo: float, c: float, hi: float, inv: tuple[bool, np.ndarray, np.ndarray]
+            ) -> float:
+    """:func:`axis_offsets` of one cell: sign(t) |offset| at |t| (np.sign's 0 at 0)."""
+    t = _statistic(lo, c, hi, inv[0])
+    sign = 1.0 if t > 0 else (-1.0 if t < 0 else (0.0 if t == 0 else t))
+    return sign * _interp(abs(t), inv[1], inv[2])
+
+
+@njit()
+def _axis_offsets(lo: np.ndarray, c: np.ndarray, hi: np.ndarray,
+                  inv: tuple[bool, np.ndarray, np.ndarray], out: np.ndarray) -> None:
+    """:func:`_offset` of every cell of the float64 (m,) powers into out (m,)."""
+    for i in range(c.shape[0]):
+        out[i] = _offset(lo[i], c[i], hi[i], inv)
 
 
 def neighbour_offsets(power: np.ndarray, neighbours: np.ndarray, inner: np.ndarray,
@@ -127,11 +201,22 @@ def neighbour_offsets(power: np.ndarray, neighbours: np.ndarray, inner: np.ndarr
     neighbours: float (n, 4) their neighbours' at range - 1, range + 1, Doppler - 1,
     Doppler + 1 (``model.cfar_2d.NEIGHBOURS``); inner: bool (n,); axes: the (range,
     Doppler) axes (``model.reference.fft_axes``)."""
-    c = np.asarray(power, dtype=float)
-    nb = np.asarray(neighbours, dtype=float).reshape(len(c), 4)
-    dr = np.where(inner, axis_offsets(nb[:, 0], c, nb[:, 1], axes[0]), 0.0)
-    dd = axis_offsets(nb[:, 2], c, nb[:, 3], axes[1])
-    return np.stack([dr, dd], axis=1).reshape(len(c), 2)
+    c = np.ascontiguousarray(power, dtype=float).reshape(-1)
+    nb = np.ascontiguousarray(neighbours, dtype=float).reshape(len(c), 4)
+    out = np.empty((len(c), 2))
+    _neighbour_offsets(c, nb, np.ascontiguousarray(np.broadcast_to(inner, c.shape)),
+                       _inversion(axes[0]), _inversion(axes[1]), out)
+    return out
+
+
+@njit()
+def _neighbour_offsets(c: np.ndarray, nb: np.ndarray, inner: np.ndarray,
+                       inv_r: tuple[bool, np.ndarray, np.ndarray],
+                       inv_d: tuple[bool, np.ndarray, np.ndarray], out: np.ndarray) -> None:
+    """:func:`neighbour_offsets` into out (float64 (n, 2))."""
+    for i in range(c.shape[0]):
+        out[i, 0] = _offset(nb[i, 0], c[i], nb[i, 1], inv_r) if inner[i] else 0.0
+        out[i, 1] = _offset(nb[i, 2], c[i], nb[i, 3], inv_d)
 
 
 def peak_offsets(power: np.ndarray, cells: np.ndarray, axes: tuple[FftAxis, FftAxis]
@@ -139,10 +224,39 @@ def peak_offsets(power: np.ndarray, cells: np.ndarray, axes: tuple[FftAxis, FftA
     """:func:`neighbour_offsets` of cells on a map (Doppler circular; 0 at the range ends).
     power: float (n_range, n_doppler) the non-coherent power map; cells: int (n, 2) of
     (range_bin, doppler_bin); axes: the map's (range, Doppler) axes. Returns float (n, 2)
-    bins."""
+    bins; the neighbours are read off the map in the kernel (:func:`_map_offsets`)."""
+    cells = np.asarray(cells).reshape(-1, 2)
+    out = np.empty((len(cells), 2))
+    if len(cells):
+        _map_offsets(power, cells, _inversion(axes[0]), _inversion(axes[1]), out)
+    return out
+
+
+@njit()
+def _map_offsets(power: np.ndarray, cells: np.ndarray,
+                 inv_r: tuple[bool, np.ndarray, np.ndarray],
+                 inv_d: tuple[bool, np.ndarray, np.ndarray], out: np.ndarray) -> None:
+    """:func:`peak_offsets` into out (float64 (n, 2)); power: any float map, read as
+    float64."""
     nr, nd = power.shape
-    r, d = cells[:, 0], cells[:, 1]
-    rm, rp = np.clip(r - 1, 0, nr - 1), np.clip(r + 1, 0, nr - 1)
-    nb = np.stack([power[rm, d], power[rp, d], power[r, (d - 1) % nd],
-                   power[r, (d + 1) % nd]], axis=1).reshape(len(cells), 4)
-    return neighbour_offsets(power[r, d], nb, (r > 0) & (r < nr - 1), axes)
+    for i in range(cells.shape[0]):
+        r, d = cells[i, 0], cells[i, 1]
+        c = np.float64(power[r, d])
+        out[i, 0] = _offset(np.float64(power[r - 1, d]), c, np.float64(power[r + 1, d]),
+                            inv_r) if 0 < r < nr - 1 else 0.0
+        out[i, 1] = _offset(np.float64(power[r, (d + nd - 1) % nd]), c,
+                            np.float64(power[r, (d + 1) % nd]), inv_d)
+
+
+@warm_up
+def _warm_up() -> None:
+    """The offsets off a map (a cube's, float32 in Fortran order, and float64), of
+    neighbours (the records') and along one axis (a calibration's): each path reaches only
+    some of them."""
+    inv = _inversion(FftAxis(8, 8))
+    cells = np.ones((1, 2), np.int64)
+    for power in (np.ones((4, 4), np.float32, order="F"), np.ones((4, 4))):
+        _map_offsets(power, cells, inv, inv, np.empty((1, 2)))
+    one = np.ones(1)
+    _neighbour_offsets(one, np.ones((1, 4)), np.ones(1, np.bool_), inv, inv, np.empty((1, 2)))
+    _axis_offsets(one, one, one, inv, np.empty(1))

@@ -29,6 +29,7 @@ backend ``host._cfar_os`` (:func:`cfar_detect` finds the k-th at the detected ce
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -36,6 +37,7 @@ import numpy as np
 from scipy import stats
 
 from host._cfar_os import os_detect, os_kth, os_kth_at, os_scaled
+from host._grouping import local_peak_cells, sidelobe_cells
 from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
     HANN_POWER_CORRELATION,
@@ -162,8 +164,9 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             r = -r if r < 0 else (2 * (nr - 1) - r if r > nr - 1 else r)
         else:
             r = (r + nr) % nr
-        for j in range(nd + 2 * pd):
-            row[j] = power[r, (j - pd + nd) % nd]
+        for j in range(nd + 2 * pd):        # column (j - pd) mod nd, without a division
+            c = j - pd
+            row[j] = power[r, c + nd if c < 0 else (c - nd if c >= nd else c)]
         # every cell's sums at once, offset by offset (the same additions per cell, in
         # offset order; independent across cells, so they vectorise)
         s = side[i]
@@ -274,19 +277,51 @@ def cfar_detect(power: np.ndarray, n_channels: int, params: CfarParams,
     if params.kind == "ca":
         threshold, noise = cfar_threshold(power, n_channels, params, windowed)
         return power > threshold, noise
+    mask, padded = _os_mask(power, n_channels, params, windowed)
+    rows, cols = np.nonzero(mask)
+    noise = np.full(power.shape, np.nan)
+    noise[rows, cols] = _os_noise_at(padded, rows, cols, n_channels, params)
+    return mask, noise
+
+
+def cfar_cells(power: np.ndarray, n_channels: int, params: CfarParams, windowed: Windows,
+               select: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The detected cells ``select`` keeps and :func:`cfar_detect`'s noise estimate at them:
+    (cells int (n, 2) of (range_bin, doppler_bin), noise float (n,)). ``select`` maps the
+    detection mask (bool (n_range, n_doppler), :func:`cfar_detect`'s) to the cells kept
+    (int (n, 2); a host's peak grouping and reported range bins): the OS-CFAR then finds
+    its order statistic at those cells only."""
+    if params.kind == "ca":
+        mask, noise_map = cfar_detect(power, n_channels, params, windowed)
+        cells = select(mask)
+        return cells, noise_map[cells[:, 0], cells[:, 1]]
+    mask, padded = _os_mask(power, n_channels, params, windowed)
+    cells = select(mask)
+    return cells, _os_noise_at(padded, np.ascontiguousarray(cells[:, 0]),
+                               np.ascontiguousarray(cells[:, 1]), n_channels, params)
+
+
+def _os_mask(power: np.ndarray, n_channels: int, params: CfarParams, windowed: Windows
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The OS-CFAR's detection mask (bool (n_range, n_doppler), :func:`cfar_detect`) of
+    ``power`` and its padded map (:func:`_os_padded`, for :func:`_os_noise_at`)."""
     if power.ndim != 2:
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     padded = _os_padded(power, params, windowed)
     (gr, gd), (tr, td) = params.guard, params.train
-    k = _os_k(params)
     scaled = os_scaled(padded, _os_alpha(params.pfa, n_channels, params), np.empty(
         padded.shape, np.float32 if power.dtype == np.float32 else np.float64))
-    mask = os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td, k)
-    rows, cols = np.nonzero(mask)
-    noise = np.full(power.shape, np.nan)
-    noise[rows, cols] = _os_noise(os_kth_at(padded, rows, cols, gr, gd, tr, td, k),
-                                  n_channels, params)
-    return mask, noise
+    return os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td,
+                     _os_k(params)), padded
+
+
+def _os_noise_at(padded: np.ndarray, rows: np.ndarray, cols: np.ndarray, n_channels: int,
+                 params: CfarParams) -> np.ndarray:
+    """The OS-CFAR's noise estimate (:func:`_os_noise`) at the cells (rows[i], cols[i]) of
+    the padded map ``padded`` (:func:`_os_padded`), float (n,)."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    return _os_noise(os_kth_at(padded, rows, cols, gr, gd, tr, td, _os_k(params)),
+                     n_channels, params)
 
 
 def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3, 3),
@@ -296,21 +331,7 @@ def local_peaks(power: np.ndarray, mask: np.ndarray, size: tuple[int, int] = (3,
     reflected at its ends, a real ADC's; the neighbourhood of ``scipy.ndimage``'s filters:
     offsets -(s // 2) .. s - s // 2 - 1). Only the cells of ``mask`` are compared with
     their neighbours. Returns int (n, 2) of (range_bin, doppler_bin), row-major order."""
-    cells = np.argwhere(mask)
-    (nr, nd), (r0, d0) = power.shape, cells.T
-    p = power[r0, d0]
-    keep = np.ones(len(cells), bool)
-    for dr in range(-(size[0] // 2), size[0] - size[0] // 2):
-        r = r0 + dr
-        if mirrored:                      # reflect without repeating the edge cell
-            r = np.clip(np.where(np.abs(r) > nr - 1, 2 * (nr - 1) - np.abs(r), np.abs(r)),
-                        0, nr - 1)
-        else:
-            r %= nr
-        for dd in range(-(size[1] // 2), size[1] - size[1] // 2):
-            if dr or dd:
-                keep &= power[r, (d0 + dd) % nd] <= p
-    return cells[keep]
+    return local_peak_cells(power, mask, size[0], size[1], mirrored)
 
 
 def detection_mask(n_range: int, n_doppler: int, bins: tuple[int, int]) -> np.ndarray:
@@ -374,18 +395,4 @@ def sidelobe_masked(power: np.ndarray, cells: np.ndarray, windowed: Windows,
     env_r = sidelobe_envelope(ax_r.n_fft, ax_r.hann, ax_r.n_samples) * scale
     env_d = sidelobe_envelope(ax_d.n_fft, ax_d.hann, ax_d.n_samples) * scale
     cells = np.asarray(cells).reshape(-1, 2)
-    out = np.zeros(len(cells), bool)
-    nr, nd = power.shape
-    fr, fd = ax_r.n_fft, ax_d.n_fft
-    # all cells at once, in chunks that keep the (n_range, chunk) gathers small:
-    # column sidelobes env_r[(r - r') mod n_fft] * power[r', d] over r', rows likewise
-    for lo in range(0, len(cells), 512):
-        r, d = cells[lo:lo + 512, 0], cells[lo:lo + 512, 1]
-        col = power[:, d] * env_r[(r[None, :] - np.arange(nr)[:, None]) % fr]
-        if ax_r.real:              # the mirror image at -r' throws sidelobes too
-            col = np.maximum(col, power[:, d] * env_r[(r[None, :] + np.arange(nr)[:, None])
-                                                      % fr])
-        row = power[r, :] * env_d[(d[:, None] - np.arange(nd)[None, :]) % fd]
-        p = power[r, d]
-        out[lo:lo + 512] = (col.max(axis=0) > p) | (row.max(axis=1) > p)
-    return out
+    return sidelobe_cells(power, cells, env_r, env_d, ax_r.real)

@@ -41,12 +41,15 @@ function for both, ``host.points.points_from_cells``. Settings: ``host.params``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from host.cells import Cells, peak_offsets
 from host.cfar import (
     CfarParams,
     Windows,
+    cfar_cells,
     cfar_detect,
     cfar_threshold,
     detection_mask,
@@ -68,14 +71,14 @@ GROUPING_SIZE = {"peak": (3, 3), "doppler": (1, 3)}
 (``host.cfar.local_peaks``), by ``DetectionParams.grouping``."""
 
 
-def _min_snr(mask: np.ndarray, power: np.ndarray, noise: np.ndarray,
+def _min_snr(cells: np.ndarray, power: np.ndarray, noise: np.ndarray,
              params: DetectionParams) -> np.ndarray:
-    """``mask`` (bool (n_range, n_doppler)) less the cells whose ``power`` is not
-    ``params.min_snr_db`` above ``noise`` (both float of that shape; ``noise`` is read at
-    the mask's cells only); unchanged if None."""
+    """bool (n,): which of the cells (int (n, 2)) have their ``power`` (float (n_range,
+    n_doppler) map) ``params.min_snr_db`` above ``noise`` (float (n,), at the cells); all
+    when it is None."""
     if params.min_snr_db is None:
-        return mask
-    return mask & (power > noise * 10.0 ** (params.min_snr_db / 10.0))
+        return np.ones(len(cells), bool)
+    return power[cells[:, 0], cells[:, 1]] > noise * 10.0 ** (params.min_snr_db / 10.0)
 
 
 def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
@@ -100,35 +103,70 @@ def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Window
     return out, noise_map
 
 
+def _static_cfar_cells(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
+                       select: Callable[[np.ndarray, np.ndarray], np.ndarray]
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """``host.cfar.cfar_cells`` on the map of :func:`map_cfar` after static removal (the
+    emptied zero-Doppler bin left out, the lowered bins divided by their noise gain): the
+    cells ``select(mask, nci)`` keeps (int (n, 2), full-map bins) and the noise at them (float
+    (n,), scaled back); the same cells and noise as ``map_cfar(..., True)``'s maps give."""
+    gain = static_noise_gain(cfg, windowed[1].hann)
+    keep = np.flatnonzero(gain > 0.0)
+    reduced = np.full(nci.shape[1], -1)
+    reduced[keep] = np.arange(len(keep))
+
+    def select_reduced(mask: np.ndarray) -> np.ndarray:
+        full = np.zeros(nci.shape, bool)
+        full[:, keep] = mask
+        cells = select(full, nci)
+        return np.column_stack([cells[:, 0], reduced[cells[:, 1]]])
+
+    cells, noise = cfar_cells(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed,
+                              select_reduced)
+    cells = np.column_stack([cells[:, 0], keep[cells[:, 1]]])
+    return cells, noise * gain[cells[:, 1]]
+
+
 def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Detected range-Doppler cells of a cube.
 
     cube: complex (n_virtual, n_range_bins, n_doppler). Returns (cells int (n, 2) of
     (range_bin, doppler_bin natural order), noise float (n,) mean noise power per cell of the
-    non-coherent map, nci float (n_range_bins, n_doppler) the non-coherent map).
+    non-coherent map, nci float (n_range_bins, n_doppler) the non-coherent map). The
+    detector's mask, then the grouping's peaks in the reported range bins, clear of
+    stronger cells' sidelobes, ``min_snr_db`` above their noise: each a test of the cell
+    alone, so the noise is needed at the last cells only (the OS-CFAR's is found there,
+    ``host.cfar.cfar_cells``).
     """
     nci = range_doppler_power(cube)
     windowed = fft_axes(cfg, params.range_window, params.doppler_window)
     mirrored = windowed[0].real
-    cf = params.cfar if params.detector != "os" else CfarParams(
-        pfa=params.cfar.pfa, guard=params.cfar.guard, train=params.cfar.train, kind="os",
-        os_rank=params.cfar.os_rank)
     size = GROUPING_SIZE[params.grouping]
+    ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
+
+    def select(mask: np.ndarray, peak_map: np.ndarray) -> np.ndarray:
+        cells = local_peaks(peak_map, mask, size, mirrored)
+        cells = cells[ok[cells[:, 0], cells[:, 1]]]
+        if params.sidelobe_margin_db is not None and len(cells):
+            cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
+        return cells
+
     if params.detector == "paper":
         mask, p0 = paper_threshold(cube, params.paper_threshold_db)
-        noise_map = np.full(nci.shape, np.median(nci))
-        cells = local_peaks(p0, _min_snr(mask, nci, noise_map, params), size, mirrored)
+        cells = select(mask, p0)
+        noise = np.full(len(cells), np.median(nci))
     else:
-        if params.detector == "ca":
-            cf = CfarParams(pfa=cf.pfa, guard=cf.guard, train=cf.train, kind="ca")
-        detected, noise_map = map_cfar(nci, cfg, cf, windowed, params.static_removed)
-        cells = local_peaks(nci, _min_snr(detected, nci, noise_map, params), size, mirrored)
-    ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
-    cells = cells[ok[cells[:, 0], cells[:, 1]]]
-    if params.sidelobe_margin_db is not None and len(cells):
-        cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
-    return cells, noise_map[cells[:, 0], cells[:, 1]], nci
+        c = params.cfar
+        cf = CfarParams(pfa=c.pfa, guard=c.guard, train=c.train, kind=params.detector,
+                        os_rank=c.os_rank) if c.kind != params.detector else c
+        if params.static_removed:
+            cells, noise = _static_cfar_cells(nci, cfg, cf, windowed, select)
+        else:
+            cells, noise = cfar_cells(nci, cfg.n_virtual, cf, windowed,
+                                      lambda mask: select(mask, nci))
+    keep = _min_snr(cells, nci, noise, params)
+    return cells[keep], noise[keep], nci
 
 
 def process_cube(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams | None = None,

@@ -19,10 +19,9 @@ from typing import Protocol
 
 import numpy as np
 
-from host.kernels import njit
+from host.kernels import njit, warm_up
 from model.array import tx_slots
 from model.config import RadarConfig
-from model.reference import signed_bin
 
 
 class UnfoldSettings(Protocol):
@@ -57,12 +56,31 @@ def tx_phasors(cfg: RadarConfig, k: np.ndarray) -> np.ndarray:
     (``model.reference.tdm_phase_compensation``'s phase, one value per TX, looked up on the
     unit circle). The phase has period num_tx n_doppler in k; k >= n_doppler / 2 is
     shifted by that period, not by n_doppler (which would undo an unfolding by +1)."""
-    k = np.asarray(k)
-    k = np.where(k >= cfg.n_doppler // 2, k - cfg.num_tx * cfg.n_doppler, k)
-    k = signed_bin(k, cfg.n_doppler)
-    n = cfg.n_doppler * cfg.num_tx
-    m = np.multiply.outer(k, _slots(cfg))
-    return _unit_circle(n)[m & (n - 1) if n & (n - 1) == 0 else m % n]   # & : mod 2^b
+    k = np.asarray(k, dtype=np.int64)
+    out = np.empty((k.size, cfg.num_tx), np.complex128)
+    _phasors(k.reshape(-1), cfg.n_doppler, _slots(cfg),
+             _unit_circle(cfg.n_doppler * cfg.num_tx), out)
+    return out.reshape(*k.shape, cfg.num_tx)
+
+
+@njit()
+def _phasors(k: np.ndarray, nd: int, slots: np.ndarray, circle: np.ndarray,
+             out: np.ndarray) -> None:
+    """:func:`tx_phasors` of the bins k (int64 (m,)) into out (complex128 (m, num_tx)):
+    circle[k q_t mod n] with n = len(circle) = n_doppler num_tx (a mask when n is a power of
+    two), slots q_t int64 (num_tx,)."""
+    n = circle.shape[0]
+    mask = n - 1 if n & (n - 1) == 0 else -1
+    shift = n                               # num_tx n_doppler
+    for i in range(k.shape[0]):
+        kk = k[i]
+        if kk >= nd // 2:
+            kk -= shift
+        if kk >= nd // 2:                   # model.reference.signed_bin
+            kk -= nd
+        for t in range(slots.shape[0]):
+            m = kk * slots[t]
+            out[i, t] = circle[m & mask if mask >= 0 else m % n]
 
 
 def alias_orders(cfg: RadarConfig, velocity_mps: np.ndarray, max_speed_mps: float
@@ -72,11 +90,25 @@ def alias_orders(cfg: RadarConfig, velocity_mps: np.ndarray, max_speed_mps: floa
     the cell then takes m = 0), and ms int (h,), every order any cell may take, and 0.
     velocity_mps: float (n,) measured (aliased)."""
     v = np.asarray(velocity_mps, dtype=float)
-    period = 2.0 * cfg.max_velocity_mps
-    lo = np.ceil((-max_speed_mps - v) / period).astype(np.int64)
-    hi = np.floor((max_speed_mps - v) / period).astype(np.int64)
-    ms = np.arange(int(min(lo.min(initial=0), 0)), int(max(hi.max(initial=0), 0)) + 1)
-    return lo, hi, ms
+    lo, hi = np.empty(v.shape, np.int64), np.empty(v.shape, np.int64)
+    m_lo, m_hi = _alias_bounds(v.reshape(-1), 2.0 * cfg.max_velocity_mps, float(max_speed_mps),
+                               lo.reshape(-1), hi.reshape(-1))
+    return lo, hi, np.arange(m_lo, m_hi + 1)
+
+
+@njit()
+def _alias_bounds(v: np.ndarray, period: float, max_speed: float, lo: np.ndarray,
+                  hi: np.ndarray) -> tuple[int, int]:
+    """:func:`alias_orders`' lo = ceil((-max_speed - v) / period) and hi = floor((max_speed
+    - v) / period) of every v (float64 (n,)) into lo, hi (int64 (n,)); returns (min(lo, 0),
+    max(hi, 0))."""
+    m_lo, m_hi = 0, 0
+    for i in range(v.shape[0]):
+        lo[i] = np.int64(np.ceil((-max_speed - v[i]) / period))
+        hi[i] = np.int64(np.floor((max_speed - v[i]) / period))
+        m_lo = min(m_lo, lo[i])
+        m_hi = max(m_hi, hi[i])
+    return m_lo, m_hi
 
 
 def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, max_speed_mps: float
@@ -85,12 +117,23 @@ def hypothesis_classes(cfg: RadarConfig, velocity_mps: np.ndarray, max_speed_mps
     (:func:`alias_orders`; m = 0 when none is), bool (n, num_tx); velocity_mps: float (n,)
     measured (aliased). Only these classes' powers enter :func:`choose_folds`."""
     lo, hi, _ = alias_orders(cfg, velocity_mps, max_speed_mps)
-    count = hi - lo + 1                        # consecutive orders lo..hi (none: m = 0)
-    first = np.where(count > 0, lo, 0)
-    count = np.maximum(count, 1)
-    c = np.arange(cfg.num_tx)
-    # class c holds an order of lo..hi when the first one at or after lo is within it
-    return (c[None, :] - first[:, None]) % cfg.num_tx < count[:, None]
+    out = np.empty((len(lo), cfg.num_tx), bool)
+    _classes(lo, hi, out)
+    return out
+
+
+@njit()
+def _classes(lo: np.ndarray, hi: np.ndarray, out: np.ndarray) -> None:
+    """:func:`hypothesis_classes` of the orders lo..hi (int64 (n,)) into out (bool (n,
+    num_tx)): class c holds an order of lo..hi (none: m = 0) when the first one at or after
+    lo (0) is within them."""
+    ntx = out.shape[1]
+    for i in range(lo.shape[0]):
+        count = hi[i] - lo[i] + 1              # consecutive orders lo..hi
+        first = lo[i] if count > 0 else 0
+        count = max(count, 1)
+        for c in range(ntx):
+            out[i, c] = (c - first) % ntx < count
 
 
 def choose_folds(class_power: np.ndarray, cfg: RadarConfig, velocity_mps: np.ndarray,
@@ -184,3 +227,9 @@ def _fold_decisions(cp: np.ndarray, v: np.ndarray, snr: np.ndarray, lo: np.ndarr
                     kbest = k
         fold[i] = ms[kbest]
         ambiguous[i] = count > 1 or ms[kbest] != 0
+
+
+@warm_up
+def _warm_up() -> None:
+    """The alias classes (reached only by radars of several TX) on one cell."""
+    _classes(np.zeros(1, np.int64), np.zeros(1, np.int64), np.empty((1, 2), np.bool_))
