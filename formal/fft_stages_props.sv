@@ -165,7 +165,7 @@ module fft_twiddle_props #(
     .out_ov);
 
   initial assume (rst);
-  localparam int LAT = 6;   // fft_twiddle's stages
+  localparam int LAT = 7;   // fft_twiddle's stages
   f_vld_pipe #(.LAT(LAT), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
     .clk, .rst, .en, .in_vld, .in_pos, .out_vld, .out_pos);
 

@@ -3,8 +3,15 @@
 // W_M^(i0*(b1+2*b0)) in the quarter-wave ROM from the sample's index tag and multiplies every
 // lane with registered inputs and products (DSP48E2 friendly; three real products per lane,
 // Gauss, four for W = 27), exact sums, convergent rounding, saturation.
-// Six register stages: ROM index; quarter-wave ROM words; coefficients (quadrant, Gauss
-// pre-adds) and operands; products; exact sums; rounded and saturated result.
+// Seven register stages: ROM index; quarter-wave ROM words; coefficients (quadrant, Gauss
+// pre-adds) and data pre-add; every multiplier's own operands; products; exact sums; rounded
+// and saturated result.
+// The operand stage gives each lane's products their own copy of the shared coefficients and
+// of the data (one fan-out each), so a place and route puts them beside the multiplier
+// (on an ECP5 a product wider than 18 bits is two MULT18X18D and the sum of their partial
+// products in fabric, all in the product's cycle, with the routes to and from the
+// multipliers; on a DSP48E2 the two operand stages are the A1/A2 and B1/B2 registers, one
+// slice per product).
 `default_nettype none
 
 module fft_twiddle #(
@@ -28,7 +35,7 @@ module fft_twiddle #(
   input  logic                  in_vld,
   input  logic [LOG2N-1:0]      in_pos,
   input  logic                  in_ov,
-  // Sample out, 6 advances later.
+  // Sample out, 7 advances later.
   output logic [NUM_CH*2*W-1:0] out_data,
   output logic                  out_vld,
   output logic [LOG2N-1:0]      out_pos,
@@ -74,21 +81,21 @@ module fft_twiddle #(
     end
   end
 
-  // ---------------------------------------------------------------- stage 3: operands
-  logic [DW-1:0]        da_q, db_q, d1_q;   // data in stages 1, 2, 3
-  logic [LOG2N-1:0]     pos_q [6];
-  logic                 ov_q  [5];
-  logic [5:0]           vld_q;
+  // ---------------------------------------------------------------- stages 3, 4: operands
+  logic [DW-1:0]        da_q, db_q, d1_q, d4_q;   // data in stages 1, 2, 3, 4
+  logic [LOG2N-1:0]     pos_q [7];
+  logic                 ov_q  [6];
+  logic [6:0]           vld_q;
 
-  // ---------------------------------------------------------------- stage 6: round, sat
-  logic [DW-1:0] y_d, y6_q;
-  logic          y_ov, ov6_q;
+  // ---------------------------------------------------------------- stage 7: round, sat
+  logic [DW-1:0] y_d, y7_q;
+  logic          y_ov, ov7_q;
 
-  // Products (stage 4) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
-  // the inverse has S -> -S), full precision before the rounding (stage 5): two forms,
+  // Products (stage 5) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
+  // the inverse has S -> -S), full precision before the rounding (stage 6): two forms,
   // same bits.
   logic signed [PRW+1:0] yr_full [NUM_CH], yi_full [NUM_CH];
-  logic signed [PRW+1:0] yr5_q [NUM_CH], yi5_q [NUM_CH];
+  logic signed [PRW+1:0] yr6_q [NUM_CH], yi6_q [NUM_CH];
 
   if (GAUSS) begin : g_gauss
     // Three real products per lane (Gauss): with d = -S (forward) or +S (inverse)
@@ -97,6 +104,9 @@ module fft_twiddle #(
     // shared by every lane); the data pre-add re + im is W+1 <= 27 bits (DSP48E2 A port).
     logic signed [COEF_W-1:0] c1_q, p1_q, m1_q;   // C, d - C, C + d
     logic signed [W:0]        a1_q [NUM_CH];      // re + im
+    // stage 4: each lane's operands (the coefficients copied per lane)
+    logic signed [COEF_W-1:0] c4_q [NUM_CH], p4_q [NUM_CH], m4_q [NUM_CH];
+    logic signed [W:0]        a4_q [NUM_CH];
     logic signed [PRW:0]      k1_q [NUM_CH];
     logic signed [PRW-1:0]    k2_q [NUM_CH];
     logic signed [PRW-1:0]    k3_q [NUM_CH];
@@ -113,9 +123,22 @@ module fft_twiddle #(
         for (int ch = 0; ch < NUM_CH; ch++) begin
           a1_q[ch] <= (W+1)'(signed'(db_q[ch*2*W +: W]))
                     + (W+1)'(signed'(db_q[ch*2*W + W +: W]));
-          k1_q[ch] <= (PRW+1)'(a1_q[ch]) * (PRW+1)'(c1_q);
-          k2_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(p1_q);
-          k3_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(m1_q);
+          a4_q[ch] <= a1_q[ch];
+          k1_q[ch] <= (PRW+1)'(a4_q[ch]) * (PRW+1)'(c4_q[ch]);
+          k2_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(p4_q[ch]);
+          k3_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(m4_q[ch]);
+        end
+      end
+    end
+
+    // keep: the per-lane copies hold the same bits, which Yosys' opt_merge would merge back
+    // into one register feeding every lane's multipliers
+    (* keep *) always_ff @(posedge clk) begin
+      if (en) begin
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          c4_q[ch] <= c1_q;
+          p4_q[ch] <= p1_q;
+          m4_q[ch] <= m1_q;
         end
       end
     end
@@ -129,6 +152,7 @@ module fft_twiddle #(
   end else begin : g_four
     // Four real products per lane (W = 27: the pre-add would not fit the 27-bit A port).
     logic signed [COEF_W-1:0] c1_q, s1_q;
+    logic signed [COEF_W-1:0] c4_q [NUM_CH], s4_q [NUM_CH];   // stage 4: per lane
     logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
     logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
     logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
@@ -139,10 +163,20 @@ module fft_twiddle #(
         c1_q <= signed'(cos2_q);
         s1_q <= signed'(sin2_q);
         for (int ch = 0; ch < NUM_CH; ch++) begin
-          prc_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(c1_q);
-          prs_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(s1_q);
-          prc_i_q[ch] <= PRW'(signed'(d1_q[ch*2*W + W +: W])) * PRW'(c1_q);
-          prs_r_q[ch] <= PRW'(signed'(d1_q[ch*2*W +: W])) * PRW'(s1_q);
+          prc_r_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(c4_q[ch]);
+          prs_i_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(s4_q[ch]);
+          prc_i_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(c4_q[ch]);
+          prs_r_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(s4_q[ch]);
+        end
+      end
+    end
+
+    // keep: per-lane copies of the same bits (see g_gauss)
+    (* keep *) always_ff @(posedge clk) begin
+      if (en) begin
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          c4_q[ch] <= c1_q;
+          s4_q[ch] <= s1_q;
         end
       end
     end
@@ -165,16 +199,17 @@ module fft_twiddle #(
       da_q     <= in_data;
       db_q     <= da_q;
       d1_q     <= db_q;
+      d4_q     <= d1_q;
       pos_q[0] <= in_pos;
       ov_q[0]  <= in_ov;
-      for (int k = 1; k < 6; k++) pos_q[k] <= pos_q[k-1];
-      for (int k = 1; k < 5; k++) ov_q[k] <= ov_q[k-1];
+      for (int k = 1; k < 7; k++) pos_q[k] <= pos_q[k-1];
+      for (int k = 1; k < 6; k++) ov_q[k] <= ov_q[k-1];
       for (int ch = 0; ch < NUM_CH; ch++) begin
-        yr5_q[ch] <= yr_full[ch];
-        yi5_q[ch] <= yi_full[ch];
+        yr6_q[ch] <= yr_full[ch];
+        yi6_q[ch] <= yi_full[ch];
       end
-      y6_q     <= y_d;
-      ov6_q    <= ov_q[4] | y_ov;
+      y7_q     <= y_d;
+      ov7_q    <= ov_q[5] | y_ov;
     end
   end
 
@@ -183,8 +218,8 @@ module fft_twiddle #(
     y_d  = '0;
     y_ov = 1'b0;
     for (int ch = 0; ch < NUM_CH; ch++) begin
-      yr = fft_pkg::round_conv(64'(yr5_q[ch]), COEF_FRAC);
-      yi = fft_pkg::round_conv(64'(yi5_q[ch]), COEF_FRAC);
+      yr = fft_pkg::round_conv(64'(yr6_q[ch]), COEF_FRAC);
+      yi = fft_pkg::round_conv(64'(yi6_q[ch]), COEF_FRAC);
       y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
       y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
       y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));
@@ -195,14 +230,14 @@ module fft_twiddle #(
     if (rst) begin
       vld_q <= '0;
     end else if (en) begin
-      vld_q <= {vld_q[4:0], in_vld};
+      vld_q <= {vld_q[5:0], in_vld};
     end
   end
 
-  assign out_data = y6_q;
-  assign out_vld  = vld_q[5];
-  assign out_pos  = pos_q[5];
-  assign out_ov   = ov6_q;
+  assign out_data = y7_q;
+  assign out_vld  = vld_q[6];
+  assign out_pos  = pos_q[6];
+  assign out_ov   = ov7_q;
 endmodule
 
 `default_nettype wire
