@@ -4,6 +4,11 @@ Chirp sequences: clean back-to-back frames, chirps lost inside a frame (next chi
 a gap), a lost frame-start chirp, an early frame start, chirps without frame start after
 reset; random TVALID gaps and TREADY stalls; a reset in mid-stream. Every output chirp, the
 per-frame damaged marks and the counters are compared with the model.
+
+Watchdogs (a design that stops the stream fails within seconds, not after the 50 ms default
+of ``rtlsim.toolchain``, a quarter of an hour of wall time here): every wait for output or
+for the input to drain is bounded by :meth:`TB.chirp_clocks`, and every test by
+:data:`TEST_LIMIT_US` of simulated time.
 """
 
 from __future__ import annotations
@@ -13,12 +18,24 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import RisingEdge
+from cocotb.triggers import RisingEdge, with_timeout
 
 from model.frame_align import frame_align
-from rtlsim.axis import AxisTB, bursty_pause, random_pause
+from rtlsim.axis import CLK_PERIOD_NS, AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 from tb import stall_regimes
+
+
+def _test_limit_us() -> float | None:
+    """Simulated-time limit of each test, us: 10 us (1,000 clocks) per sample of a frame. The
+    longest test, ``stall_cross_with_losses``, simulates about 0.6 us per frame sample with the
+    CI stall pairs (12 us at N_RANGE 4 x 6 chirps, 76 us at 16 x 8) and 4x that with all 16
+    pairs (``STALL_CROSS=full``). None outside a simulation (pytest collecting the module)."""
+    samples = param("N_RANGE", 0) * param("FRAME_CHIRPS", 0)
+    return 10.0 * samples if samples else None
+
+
+TEST_LIMIT_US = _test_limit_us()
 
 
 class TB(AxisTB):
@@ -35,6 +52,19 @@ class TB(AxisTB):
             await RisingEdge(self.dut.clk)
             if self.dut.frame_done.value == 1:
                 self.done.append(bool(self.dut.frame_done_damaged.value))
+
+    @property
+    def chirp_clocks(self) -> int:
+        """Clocks within which the next output chirp must arrive (or the input drain): twice
+        the worst case of the stall patterns here, where before an output chirp up to
+        FRAME_CHIRPS + 1 input chirps are discarded or forwarded, and every beat in or out is
+        held at most 4 N_RANGE + 64 clocks (the longest pause runs of ``stall_regimes`` and
+        ``bursty_pause(.., 60)``)."""
+        return 2 * (self.frame_chirps + 2) * self.n_range * (4 * self.n_range + 64)
+
+    async def wait_quiet(self, quiet: int = 64) -> None:
+        """:meth:`AxisTB.wait_quiet` within :attr:`chirp_clocks` (``SimTimeoutError``)."""
+        await with_timeout(super().wait_quiet(quiet), self.chirp_clocks * CLK_PERIOD_NS, "ns")
 
     def chirp(self) -> np.ndarray:
         return self.rng.integers(1, 1 << 32, (self.n_range, self.num_rx), dtype=np.uint32)
@@ -62,7 +92,7 @@ class TB(AxisTB):
     async def collect(self, n_chirps: int) -> list[np.ndarray]:
         out = []
         for _ in range(n_chirps):
-            out.append(await self.recv_words(self.num_rx))
+            out.append(await self.recv_words(self.num_rx, timeout_cycles=self.chirp_clocks))
         return out
 
     def counters(self) -> tuple[int, int, int]:
@@ -85,7 +115,7 @@ class TB(AxisTB):
                            sum(self.done), want.chirps_filled, want.chirps_discarded)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def clean_frames_back_to_back(dut) -> None:
     """Whole frames pass through unchanged at one sample per clock."""
     tb = TB(dut)
@@ -98,7 +128,7 @@ async def clean_frames_back_to_back(dut) -> None:
     assert not any(tb.done)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def lost_chirps_with_gaps_and_stalls(dut) -> None:
     """Random chirp losses, random TVALID gaps and TREADY stalls (long ones too)."""
     tb = TB(dut)
@@ -116,7 +146,7 @@ async def lost_chirps_with_gaps_and_stalls(dut) -> None:
         assert any(tb.done), "some frame must be damaged"
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def start_lost_early_start_and_midframe_entry(dut) -> None:
     """The frame-start chirp lost; a frame start arriving early; entry in mid-frame."""
     tb = TB(dut)
@@ -154,7 +184,7 @@ async def clean_frames_after_reset(tb: TB) -> None:
     assert tb.counters()[:2] == base[:2] == (0, 0)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def reset_mid_stream(dut) -> None:
     """A reset in the middle of a frame, then clean frames: nothing of the old stream leaks."""
     tb = TB(dut)
@@ -171,7 +201,7 @@ async def reset_mid_stream(dut) -> None:
     await clean_frames_after_reset(tb)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def stall_cross_with_losses(dut) -> None:
     """Stall regimes crossed (tb/stall_regimes.py: CI subset, all 16 pairs with
     STALL_CROSS=full), each pair from reset with random chirp losses: output chirps, frame
@@ -189,7 +219,7 @@ async def stall_cross_with_losses(dut) -> None:
     await stall_regimes.run_cross(tb, tb.n_range, run)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def reset_during_backpressure(dut) -> None:
     """Reset while the output is valid and held by TREADY low: counters cleared, nothing of
     the old stream leaks, the next frames pass unchanged and undamaged."""
