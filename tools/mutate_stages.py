@@ -167,6 +167,17 @@ EQUIVALENT: dict[str, str] = {
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
         "stable), and the input contract (the proof's assumption) puts TLAST only on sample "
         "N_RANGE-1 >= 1, so s_axis_tlast is 0 whenever the counter can count"),
+    "frame_align:count:2": (
+        "chirps_filled not counted when s_axis_tlast is high as a fill chirp ends: as "
+        "frame_align:count:6, in FILL the input holds the first sample of the next chirp "
+        "(FILL is entered on a valid first sample, its TREADY is low, so AXI holds TVALID and "
+        "the payload), and the input contract (the proof's assumption) puts TLAST only on "
+        "sample N_RANGE-1 >= 1: s_axis_tlast is 0 whenever the counter can count "
+        "(the proof's bounded base case finds no counterexample either)"),
+    "frame_align:dropfirst:16": (
+        "discard_q <= !sof instead of gap && !sof: discard_q is written only when need_fill, "
+        "and need_fill with !sof needs gap (its arms: frame_begun && (sof || gap), and "
+        "!frame_begun && gap && !sof), so the two values agree"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "

@@ -48,10 +48,31 @@ class TB(AxisTB):
         cocotb.start_soon(self._watch_frames())
 
     async def _watch_frames(self) -> None:
+        """Every clock: record each frame's damaged mark, and check the clock-level rules
+        the proof (formal/frame_align.sby) states and the model cannot see: in PASS (state
+        read inside the DUT) beats move 1:1, an input beat only with an output beat (a
+        chirp to discard is taken in DISCARD, not in the clock that decides it: mutant
+        frame_align:drop:9); the clock after a damaged frame's last beat, a frame start
+        held at the input is forwarded at once (no bubble: frame_align:drop:16)."""
+        d = self.dut
+        fill_ended = False
+        pass_code = None   # state_q's value in PASS: its reset value (whatever the encoding)
         while True:
-            await RisingEdge(self.dut.clk)
-            if self.dut.frame_done.value == 1:
-                self.done.append(bool(self.dut.frame_done_damaged.value))
+            await RisingEdge(d.clk)
+            if d.rst.value == 1:
+                fill_ended = False
+                pass_code = int(d.state_q.value)
+                continue
+            s_valid, m_valid = d.s_axis_tvalid.value == 1, d.m_axis_tvalid.value == 1
+            in_beat = s_valid and d.s_axis_tready.value == 1
+            out_beat = m_valid and d.m_axis_tready.value == 1
+            if int(d.state_q.value) == pass_code:
+                assert in_beat == out_beat, "PASS: an input beat without an output beat"
+            if fill_ended and s_valid and int(d.s_axis_tuser.value) & 1:
+                assert m_valid, "a frame start waiting after a fill is not forwarded at once"
+            fill_ended = d.frame_done.value == 1 and d.frame_done_damaged.value == 1
+            if d.frame_done.value == 1:
+                self.done.append(bool(d.frame_done_damaged.value))
 
     @property
     def chirp_clocks(self) -> int:
@@ -88,6 +109,29 @@ class TB(AxisTB):
     async def send(self, chirps, sof, gap) -> None:
         for ch, s, g in zip(chirps, sof, gap, strict=True):
             await self.send_words(ch, tuser=[int(s) | (int(g) << 1)] + [0] * (len(ch) - 1))
+
+    async def send_garbage_idle(self, chirps, sof, gap) -> None:
+        """Drive the input directly (cocotbext's source, idle, holds its last TDATA/TUSER)
+        with random idle clocks whose TDATA, TLAST and TUSER are random: AXI4-Stream leaves
+        them undefined while TVALID is low, so no decision may look at them then."""
+        d = self.dut
+        for ch, s, g in zip(chirps, sof, gap, strict=True):
+            for i, word in enumerate(ch):
+                while self.rng.random() < 0.4:
+                    d.s_axis_tvalid.value = 0
+                    d.s_axis_tdata.value = int.from_bytes(self.rng.bytes(4 * self.num_rx),
+                                                          "little")
+                    d.s_axis_tlast.value = int(self.rng.integers(0, 2))
+                    d.s_axis_tuser.value = int(self.rng.integers(0, 4))
+                    await RisingEdge(d.clk)
+                d.s_axis_tvalid.value = 1
+                d.s_axis_tdata.value = sum(int(w) << (32 * k) for k, w in enumerate(word))
+                d.s_axis_tlast.value = int(i == len(ch) - 1)
+                d.s_axis_tuser.value = (int(s) | int(g) << 1) if i == 0 else 0
+                await RisingEdge(d.clk)
+                while d.s_axis_tready.value != 1:
+                    await RisingEdge(d.clk)
+        d.s_axis_tvalid.value = 0
 
     async def collect(self, n_chirps: int) -> list[np.ndarray]:
         out = []
@@ -164,6 +208,47 @@ async def start_lost_early_start_and_midframe_entry(dut) -> None:
     gap[2 + 3 * f - 2] = True
     await tb.send(chirps, sof, gap)
     await tb.check(chirps, sof, gap, "edge cases")
+
+
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
+async def garbage_while_idle(dut) -> None:
+    """Random TDATA, TLAST and TUSER (frame start, gap) on every idle clock of the input,
+    with chirp losses: output, frame marks and counters as the model says (a decision taken
+    on an idle clock's TUSER, e.g. at_first without TVALID, fills or discards at random:
+    mutant frame_align:dropfirst:0)."""
+    tb = TB(dut)
+    tb.rng = np.random.default_rng(500)
+    await tb.reset()
+    seq = tb.sequence(6, faults=True)
+    assert any(seq[2]), "the seed must produce losses"
+    driver = cocotb.start_soon(tb.send_garbage_idle(*seq))
+    await tb.check(*seq, "garbage while idle")
+    await driver
+
+
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
+async def counters_saturate(dut) -> None:
+    """Each status counter, preloaded inside the DUT to 2^32 - 2, sees two or more events
+    and stops at 2^32 - 1 instead of wrapping to 0 (its saturation term dropped: mutants
+    frame_align:drop:18, drop:21)."""
+    tb = TB(dut)
+    await tb.reset()
+    f = tb.frame_chirps
+    chirps = [tb.chirp() for _ in range(3 + 3 * f)]
+    sof, gap = [False] * len(chirps), [False] * len(chirps)
+    sof[2] = sof[2 + f - 1] = True           # 2 chirps discarded, then an early frame start
+    gap[2 + 2 * f - 1] = True                # the next frame's start chirp lost
+    sof[2 + 2 * f] = True
+    want = frame_align(chirps, sof, gap, f)
+    assert min(sum(want.frames_damaged), want.chirps_filled, want.chirps_discarded) >= 2, want
+    top = (1 << 32) - 1
+    for name in ("dmg_cnt_q", "fill_cnt_q", "disc_cnt_q"):
+        getattr(dut, name).value = top - 1
+    await tb.send(chirps, sof, gap)
+    got = await tb.collect(len(want.chirps))
+    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
+    await tb.wait_quiet(4 * tb.n_range)
+    assert tb.counters() == (top, top, top), tb.counters()
 
 
 async def clean_frames_after_reset(tb: TB) -> None:
