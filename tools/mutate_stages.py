@@ -178,6 +178,14 @@ EQUIVALENT: dict[str, str] = {
         "discard_q <= !sof instead of gap && !sof: discard_q is written only when need_fill, "
         "and need_fill with !sof needs gap (its arms: frame_begun && (sof || gap), and "
         "!frame_begun && gap && !sof), so the two values agree"),
+    "frame_align:drop:6": (
+        "need_discard without !gap: differs only when gap && !sof && !frame_begun on a first "
+        "sample, where need_fill is true too; PASS tests need_fill first and TREADY/TVALID "
+        "are gated by need_fill || need_discard, so nothing changes"),
+    "frame_align:tie:1": (
+        "frame_end with chirp_q >= FRAME_CHIRPS - 1 instead of ==: chirp_q never exceeds "
+        "FRAME_CHIRPS - 1 (frame_align's proof asserts chirp_q <= FRAME_CHIRPS - 1), so the "
+        "two agree"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "
