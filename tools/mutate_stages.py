@@ -182,6 +182,10 @@ EQUIVALENT: dict[str, str] = {
         "need_discard without !gap: differs only when gap && !sof && !frame_begun on a first "
         "sample, where need_fill is true too; PASS tests need_fill first and TREADY/TVALID "
         "are gated by need_fill || need_discard, so nothing changes"),
+    "frame_align:dropfirst:5": (
+        "need_fill's second arm without !frame_begun (gap && !sof): it differs only when "
+        "frame_begun && gap, where the first arm, frame_begun && (sof || gap), is true "
+        "already"),
     "frame_align:tie:1": (
         "frame_end with chirp_q >= FRAME_CHIRPS - 1 instead of ==: chirp_q never exceeds "
         "FRAME_CHIRPS - 1 (frame_align's proof asserts chirp_q <= FRAME_CHIRPS - 1), so the "
