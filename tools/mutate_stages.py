@@ -186,6 +186,10 @@ EQUIVALENT: dict[str, str] = {
         "need_fill's second arm without !frame_begun (gap && !sof): it differs only when "
         "frame_begun && gap, where the first arm, frame_begun && (sof || gap), is true "
         "already"),
+    "frame_align:swap:0": (
+        "state_t's encoding changed (FILL = 0, PASS = 1): every use names the state, reset "
+        "and the default arm load PASS by name, and the fourth code is unreachable either "
+        "way; no port shows the encoding"),
     "frame_align:tie:1": (
         "frame_end with chirp_q >= FRAME_CHIRPS - 1 instead of ==: chirp_q never exceeds "
         "FRAME_CHIRPS - 1 (frame_align's proof asserts chirp_q <= FRAME_CHIRPS - 1), so the "
