@@ -12,7 +12,7 @@ import pytest
 from model import chirp_pingpong as cp
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
-from tb import stall_regimes
+from tb import progress, stall_regimes
 
 
 class TB(AxisTB):
@@ -22,6 +22,8 @@ class TB(AxisTB):
         self.n_range = param("N_RANGE")
         self.backpressure = bool(param("ADC_BACKPRESSURE"))
         assert param("DATA_W") == 16
+        # a stopped stream fails at once: the longest pause here is 4 N_RANGE clocks
+        progress.watch(self, stuck=16 * self.n_range + 2000)
 
     def stream(self, n_chirps: int, chirps_per_frame: int = 16):
         """Random ADC stream of n_chirps good chirps: (words, tlast, sof)."""

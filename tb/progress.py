@@ -1,0 +1,39 @@
+"""Progress watchdog of the block testbenches (issue 33): a design that stops its stream
+fails its test within a few thousand clocks, instead of simulating until the 50 ms
+simulated-time watchdog of ``rtlsim.toolchain`` (minutes to a quarter of an hour of wall
+time per test, where a mutation campaign spends most of its time on hangs).
+
+Imported by cocotb testbenches only (it awaits cocotb triggers).
+"""
+
+from __future__ import annotations
+
+import cocotb
+from cocotb.triggers import RisingEdge
+
+
+def watch(tb, stuck: int) -> None:
+    """Start the watchdog of ``tb`` (an ``rtlsim.axis.AxisTB``): every clock out of reset, if
+    the source still holds data or the output is valid but no beat moved on either
+    interface for ``stuck`` consecutive clocks, the test fails. ``stuck`` must exceed the
+    longest pause the test's own stall patterns make (a paused source, a stalled sink)."""
+    cocotb.start_soon(_watch(tb, stuck))
+
+
+async def _watch(tb, stuck: int) -> None:
+    d = tb.dut
+    s_valid, s_ready, m_valid, m_ready = (
+        getattr(d, f"{prefix}_{name}") for prefix, name in (
+            (tb._in_prefix, "tvalid"), (tb._in_prefix, "tready"),
+            (tb._out_prefix, "tvalid"), (tb._out_prefix, "tready")))
+    still = 0
+    while True:
+        await RisingEdge(d.clk)
+        out_valid = m_valid.value == 1
+        moved = ((s_valid.value == 1 and s_ready.value == 1)
+                 or (out_valid and m_ready.value == 1))
+        pending = out_valid or not tb.source.idle()
+        still = 0 if d.rst.value == 1 or moved or not pending else still + 1
+        if still >= stuck:
+            raise AssertionError(f"stream stopped: no beat moved for {stuck} clocks with "
+                                 "input waiting or the output valid")
