@@ -128,6 +128,10 @@ EQUIVALENT: dict[str, str] = {
     "corner_turn:drop:4": (
         "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
         "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
+    "chirp_pingpong:const:6": (
+        "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
+        "(at pos_q == 0 ovf_drop reads full_q), and pos_q leaves 0 only by a beat at pos_q "
+        "== 0, which loads discard_q; so the reset value is never read"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
