@@ -132,6 +132,10 @@ EQUIVALENT: dict[str, str] = {
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
         "(at pos_q == 0 ovf_drop reads full_q), and pos_q leaves 0 only by a beat at pos_q "
         "== 0, which loads discard_q; so the reset value is never read"),
+    "chirp_pingpong:const:8": (
+        "chirp_sof_q reset to 1 instead of 0: it is read only by a commit (the last sample "
+        "of a chirp taken from pos_q == 0 without skipping), and that chirp's first beat at "
+        "pos_q == 0 loaded chirp_sof_q; so the reset value is never read"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),

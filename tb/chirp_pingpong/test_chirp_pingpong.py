@@ -22,8 +22,9 @@ class TB(AxisTB):
         self.n_range = param("N_RANGE")
         self.backpressure = bool(param("ADC_BACKPRESSURE"))
         assert param("DATA_W") == 16
-        # a stopped stream fails at once: the longest pause here is 4 N_RANGE clocks
-        progress.watch(self, stuck=16 * self.n_range + 2000)
+        # a stopped or endless stream fails at once: the longest pause here is 4 N_RANGE
+        # clocks; no beat out that did not come in
+        progress.watch(self, stuck=16 * self.n_range + 2000, conserving=True)
 
     def stream(self, n_chirps: int, chirps_per_frame: int = 16):
         """Random ADC stream of n_chirps good chirps: (words, tlast, sof)."""

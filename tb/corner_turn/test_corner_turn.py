@@ -27,7 +27,8 @@ class TB(AxisTB):
         self.frame_words = self.num_tx * self.n_range * self.n_loops
         # a stopped stream fails at once: the longest pause here is max(3 N_DOPPLER,
         # 4 N_RANGE) clocks
-        progress.watch(self, stuck=16 * (self.n_range + self.n_doppler) + 2000)
+        progress.watch(self, stuck=16 * (self.n_range + self.n_doppler) + 2000,
+                       conserving=True)
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)
