@@ -136,6 +136,11 @@ EQUIVALENT: dict[str, str] = {
         "chirp_sof_q reset to 1 instead of 0: it is read only by a commit (the last sample "
         "of a chirp taken from pos_q == 0 without skipping), and that chirp's first beat at "
         "pos_q == 0 loaded chirp_sof_q; so the reset value is never read"),
+    "chirp_pingpong:dropfirst:0": (
+        "s_axis_tready without skip_q (ADC_BACKPRESSURE = 1): a skip starts on a beat taken "
+        "with skip_q low, so with full_q[wr_bank_q] low; while skipping nothing is committed "
+        "(only a commit sets full_q, the read side only clears it) and wr_bank_q stays, so "
+        "full_q[wr_bank_q] stays low and skip_q || !full_q[wr_bank_q] equals !full_q[...]"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),

@@ -204,6 +204,31 @@ async def test_overflow_while_resynchronising(dut):
 
 
 @cocotb.test()
+async def test_counters_saturate(dut):
+    """The error counters, preloaded inside the DUT to 2^32 - 1, stay there through more
+    overflow drops and a framing error instead of wrapping to 0 (a saturation term dropped:
+    mutant chirp_pingpong:drop:10)."""
+    tb = TB(dut)
+    if tb.backpressure:
+        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+        return
+    await tb.reset()
+    top = (1 << 32) - 1
+    for name in ("drop_cnt_q", "chirp_drop_q", "framing_cnt_q"):
+        getattr(dut, name).value = top
+    n = tb.n_range
+    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
+    words, tlast, sof = tb.stream(5, chirps_per_frame=5)
+    tlast = tlast.copy()
+    tlast[4 * n - 1] = False      # as test_overflow_while_resynchronising: 2 chirps dropped
+    await tb.send(words, tlast, sof)
+    await tb.source.wait()
+    await tb.cycles(8)
+    st = tb.status()
+    assert (st["drop_count"], st["chirps_dropped"], st["framing_error_count"]) == (top,) * 3, st
+
+
+@cocotb.test()
 async def test_reset_recovery(dut):
     """Reset in mid-chirp under stalls, then clean chirps."""
     tb = TB(dut)
