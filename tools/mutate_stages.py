@@ -141,6 +141,12 @@ EQUIVALENT: dict[str, str] = {
         "with skip_q low, so with full_q[wr_bank_q] low; while skipping nothing is committed "
         "(only a commit sets full_q, the read side only clears it) and wr_bank_q stays, so "
         "full_q[wr_bank_q] stays low and skip_q || !full_q[wr_bank_q] equals !full_q[...]"),
+    "chirp_pingpong:dropfirst:2": (
+        "keep without !skip_q: while skipping pos_q stays 0, so ovf_drop reads "
+        "full_q[wr_bank_q] and the extra writes go only to address 0 of a bank that is not "
+        "full (not being read), which the next chirp's first beat overwrites before that "
+        "bank can be committed; commit needs last_pos, false at pos_q 0 (N_RANGE >= 2), and "
+        "the counters test skip_q themselves"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
