@@ -147,6 +147,15 @@ EQUIVALENT: dict[str, str] = {
         "full (not being read), which the next chirp's first beat overwrites before that "
         "bank can be committed; commit needs last_pos, false at pos_q 0 (N_RANGE >= 2), and "
         "the counters test skip_q themselves"),
+    "chirp_pingpong:dropfirst:4": (
+        "commit without beat: inside the write branch (if (beat)) nothing changes; outside "
+        "it commit only writes sof_q/gap_q of the write bank, which is not full (not read) "
+        "and gets the same values, or new ones, from that bank's real commit before it is "
+        "read (idle clocks with random TLAST do not kill it)"),
+    "chirp_pingpong:dropfirst:5": (
+        "ram_wr_en = keep without beat: the extra writes go to {wr_bank_q, pos_q} of a bank "
+        "that is not full (keep needs !ovf_drop), and pos_q advances only on a beat, which "
+        "writes that address again before the bank is committed"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
