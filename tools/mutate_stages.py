@@ -156,6 +156,12 @@ EQUIVALENT: dict[str, str] = {
         "ram_wr_en = keep without beat: the extra writes go to {wr_bank_q, pos_q} of a bank "
         "that is not full (keep needs !ovf_drop), and pos_q advances only on a beat, which "
         "writes that address again before the bank is committed"),
+    "chirp_pingpong:noreset:3": (
+        "discard_q left out of reset (as chirp_pingpong:const:6): read only while "
+        "pos_q != 0, after the chirp's first beat at pos_q == 0 loaded it"),
+    "chirp_pingpong:noreset:5": (
+        "chirp_sof_q left out of reset (as chirp_pingpong:const:8): read only by a commit, "
+        "after the chirp's first beat at pos_q == 0 loaded it"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
