@@ -162,6 +162,12 @@ EQUIVALENT: dict[str, str] = {
     "chirp_pingpong:noreset:5": (
         "chirp_sof_q left out of reset (as chirp_pingpong:const:8): read only by a commit, "
         "after the chirp's first beat at pos_q == 0 loaded it"),
+    "chirp_pingpong:sticky:1": (
+        "skip_q <= !s_axis_tlast instead of setting it only on a missing TLAST: the line is "
+        "in the branch taken only while skip_q is low, so writing 0 there changes nothing"),
+    "chirp_pingpong:tie:1": (
+        "rd_last = rd_idx_q >= N_RANGE - 1 instead of ==: rd_idx_q counts up from 0 and "
+        "returns to 0 at rd_last, so it never exceeds N_RANGE - 1 and the two agree"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
