@@ -265,6 +265,30 @@ async def test_counters_saturate(dut):
 
 
 @cocotb.test()
+async def test_overflow_flag_stays(dut):
+    """status_overflow is sticky: a later chirp ended by an early TLAST (a framing error, not
+    an overflow) leaves it set (mutant chirp_pingpong:sticky:2 clears it there)."""
+    tb = TB(dut)
+    if tb.backpressure:
+        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+        return
+    await tb.reset()
+    n = tb.n_range
+    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
+    words, tlast, sof = tb.stream(3, chirps_per_frame=3)     # chirp 2 dropped: banks full
+    await tb.send(words, tlast, sof)
+    await tb.source.wait()
+    await tb.cycles(8)
+    assert tb.status()["status_overflow"] == 1, tb.status()
+    tb.set_backpressure_generator(no_pause())
+    await tb.wait_quiet()
+    await tb.send_words(tb.stream(1)[0][:n - 1])              # TLAST on sample N_RANGE-2
+    await tb.wait_quiet()
+    st = tb.status()
+    assert st["status_overflow"] == 1 and st["status_framing_error"] == 1, st
+
+
+@cocotb.test()
 async def test_reset_recovery(dut):
     """Reset in mid-chirp under stalls, then clean chirps."""
     tb = TB(dut)
