@@ -128,6 +128,46 @@ EQUIVALENT: dict[str, str] = {
     "corner_turn:drop:4": (
         "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
         "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
+    "chirp_pingpong:const:6": (
+        "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
+        "(at pos_q == 0 ovf_drop reads full_q), and pos_q leaves 0 only by a beat at pos_q "
+        "== 0, which loads discard_q; so the reset value is never read"),
+    "chirp_pingpong:const:8": (
+        "chirp_sof_q reset to 1 instead of 0: it is read only by a commit (the last sample "
+        "of a chirp taken from pos_q == 0 without skipping), and that chirp's first beat at "
+        "pos_q == 0 loaded chirp_sof_q; so the reset value is never read"),
+    "chirp_pingpong:dropfirst:0": (
+        "s_axis_tready without skip_q (ADC_BACKPRESSURE = 1): a skip starts on a beat taken "
+        "with skip_q low, so with full_q[wr_bank_q] low; while skipping nothing is committed "
+        "(only a commit sets full_q, the read side only clears it) and wr_bank_q stays, so "
+        "full_q[wr_bank_q] stays low and skip_q || !full_q[wr_bank_q] equals !full_q[...]"),
+    "chirp_pingpong:dropfirst:2": (
+        "keep without !skip_q: while skipping pos_q stays 0, so ovf_drop reads "
+        "full_q[wr_bank_q] and the extra writes go only to address 0 of a bank that is not "
+        "full (not being read), which the next chirp's first beat overwrites before that "
+        "bank can be committed; commit needs last_pos, false at pos_q 0 (N_RANGE >= 2), and "
+        "the counters test skip_q themselves"),
+    "chirp_pingpong:dropfirst:4": (
+        "commit without beat: inside the write branch (if (beat)) nothing changes; outside "
+        "it commit only writes sof_q/gap_q of the write bank, which is not full (not read) "
+        "and gets the same values, or new ones, from that bank's real commit before it is "
+        "read (idle clocks with random TLAST do not kill it)"),
+    "chirp_pingpong:dropfirst:5": (
+        "ram_wr_en = keep without beat: the extra writes go to {wr_bank_q, pos_q} of a bank "
+        "that is not full (keep needs !ovf_drop), and pos_q advances only on a beat, which "
+        "writes that address again before the bank is committed"),
+    "chirp_pingpong:noreset:3": (
+        "discard_q left out of reset (as chirp_pingpong:const:6): read only while "
+        "pos_q != 0, after the chirp's first beat at pos_q == 0 loaded it"),
+    "chirp_pingpong:noreset:5": (
+        "chirp_sof_q left out of reset (as chirp_pingpong:const:8): read only by a commit, "
+        "after the chirp's first beat at pos_q == 0 loaded it"),
+    "chirp_pingpong:sticky:1": (
+        "skip_q <= !s_axis_tlast instead of setting it only on a missing TLAST: the line is "
+        "in the branch taken only while skip_q is low, so writing 0 there changes nothing"),
+    "chirp_pingpong:tie:1": (
+        "rd_last = rd_idx_q >= N_RANGE - 1 instead of ==: rd_idx_q counts up from 0 and "
+        "returns to 0 at rd_last, so it never exceeds N_RANGE - 1 and the two agree"),
     "frame_align:const:8": (
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
@@ -167,6 +207,33 @@ EQUIVALENT: dict[str, str] = {
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
         "stable), and the input contract (the proof's assumption) puts TLAST only on sample "
         "N_RANGE-1 >= 1, so s_axis_tlast is 0 whenever the counter can count"),
+    "frame_align:count:2": (
+        "chirps_filled not counted when s_axis_tlast is high as a fill chirp ends: as "
+        "frame_align:count:6, in FILL the input holds the first sample of the next chirp "
+        "(FILL is entered on a valid first sample, its TREADY is low, so AXI holds TVALID and "
+        "the payload), and the input contract (the proof's assumption) puts TLAST only on "
+        "sample N_RANGE-1 >= 1: s_axis_tlast is 0 whenever the counter can count "
+        "(the proof's bounded base case finds no counterexample either)"),
+    "frame_align:dropfirst:16": (
+        "discard_q <= !sof instead of gap && !sof: discard_q is written only when need_fill, "
+        "and need_fill with !sof needs gap (its arms: frame_begun && (sof || gap), and "
+        "!frame_begun && gap && !sof), so the two values agree"),
+    "frame_align:drop:6": (
+        "need_discard without !gap: differs only when gap && !sof && !frame_begun on a first "
+        "sample, where need_fill is true too; PASS tests need_fill first and TREADY/TVALID "
+        "are gated by need_fill || need_discard, so nothing changes"),
+    "frame_align:dropfirst:5": (
+        "need_fill's second arm without !frame_begun (gap && !sof): it differs only when "
+        "frame_begun && gap, where the first arm, frame_begun && (sof || gap), is true "
+        "already"),
+    "frame_align:swap:0": (
+        "state_t's encoding changed (FILL = 0, PASS = 1): every use names the state, reset "
+        "and the default arm load PASS by name, and the fourth code is unreachable either "
+        "way; no port shows the encoding"),
+    "frame_align:tie:1": (
+        "frame_end with chirp_q >= FRAME_CHIRPS - 1 instead of ==: chirp_q never exceeds "
+        "FRAME_CHIRPS - 1 (frame_align's proof asserts chirp_q <= FRAME_CHIRPS - 1), so the "
+        "two agree"),
     "frame_store_gearbox:drop:9": (
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "

@@ -8,11 +8,12 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
+from cocotb.triggers import RisingEdge
 
 from model import chirp_pingpong as cp
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
-from tb import stall_regimes
+from tb import progress, stall_regimes
 
 
 class TB(AxisTB):
@@ -22,6 +23,9 @@ class TB(AxisTB):
         self.n_range = param("N_RANGE")
         self.backpressure = bool(param("ADC_BACKPRESSURE"))
         assert param("DATA_W") == 16
+        # a stopped or endless stream fails at once: the longest pause here is 4 N_RANGE
+        # clocks; no beat out that did not come in
+        progress.watch(self, stuck=16 * self.n_range + 2000, conserving=True)
 
     def stream(self, n_chirps: int, chirps_per_frame: int = 16):
         """Random ADC stream of n_chirps good chirps: (words, tlast, sof)."""
@@ -41,6 +45,27 @@ class TB(AxisTB):
         for end in ends:
             await self.send_words(words[start:end], tuser=sof[start:end])
             start = end
+
+    async def send_garbage_idle(self, words, tlast, sof) -> None:
+        """Drive the input directly (cocotbext's source, idle, zeroes TLAST between beats)
+        with random idle clocks whose TDATA, TLAST and TUSER are random: AXI4-Stream leaves
+        them undefined while TVALID is low."""
+        d = self.dut
+        for word, last, first in zip(words, tlast, sof, strict=True):
+            while self.rng.random() < 0.5:
+                d.s_axis_tvalid.value = 0
+                d.s_axis_tdata.value = int.from_bytes(self.rng.bytes(4 * self.num_rx), "little")
+                d.s_axis_tlast.value = int(self.rng.integers(0, 2))
+                d.s_axis_tuser.value = int(self.rng.integers(0, 2))
+                await RisingEdge(d.clk)
+            d.s_axis_tvalid.value = 1
+            d.s_axis_tdata.value = sum(int(w) << (32 * k) for k, w in enumerate(word))
+            d.s_axis_tlast.value = int(last)
+            d.s_axis_tuser.value = int(first)
+            await RisingEdge(d.clk)
+            while d.s_axis_tready.value != 1:
+                await RisingEdge(d.clk)
+        d.s_axis_tvalid.value = 0
 
     async def drain(self, quiet: int = 64) -> list[cp.OutChirp]:
         await self.wait_quiet(quiet)
@@ -107,6 +132,20 @@ async def test_random_stalls(dut):
     tb.compare(got, cp.chirp_pingpong(*stream, tb.n_range))
     st = tb.status()
     assert st["drop_count"] == 0 and st["status_overflow"] == 0, st
+
+
+@cocotb.test()
+async def test_garbage_while_idle(dut):
+    """Random TDATA, TLAST and TUSER on every idle clock of the ADC stream: exact chirps,
+    nothing dropped, no framing error (no decision may read an idle clock's sidebands)."""
+    tb = TB(dut)
+    await tb.reset()
+    stream = tb.stream(8)
+    await tb.send_garbage_idle(*stream)
+    got = await tb.drain()
+    tb.compare(got, cp.chirp_pingpong(*stream, tb.n_range))
+    st = tb.status()
+    assert st["drop_count"] == 0 and st["framing_error_count"] == 0, st
 
 
 @cocotb.test()
@@ -198,6 +237,55 @@ async def test_overflow_while_resynchronising(dut):
     assert errors == 1 and len(attempts) == 5
     tb.compare(got, cp.pingpong_output(attempts, dropped=[2]))
     assert tb.status()["drop_count"] == 2 * n
+
+
+@cocotb.test()
+async def test_counters_saturate(dut):
+    """The error counters, preloaded inside the DUT to 2^32 - 1, stay there through more
+    overflow drops and a framing error instead of wrapping to 0 (a saturation term dropped:
+    mutant chirp_pingpong:drop:10)."""
+    tb = TB(dut)
+    if tb.backpressure:
+        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+        return
+    await tb.reset()
+    top = (1 << 32) - 1
+    for name in ("drop_cnt_q", "chirp_drop_q", "framing_cnt_q"):
+        getattr(dut, name).value = top
+    n = tb.n_range
+    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
+    words, tlast, sof = tb.stream(5, chirps_per_frame=5)
+    tlast = tlast.copy()
+    tlast[4 * n - 1] = False      # as test_overflow_while_resynchronising: 2 chirps dropped
+    await tb.send(words, tlast, sof)
+    await tb.source.wait()
+    await tb.cycles(8)
+    st = tb.status()
+    assert (st["drop_count"], st["chirps_dropped"], st["framing_error_count"]) == (top,) * 3, st
+
+
+@cocotb.test()
+async def test_overflow_flag_stays(dut):
+    """status_overflow is sticky: a later chirp ended by an early TLAST (a framing error, not
+    an overflow) leaves it set (mutant chirp_pingpong:sticky:2 clears it there)."""
+    tb = TB(dut)
+    if tb.backpressure:
+        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+        return
+    await tb.reset()
+    n = tb.n_range
+    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
+    words, tlast, sof = tb.stream(3, chirps_per_frame=3)     # chirp 2 dropped: banks full
+    await tb.send(words, tlast, sof)
+    await tb.source.wait()
+    await tb.cycles(8)
+    assert tb.status()["status_overflow"] == 1, tb.status()
+    tb.set_backpressure_generator(no_pause())
+    await tb.wait_quiet()
+    await tb.send_words(tb.stream(1)[0][:n - 1])              # TLAST on sample N_RANGE-2
+    await tb.wait_quiet()
+    st = tb.status()
+    assert st["status_overflow"] == 1 and st["status_framing_error"] == 1, st
 
 
 @cocotb.test()

@@ -11,7 +11,7 @@ import pytest
 from model import corner_turn as ct
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
-from tb import stall_regimes
+from tb import progress, stall_regimes
 
 
 class TB(AxisTB):
@@ -25,6 +25,10 @@ class TB(AxisTB):
         assert param("DATA_W") == 16
         self.read_order = param("READ_ORDER", 0)
         self.frame_words = self.num_tx * self.n_range * self.n_loops
+        # a stopped stream fails at once: the longest pause here is max(3 N_DOPPLER,
+        # 4 N_RANGE) clocks
+        progress.watch(self, stuck=16 * (self.n_range + self.n_doppler) + 2000,
+                       conserving=True)
 
     def random_frame(self) -> np.ndarray:
         return self.rng.integers(0, 1 << 32, (self.frame_words, self.num_rx), dtype=np.uint32)

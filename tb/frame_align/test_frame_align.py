@@ -4,6 +4,11 @@ Chirp sequences: clean back-to-back frames, chirps lost inside a frame (next chi
 a gap), a lost frame-start chirp, an early frame start, chirps without frame start after
 reset; random TVALID gaps and TREADY stalls; a reset in mid-stream. Every output chirp, the
 per-frame damaged marks and the counters are compared with the model.
+
+Watchdogs (a design that stops the stream fails within seconds, not after the 50 ms default
+of ``rtlsim.toolchain``, a quarter of an hour of wall time here): every wait for output or
+for the input to drain is bounded by :meth:`TB.chirp_clocks`, and every test by
+:data:`TEST_LIMIT_US` of simulated time.
 """
 
 from __future__ import annotations
@@ -13,12 +18,24 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import RisingEdge
+from cocotb.triggers import RisingEdge, with_timeout
 
 from model.frame_align import frame_align
-from rtlsim.axis import AxisTB, bursty_pause, random_pause
+from rtlsim.axis import CLK_PERIOD_NS, AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 from tb import stall_regimes
+
+
+def _test_limit_us() -> float | None:
+    """Simulated-time limit of each test, us: 10 us (1,000 clocks) per sample of a frame. The
+    longest test, ``stall_cross_with_losses``, simulates about 0.6 us per frame sample with the
+    CI stall pairs (12 us at N_RANGE 4 x 6 chirps, 76 us at 16 x 8) and 4x that with all 16
+    pairs (``STALL_CROSS=full``). None outside a simulation (pytest collecting the module)."""
+    samples = param("N_RANGE", 0) * param("FRAME_CHIRPS", 0)
+    return 10.0 * samples if samples else None
+
+
+TEST_LIMIT_US = _test_limit_us()
 
 
 class TB(AxisTB):
@@ -31,10 +48,44 @@ class TB(AxisTB):
         cocotb.start_soon(self._watch_frames())
 
     async def _watch_frames(self) -> None:
+        """Every clock: record each frame's damaged mark, and check the clock-level rules
+        the proof (formal/frame_align.sby) states and the model cannot see: in PASS (state
+        read inside the DUT) beats move 1:1, an input beat only with an output beat (a
+        chirp to discard is taken in DISCARD, not in the clock that decides it: mutant
+        frame_align:drop:9); the clock after a damaged frame's last beat, a frame start
+        held at the input is forwarded at once (no bubble: frame_align:drop:16)."""
+        d = self.dut
+        fill_ended = False
+        pass_code = None   # state_q's value in PASS: its reset value (whatever the encoding)
         while True:
-            await RisingEdge(self.dut.clk)
-            if self.dut.frame_done.value == 1:
-                self.done.append(bool(self.dut.frame_done_damaged.value))
+            await RisingEdge(d.clk)
+            if d.rst.value == 1:
+                fill_ended = False
+                pass_code = int(d.state_q.value)
+                continue
+            s_valid, m_valid = d.s_axis_tvalid.value == 1, d.m_axis_tvalid.value == 1
+            in_beat = s_valid and d.s_axis_tready.value == 1
+            out_beat = m_valid and d.m_axis_tready.value == 1
+            if int(d.state_q.value) == pass_code:
+                assert in_beat == out_beat, "PASS: an input beat without an output beat"
+            if fill_ended and s_valid and int(d.s_axis_tuser.value) & 1:
+                assert m_valid, "a frame start waiting after a fill is not forwarded at once"
+            fill_ended = d.frame_done.value == 1 and d.frame_done_damaged.value == 1
+            if d.frame_done.value == 1:
+                self.done.append(bool(d.frame_done_damaged.value))
+
+    @property
+    def chirp_clocks(self) -> int:
+        """Clocks within which the next output chirp must arrive (or the input drain): twice
+        the worst case of the stall patterns here, where before an output chirp up to
+        FRAME_CHIRPS + 1 input chirps are discarded or forwarded, and every beat in or out is
+        held at most 4 N_RANGE + 64 clocks (the longest pause runs of ``stall_regimes`` and
+        ``bursty_pause(.., 60)``)."""
+        return 2 * (self.frame_chirps + 2) * self.n_range * (4 * self.n_range + 64)
+
+    async def wait_quiet(self, quiet: int = 64) -> None:
+        """:meth:`AxisTB.wait_quiet` within :attr:`chirp_clocks` (``SimTimeoutError``)."""
+        await with_timeout(super().wait_quiet(quiet), self.chirp_clocks * CLK_PERIOD_NS, "ns")
 
     def chirp(self) -> np.ndarray:
         return self.rng.integers(1, 1 << 32, (self.n_range, self.num_rx), dtype=np.uint32)
@@ -59,10 +110,33 @@ class TB(AxisTB):
         for ch, s, g in zip(chirps, sof, gap, strict=True):
             await self.send_words(ch, tuser=[int(s) | (int(g) << 1)] + [0] * (len(ch) - 1))
 
+    async def send_garbage_idle(self, chirps, sof, gap) -> None:
+        """Drive the input directly (cocotbext's source, idle, holds its last TDATA/TUSER)
+        with random idle clocks whose TDATA, TLAST and TUSER are random: AXI4-Stream leaves
+        them undefined while TVALID is low, so no decision may look at them then."""
+        d = self.dut
+        for ch, s, g in zip(chirps, sof, gap, strict=True):
+            for i, word in enumerate(ch):
+                while self.rng.random() < 0.4:
+                    d.s_axis_tvalid.value = 0
+                    d.s_axis_tdata.value = int.from_bytes(self.rng.bytes(4 * self.num_rx),
+                                                          "little")
+                    d.s_axis_tlast.value = int(self.rng.integers(0, 2))
+                    d.s_axis_tuser.value = int(self.rng.integers(0, 4))
+                    await RisingEdge(d.clk)
+                d.s_axis_tvalid.value = 1
+                d.s_axis_tdata.value = sum(int(w) << (32 * k) for k, w in enumerate(word))
+                d.s_axis_tlast.value = int(i == len(ch) - 1)
+                d.s_axis_tuser.value = (int(s) | int(g) << 1) if i == 0 else 0
+                await RisingEdge(d.clk)
+                while d.s_axis_tready.value != 1:
+                    await RisingEdge(d.clk)
+        d.s_axis_tvalid.value = 0
+
     async def collect(self, n_chirps: int) -> list[np.ndarray]:
         out = []
         for _ in range(n_chirps):
-            out.append(await self.recv_words(self.num_rx))
+            out.append(await self.recv_words(self.num_rx, timeout_cycles=self.chirp_clocks))
         return out
 
     def counters(self) -> tuple[int, int, int]:
@@ -85,7 +159,7 @@ class TB(AxisTB):
                            sum(self.done), want.chirps_filled, want.chirps_discarded)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def clean_frames_back_to_back(dut) -> None:
     """Whole frames pass through unchanged at one sample per clock."""
     tb = TB(dut)
@@ -98,7 +172,7 @@ async def clean_frames_back_to_back(dut) -> None:
     assert not any(tb.done)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def lost_chirps_with_gaps_and_stalls(dut) -> None:
     """Random chirp losses, random TVALID gaps and TREADY stalls (long ones too)."""
     tb = TB(dut)
@@ -116,7 +190,7 @@ async def lost_chirps_with_gaps_and_stalls(dut) -> None:
         assert any(tb.done), "some frame must be damaged"
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def start_lost_early_start_and_midframe_entry(dut) -> None:
     """The frame-start chirp lost; a frame start arriving early; entry in mid-frame."""
     tb = TB(dut)
@@ -134,6 +208,47 @@ async def start_lost_early_start_and_midframe_entry(dut) -> None:
     gap[2 + 3 * f - 2] = True
     await tb.send(chirps, sof, gap)
     await tb.check(chirps, sof, gap, "edge cases")
+
+
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
+async def garbage_while_idle(dut) -> None:
+    """Random TDATA, TLAST and TUSER (frame start, gap) on every idle clock of the input,
+    with chirp losses: output, frame marks and counters as the model says (a decision taken
+    on an idle clock's TUSER, e.g. at_first without TVALID, fills or discards at random:
+    mutant frame_align:dropfirst:0)."""
+    tb = TB(dut)
+    tb.rng = np.random.default_rng(500)
+    await tb.reset()
+    seq = tb.sequence(6, faults=True)
+    assert any(seq[2]), "the seed must produce losses"
+    driver = cocotb.start_soon(tb.send_garbage_idle(*seq))
+    await tb.check(*seq, "garbage while idle")
+    await driver
+
+
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
+async def counters_saturate(dut) -> None:
+    """Each status counter, preloaded inside the DUT to 2^32 - 2, sees two or more events
+    and stops at 2^32 - 1 instead of wrapping to 0 (its saturation term dropped: mutants
+    frame_align:drop:18, drop:21)."""
+    tb = TB(dut)
+    await tb.reset()
+    f = tb.frame_chirps
+    chirps = [tb.chirp() for _ in range(3 + 3 * f)]
+    sof, gap = [False] * len(chirps), [False] * len(chirps)
+    sof[2] = sof[2 + f - 1] = True           # 2 chirps discarded, then an early frame start
+    gap[2 + 2 * f - 1] = True                # the next frame's start chirp lost
+    sof[2 + 2 * f] = True
+    want = frame_align(chirps, sof, gap, f)
+    assert min(sum(want.frames_damaged), want.chirps_filled, want.chirps_discarded) >= 2, want
+    top = (1 << 32) - 1
+    for name in ("dmg_cnt_q", "fill_cnt_q", "disc_cnt_q"):
+        getattr(dut, name).value = top - 1
+    await tb.send(chirps, sof, gap)
+    got = await tb.collect(len(want.chirps))
+    assert all(np.array_equal(g, w) for g, w in zip(got, want.chirps, strict=True))
+    await tb.wait_quiet(4 * tb.n_range)
+    assert tb.counters() == (top, top, top), tb.counters()
 
 
 async def clean_frames_after_reset(tb: TB) -> None:
@@ -154,7 +269,7 @@ async def clean_frames_after_reset(tb: TB) -> None:
     assert tb.counters()[:2] == base[:2] == (0, 0)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def reset_mid_stream(dut) -> None:
     """A reset in the middle of a frame, then clean frames: nothing of the old stream leaks."""
     tb = TB(dut)
@@ -163,15 +278,17 @@ async def reset_mid_stream(dut) -> None:
     seq = tb.sequence(3, faults=False)
     await tb.send(*seq)
     await tb.cycles(tb.frame_chirps * tb.n_range + tb.n_range // 2)
-    await tb.reset()
+    # the queue cleared before the reset: after it the source starts no chirp of the old
+    # stream (a frame-start chirp would begin a frame the clean frames then fill up)
     tb.source.clear()
+    await tb.reset()
     tb.sink.clear()
     tb.done.clear()
-    # the interrupted chirp's tail has no frame start: it is discarded (counted)
+    # the interrupted chirp (if the reset did not flush it) has no frame start: discarded
     await clean_frames_after_reset(tb)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def stall_cross_with_losses(dut) -> None:
     """Stall regimes crossed (tb/stall_regimes.py: CI subset, all 16 pairs with
     STALL_CROSS=full), each pair from reset with random chirp losses: output chirps, frame
@@ -189,7 +306,7 @@ async def stall_cross_with_losses(dut) -> None:
     await stall_regimes.run_cross(tb, tb.n_range, run)
 
 
-@cocotb.test()
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def reset_during_backpressure(dut) -> None:
     """Reset while the output is valid and held by TREADY low: counters cleared, nothing of
     the old stream leaks, the next frames pass unchanged and undamaged."""
@@ -206,7 +323,10 @@ async def reset_during_backpressure(dut) -> None:
 
 
 PARAMS = [dict(NUM_RX=2, DATA_W=16, N_RANGE=4, FRAME_CHIRPS=6),
-          dict(NUM_RX=4, DATA_W=16, N_RANGE=16, FRAME_CHIRPS=8)]
+          dict(NUM_RX=4, DATA_W=16, N_RANGE=16, FRAME_CHIRPS=8),
+          # neither count a power of two: the sample and chirp counters must wrap by compare,
+          # not by overflow (mutant frame_align:last:7)
+          dict(NUM_RX=1, DATA_W=16, N_RANGE=6, FRAME_CHIRPS=5)]
 
 
 @pytest.mark.parametrize("parameters", PARAMS, ids=lambda p: f"rx{p['NUM_RX']}_n{p['N_RANGE']}")

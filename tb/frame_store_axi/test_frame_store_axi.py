@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import logging
 import os
+from collections.abc import Awaitable
 from pathlib import Path
+from typing import TypeVar
 
 import cocotb
 import numpy as np
@@ -22,6 +24,8 @@ from model import frame_store_axi as fs
 from model.axis_packetizer import words_to_bytes
 from rtlsim.axis import CLK_PERIOD_NS, AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+
+T = TypeVar("T")
 
 
 class FaultRamWrite(AxiRamWrite):
@@ -161,10 +165,15 @@ class TB(AxisTB):
             frames.append(np.vstack(vecs))
         return frames
 
+    async def within_budget(self, n_frames: int, wait: Awaitable[T]) -> T:
+        """Await ``wait`` (a coroutine or task) within a generous budget for ``n_frames``
+        frames (10,000 clocks + 200 per word, far above what the stall patterns here cost):
+        a stream that stops fails the test (``SimTimeoutError``) instead of hanging it."""
+        budget = (10_000 + 200 * n_frames * self.g.frame_words) * CLK_PERIOD_NS
+        return await with_timeout(wait, budget, "ns")
+
     async def run_frames(self, frames: list[np.ndarray]) -> list[np.ndarray]:
-        """Send the frames and receive as many, within a generous budget (10,000 clocks +
-        200 per word, far above what the stall patterns here cost): a stream that stops
-        fails the test instead of hanging it."""
+        """Send the frames and receive as many, within :meth:`within_budget`."""
 
         async def both() -> list[np.ndarray]:
             rx = cocotb.start_soon(self.recv_frames(len(frames)))
@@ -172,8 +181,7 @@ class TB(AxisTB):
                 await self.send_frame(f)
             return await rx
 
-        budget = (10_000 + 200 * sum(len(f) for f in frames)) * CLK_PERIOD_NS
-        return await with_timeout(both(), budget, "ns")
+        return await self.within_budget(len(frames), both())
 
     def status(self) -> dict[str, int]:
         d = self.dut
@@ -250,7 +258,7 @@ async def test_axi_stalls(dut):
             tb.ram.set_pause(long_stalls(20, 4 * tb.g.n_doppler))
             tb.set_backpressure_generator(bursty_pause(3, max_run=2 * tb.g.n_doppler))
         await tb.send_frame(f)
-    got = await rx
+    got = await tb.within_budget(nfr, rx)
     tb.check_payload(got, frames)
     tb.check_trace(0, nfr)
     st = tb.status()
@@ -351,7 +359,7 @@ async def test_framing_error(dut):
     await tb.source.send(AxiStreamFrame(words_to_bytes(f[nr - 1:nr])))
     for c in range(1, len(f) // nr):
         await tb.source.send(AxiStreamFrame(words_to_bytes(f[c * nr:(c + 1) * nr])))
-    got = await rx
+    got = await tb.within_budget(1, rx)
     tb.check_payload(got, [f])
     st = tb.status()
     assert st["status_framing_error"] == 1 and st["framing_error_count"] == 1, st
@@ -380,6 +388,45 @@ async def test_reset_recovery(dut):
     tb.check_payload(got, frames)
     tb.check_trace(0, 3)
     assert tb.status()["frames_out"] == 3
+
+
+@cocotb.test()
+async def test_input_held_through_reset(dut):
+    """A source outside the store's reset presents a frame's first word during a reset and
+    holds it (TVALID high until TREADY): no word is taken while the store is in reset (one
+    taken then is lost, the reset empties the write FIFO: mutant frame_store_fifo:dropfirst:0,
+    its TREADY without !rst, seen where the write gearbox passes words straight through,
+    WORD_W >= AXI_DATA_W), and the frame comes out whole after the reset."""
+    tb = TB(dut)
+    await tb.reset()
+    d = tb.dut
+    frame = tb.random_frame()
+    d.rst.value = 1
+    await RisingEdge(d.clk)   # the testbench's own source has seen the reset (TVALID low)
+    d.s_axis_tdata.value = sum(int(w) << (32 * i) for i, w in enumerate(frame[0]))
+    d.s_axis_tlast.value = int(tb.g.n_range == 1)
+    d.s_axis_tvalid.value = 1
+    taken_in_reset = 0
+    for cyc in range(64):
+        if cyc == 4:
+            d.rst.value = 0
+        await RisingEdge(d.clk)
+        if d.s_axis_tready.value == 1:
+            taken_in_reset += d.rst.value == 1
+            break
+    else:
+        raise AssertionError("the word held through the reset was never taken")
+    d.s_axis_tvalid.value = 0
+    assert not taken_in_reset, "a word was taken during the reset (and lost with it)"
+    nr = tb.g.n_range
+    rx = cocotb.start_soon(tb.recv_frames(1))
+    if nr > 1:
+        await tb.source.send(AxiStreamFrame(words_to_bytes(frame[1:nr])))
+    for c in range(1, len(frame) // nr):
+        await tb.source.send(AxiStreamFrame(words_to_bytes(frame[c * nr:(c + 1) * nr])))
+    tb.check_payload(await tb.within_budget(1, rx), [frame])
+    st = tb.status()
+    assert st["frames_in"] == st["frames_out"] == 1 and st["framing_error_count"] == 0, st
 
 
 # ------------------------------------------------------------------------------------------

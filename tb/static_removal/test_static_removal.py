@@ -15,6 +15,7 @@ from cocotb.triggers import RisingEdge
 from model.static_removal import static_removal
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 VECTORS = 6
 """Slow-time vectors per test frame (TX slots x range bins of a frame, as the block sees it)."""
@@ -31,6 +32,9 @@ class TB(AxisTB):
         self.frame_words = VECTORS * self.n_doppler
         self.schedule: list[bool] = []      # enable of frame k (set by drive_enable)
         dut.enable.value = 0
+        # a stopped or endless stream fails at once: the longest pause here is 2 N_DOPPLER
+        # clocks; no beat out that did not come in
+        progress.watch(self, stuck=16 * self.n_doppler + 2000, conserving=True)
 
     def random_frame(self) -> np.ndarray:
         """uint32 (frame_words, num_rx): per-vector DC offsets (the static part) plus noise, a
