@@ -81,6 +81,14 @@ def _min_snr(cells: np.ndarray, power: np.ndarray, noise: np.ndarray,
     return power[cells[:, 0], cells[:, 1]] > noise * 10.0 ** (params.min_snr_db / 10.0)
 
 
+def _static_columns(cfg: RadarConfig, windowed: Windows) -> tuple[np.ndarray, np.ndarray]:
+    """The Doppler bins the CFAR sees after static removal: (gain float (n_doppler,), the
+    noise gain of every bin, ``host.cube.static_noise_gain``; keep int (m,), the bins whose
+    gain is not 0: all but the emptied zero-Doppler bin)."""
+    gain = static_noise_gain(cfg, windowed[1].hann)
+    return gain, np.flatnonzero(gain > 0.0)
+
+
 def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
              static_removed: bool, thresholds: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """``host.cfar.cfar_detect`` of the map ``nci`` (float (n_range_bins, n_doppler)):
@@ -93,8 +101,7 @@ def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Window
     run = cfar_threshold if thresholds else cfar_detect
     if not static_removed:
         return run(nci, cfg.n_virtual, cf, windowed)
-    gain = static_noise_gain(cfg, windowed[1].hann)
-    keep = np.flatnonzero(gain > 0.0)
+    gain, keep = _static_columns(cfg, windowed)
     first, noise = run(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed)
     out = np.full(nci.shape, np.inf) if thresholds else np.zeros(nci.shape, bool)
     out[:, keep] = first * gain[keep] if thresholds else first
@@ -110,8 +117,7 @@ def _static_cfar_cells(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, window
     emptied zero-Doppler bin left out, the lowered bins divided by their noise gain): the
     cells ``select(mask, nci)`` keeps (int (n, 2), full-map bins) and the noise at them (float
     (n,), scaled back); the same cells and noise as ``map_cfar(..., True)``'s maps give."""
-    gain = static_noise_gain(cfg, windowed[1].hann)
-    keep = np.flatnonzero(gain > 0.0)
+    gain, keep = _static_columns(cfg, windowed)
     reduced = np.full(nci.shape[1], -1)
     reduced[keep] = np.arange(len(keep))
 
