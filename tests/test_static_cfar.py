@@ -103,3 +103,28 @@ def test_noise_estimate_scaled_back() -> None:
         threshold, _ = map_cfar(nci, cfg, c, windowed, True, thresholds=True)
         assert mask.sum() > 100 and np.array_equal(mask, nci > threshold)
         assert np.isinf(threshold[:, 0]).all()
+
+
+def test_detection_path_equals_the_maps() -> None:
+    """The detector's cells-first path after static removal (``host.pipeline.
+    _static_cfar_cells``, the OS order statistic found at the kept cells only) gives exactly
+    the cells and noise that ``map_cfar``'s full maps give, CA and OS, bin 0 never kept."""
+    from host.pipeline import _static_cfar_cells
+
+    cfg = PROFILE.config
+    windowed = fft_axes(cfg, True, True)
+    nci = range_doppler_power(frame_cube(_noise_frames(1, 5)[0], cfg,
+                                         remove_static_clutter=True))
+    rng = np.random.default_rng(6)
+
+    def select(mask: np.ndarray, power: np.ndarray) -> np.ndarray:
+        cells = np.argwhere(mask)       # every detection, then a random half of them
+        return cells[rng.random(len(cells)) < 0.5]
+
+    for kind in ("ca", "os"):
+        cf = CfarParams(pfa=0.05, kind=kind)
+        cells, noise = _static_cfar_cells(nci, cfg, cf, windowed, select)
+        mask, noise_map = map_cfar(nci, cfg, cf, windowed, True)
+        assert len(cells) > 50 and mask[cells[:, 0], cells[:, 1]].all()
+        assert not (cells[:, 1] == 0).any()
+        assert np.array_equal(noise, noise_map[cells[:, 0], cells[:, 1]])
