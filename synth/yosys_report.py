@@ -174,6 +174,7 @@ def write_report(results: list[Result], out: Path, set_name: str, version: str) 
     table = markdown(results)
     cap = capacity_table(results)
     notes = (f"\nYosys {version} `synth_xilinx -family xcup -flatten -noiopad -noclkbuf` "
+             "with the multipliers' registers packed into the DSP48E2s (docs/synth.md) "
              "(`-uram` for the buffers' blocks, the detector and the tops), out of context. "
              "LUT = logic LUTs, "
              "LUTRAM = LUTs used as distributed RAM or shift registers; BRAM in 36 Kb "

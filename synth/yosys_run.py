@@ -34,6 +34,34 @@ def yosys_version(yosys: list[str]) -> str:
     return v[1] if len(v) > 1 else "?"
 
 
+def synth_xilinx_commands(flags: str) -> list[str]:
+    """``synth_xilinx {flags}`` (an UltraScale+ family) with the multipliers' registers packed
+    into their DSP48E2s. Yosys' ``xilinx_dsp`` packs input (A1/A2, B1/B2), product (M) and
+    output (P, with the post-adder) registers, C registers and cascades into DSP48E1s only: for
+    ``-family xcu``/``xcup`` it runs no rule, so every DSP48E2 keeps AREG = BREG = MREG = PREG
+    = 0 and those registers stay fabric FFs (Vivado packs them). The DSP48E2 has the same
+    registers with the same clock enables and resets, and the same OPMODE bits for the Z
+    multiplexer, so the DSP step runs alone and its DSP48E2s go through the DSP48E1 rules:
+    ``USE_DPORT`` set to TRUE keeps the pre-adder (a 25-bit D port on the DSP48E1, configured
+    otherwise on the DSP48E2) out. A ``keep`` that only holds a per-lane operand copy apart
+    for the ECP5 placer (``fft_twiddle``) is dropped where the copy feeds a DSP48E2's A or B
+    port, so a packed copy leaves no unused fabric register behind. docs/synth.md."""
+    feeds_dsp = ("t:DSP48E2 %ci2:+DSP48E2[A,B]:+$dff[Q]:+$dffe[Q]:+$sdff[Q]:+$sdffe[Q]"
+                 " a:keep %i t:$*dff* %i")
+    return [
+        "scratchpad -set xilinx_dsp.multonly 1",
+        f"synth_xilinx {flags} -run :coarse",
+        "scratchpad -unset xilinx_dsp.multonly",
+        f"setattr -unset keep {feeds_dsp}",
+        "chtype -map DSP48E2 DSP48E1 t:DSP48E2",
+        "setparam -set USE_DPORT \"TRUE\" -set USE_PATTERN_DETECT \"NO_PATDET\" t:DSP48E1",
+        "xilinx_dsp -family xc7",
+        "setparam -unset USE_DPORT t:DSP48E1",
+        "chtype -map DSP48E1 DSP48E2 t:DSP48E1",
+        f"synth_xilinx {flags} -run coarse:",
+    ]
+
+
 def _script(job: Job, files: list[Path], stat_json: Path) -> str:
     """The Yosys script of ``job`` reading ``files``, writing its cell counts to ``stat_json``."""
     sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
@@ -48,7 +76,7 @@ def _script(job: Job, files: list[Path], stat_json: Path) -> str:
         # ROM tables stay case logic: constant-propagated address bits prune the unused
         # entries of the 4096-entry coefficient tables (as we expect Vivado to).
         "proc -norom",
-        f"synth_xilinx {flags}",
+        *synth_xilinx_commands(flags),
         f"tee -q -o {stat_json} stat -json",
         "",
     ])

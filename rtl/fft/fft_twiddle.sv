@@ -99,10 +99,12 @@ module fft_twiddle #(
 
   if (GAUSS) begin : g_gauss
     // Three real products per lane (Gauss): with d = -S (forward) or +S (inverse)
-    //   k1 = C*(re + im), k2 = re*(d - C), k3 = im*(C + d), yr = k1 - k3, yi = k1 + k2.
+    //   k1 = C*(re + im), k2 = re*(d - C), k3 = im*(-C - d), yr = k1 + k3, yi = k1 + k2.
     // |C +- S| <= 92682 < 2^17, so both coefficient sums stay COEF_W bits (one per twiddle,
     // shared by every lane); the data pre-add re + im is W+1 <= 27 bits (DSP48E2 A port).
-    logic signed [COEF_W-1:0] c1_q, p1_q, m1_q;   // C, d - C, C + d
+    // Both sums are additions of a product to k1 (k3 takes the negated coefficient), the form
+    // a DSP48E2 post-adder with its P register takes (C port = k1).
+    logic signed [COEF_W-1:0] c1_q, p1_q, m1_q;   // C, d - C, -C - d
     logic signed [W:0]        a1_q [NUM_CH];      // re + im
     // stage 4: each lane's operands (the coefficients copied per lane)
     logic signed [COEF_W-1:0] c4_q [NUM_CH], p4_q [NUM_CH], m4_q [NUM_CH];
@@ -119,7 +121,7 @@ module fft_twiddle #(
       if (en) begin
         c1_q <= signed'(cos2_q);
         p1_q <= COEF_W'(INVERSE ? ss - cc : -ss - cc);
-        m1_q <= COEF_W'(INVERSE ? cc + ss : cc - ss);
+        m1_q <= COEF_W'(INVERSE ? -cc - ss : ss - cc);
         for (int ch = 0; ch < NUM_CH; ch++) begin
           a1_q[ch] <= (W+1)'(signed'(db_q[ch*2*W +: W]))
                     + (W+1)'(signed'(db_q[ch*2*W + W +: W]));
@@ -145,7 +147,7 @@ module fft_twiddle #(
 
     always_comb begin
       for (int ch = 0; ch < NUM_CH; ch++) begin
-        yr_full[ch] = (PRW+2)'(k1_q[ch]) - (PRW+2)'(k3_q[ch]);
+        yr_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k3_q[ch]);
         yi_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k2_q[ch]);
       end
     end

@@ -115,7 +115,7 @@ def test_gauss_twiddle_identity_and_widths(w: int, inverse: bool) -> None:
     operand fits the width the RTL gives it (coefficient sums 18 bits, re + im W+1 bits)."""
     c, s = cos_table(), sin_table()                          # (4096,) each
     d = s if inverse else -s
-    p_coef, m_coef = d - c, c + d                            # RTL p1_q, m1_q
+    p_coef, m_coef = d - c, -c - d                           # RTL p1_q, m1_q
     lim = 1 << 17
     assert (np.abs(p_coef) < lim).all() and (np.abs(m_coef) < lim).all()
     lo, hi = -(1 << (w - 1)), (1 << (w - 1)) - 1
@@ -127,5 +127,5 @@ def test_gauss_twiddle_identity_and_widths(w: int, inverse: bool) -> None:
         assert all(-(1 << w) <= v < (1 << w) for v in a)    # W+1 bits
         k1, k2, k3 = a * ci, re * pi, im * mi
         sg = 1 if inverse else -1                            # x * (C + sg*jS)
-        assert (k1 - k3 == re * ci - sg * im * si).all()
+        assert (k1 + k3 == re * ci - sg * im * si).all()
         assert (k1 + k2 == im * ci + sg * re * si).all()
