@@ -44,6 +44,7 @@ module fft_sdf_bf #(
   localparam int MW = FW + LOG2N + 1;         // delay line word: data, index, overflow
   localparam int DB = $clog2(D);              // index bit selecting the butterfly half
   localparam int PW = (D > 1) ? $clog2(D) : 1;
+  localparam int BRAM_D = 64;                 // shortest delay line read through block RAM
 
   if (D < 1 || (1 << DB) != D || DB >= LOG2N) begin : g_bad_d
     $fatal(1, "%m: D=%0d must be a power of two below 2^LOG2N", D);
@@ -65,7 +66,22 @@ module fft_sdf_bf #(
   // D >= 2: the head is prefetched into a register at the previous advance (mem[ptr+1] is
   // never the slot being written), so the delay line is a simple dual-port RAM with a
   // registered read port (block RAM / SRL friendly). D = 1: the single slot itself.
-  if (D >= 2) begin : g_prefetch
+  // D >= BRAM_D (the lines synthesis maps to block RAM: ECP5 DP16KD, 4.3 ns clock-to-out
+  // without its output register): read two advances ahead, the RAM's read register then a
+  // fabric register, so no logic follows the RAM in the same cycle (mem[ptr+2] is not written
+  // at this advance nor the next; same head, same latency).
+  if (D >= BRAM_D) begin : g_prefetch2
+    logic [MW-1:0] rd_q, head_q;
+    logic [PW-1:0] rd_addr;
+    assign rd_addr = ptr_q + PW'(2);   // modulo D = 2^PW
+    always_ff @(posedge clk) begin
+      if (en) begin
+        rd_q   <= mem_q[rd_addr];
+        head_q <= rd_q;
+      end
+    end
+    assign head = head_q;
+  end else if (D >= 2) begin : g_prefetch
     logic [MW-1:0] head_q;
     always_ff @(posedge clk) begin
       if (en) head_q <= mem_q[(ptr_q == PW'(D - 1)) ? '0 : ptr_q + 1'b1];
