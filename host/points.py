@@ -124,7 +124,11 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
     range_m = (r + dr - coupling) * cfg.range_bin_m - range_bias_m
     ax_r, ax_d = fft_axes(cfg, params.range_window, params.doppler_window)
-    scallop = ax_r.response(dr) * ax_d.response(dd)
+    if (ax_r.n_fft, ax_r.n_samples, ax_r.hann) == (ax_d.n_fft, ax_d.n_samples, ax_d.hann):
+        both = ax_r.response(offsets.T.ravel())         # one response: both axes' alike
+        scallop = both[:len(r)] * both[len(r):]
+    else:
+        scallop = ax_r.response(dr) * ax_d.response(dd)
     cg = ax_r.coherent_gain * ax_d.coherent_gain
     amp = np.abs(amplitude)
     amp_adc = amp / (cg * scallop[cell])
