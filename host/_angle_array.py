@@ -129,13 +129,26 @@ def supported(power: np.ndarray, first: np.ndarray, held: np.ndarray, noise: np.
               n: int, params: GateSettings) -> np.ndarray:
     """The gates of a further component (``host.angle.AngleParams``), bool (m,): power
     |a|^2 of the candidate, first |a_1|^2 of the row's first component, held sum |a_j|^2 of
-    the components held, noise per channel (float (m,) each), n channels: coherent SNR
-    |a|^2 n / noise >= ``min_snr_db``, first / |a|^2 within ``dynamic_range_db``, and the
-    model-order test |a|^2 >= noise + 10^(``array_error_db`` / 10) held."""
+    the components held, noise per channel (float (m,) each), n channels: the level gates
+    (:func:`level_gates`) and the model-order test (:func:`model_order`)."""
+    return level_gates(power, first, noise, n, params) & model_order(power, held, noise,
+                                                                     params)
+
+
+def level_gates(power: np.ndarray, first: np.ndarray, noise: np.ndarray, n: int,
+                params: GateSettings) -> np.ndarray:
+    """bool (m,): coherent SNR |a|^2 n / noise >= ``min_snr_db`` and first / |a|^2 within
+    ``dynamic_range_db`` (arguments as :func:`supported`'s)."""
     with np.errstate(divide="ignore"):
         return (10 * np.log10(power * n / noise) >= params.min_snr_db) & (
-            10 * np.log10(first / np.maximum(power, 1e-300)) <= params.dynamic_range_db) & (
-            power >= noise + 10 ** (params.array_error_db / 10) * held)
+            10 * np.log10(first / np.maximum(power, 1e-300)) <= params.dynamic_range_db)
+
+
+def model_order(power: np.ndarray, held: np.ndarray, noise: np.ndarray,
+                params: GateSettings) -> np.ndarray:
+    """bool (m,): the model-order test |a|^2 >= noise + 10^(``array_error_db`` / 10) held
+    (arguments as :func:`supported`'s)."""
+    return power >= noise + 10 ** (params.array_error_db / 10) * held
 
 
 def relax_general(x: np.ndarray, noise: np.ndarray, grid: ArrayGrid, params: GateSettings

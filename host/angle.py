@@ -89,7 +89,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from host._angle_array import ArrayGrid, array_grid, bartlett_peaks, relax_general, supported
+from host._angle_array import (
+    ArrayGrid,
+    array_grid,
+    bartlett_peaks,
+    level_gates,
+    model_order,
+    relax_general,
+)
 from host._angle_kept import kept_slots
 from host._angle_peaks import COARSE_FFT, class_peaks, peak_sins
 from host._angle_relax import (
@@ -272,9 +279,11 @@ def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleP
         s2, _ = peak_sins(r, params.n_fft)
         a2 = np.sum(np.conj(steering_rows(s2, n)) * r, axis=1) / n
         p2 = np.abs(a2) ** 2
-        more[rows] = supported(p2, p1[rows], p1[rows], noise[rows], n, params)
-        cand = splittable[rows] & ~more[rows] & supported(p2, p1[rows], 0.0 * p1[rows],
-                                                          noise[rows], n, params)
+        p1r, nr_ = p1[rows], noise[rows]
+        gates = level_gates(p2, p1r, nr_, n, params)      # shared by both tests below
+        more[rows] = gates & model_order(p2, p1r, nr_, params)
+        cand = splittable[rows] & ~more[rows] & gates & model_order(p2, 0.0 * p1r, nr_,
+                                                                    params)
         if cand.any():                  # two unresolved targets the first one sits between?
             c = rows[cand]
             s_p, a_p, kept = split_rows(xc[c], noise[c], np.stack([s1[c], s2[cand]], axis=1),

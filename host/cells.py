@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -248,11 +249,64 @@ def _map_offsets(power: np.ndarray, cells: np.ndarray,
                             np.float64(power[r, (d + 1) % nd]), inv_d)
 
 
+def scallop(axes: tuple[FftAxis, FftAxis], offsets: np.ndarray) -> np.ndarray:
+    """The window response at each cell's peak, float (n,): ``FftAxis.response`` of the
+    range axis at offsets[:, 0] times the Doppler axis' at offsets[:, 1] (offsets float
+    (n, 2) bins; axes the (range, Doppler) axes), in one compiled pass: the same
+    operations in the same order as ``model.reference.FftAxis.response`` (sines and the
+    hypotenuse from the C library, as numpy's), so the same values bit for bit
+    (``tests/test_host_pipeline.py``)."""
+    off = np.ascontiguousarray(offsets, dtype=float).reshape(-1, 2)
+    out = np.empty(len(off))
+    _scallop(off, _response_constants(axes[0]), _response_constants(axes[1]), out)
+    return out
+
+
+@lru_cache(maxsize=32)
+def _response_constants(axis: FftAxis) -> tuple[float, int, bool, float, float, float]:
+    """What :func:`_response` needs of ``axis``, computed as ``FftAxis.response`` computes
+    it: (n_samples / n_fft, n_samples, hann, 0.25 cos(phi), 0.25 sin(phi), n_samples / 2),
+    phi = pi (n - 1) / n."""
+    n = axis.n_samples
+    phi = np.pi * (n - 1) / n
+    return (axis.n_samples / axis.n_fft, n, axis.hann, float(0.25 * np.cos(phi)),
+            float(0.25 * np.sin(phi)), n / 2)
+
+
+@njit()
+def _dirichlet(y: float, n: int, sin_pi_y: float) -> float:
+    """``model.reference._dirichlet_ratio`` of one value."""
+    den = math.sin(math.pi * y / n)
+    return float(n) if abs(den) < 1e-12 else sin_pi_y / den
+
+
+@njit()
+def _response(offset: float, k: tuple[float, int, bool, float, float, float]) -> float:
+    """``FftAxis.response`` of one offset, the axis given by :func:`_response_constants`."""
+    ratio, n, hann, c, sn, half = k
+    x = offset * ratio
+    s = math.sin(math.pi * x)
+    r0 = _dirichlet(x, n, s)
+    if not hann:
+        return abs(r0) / n
+    rm = _dirichlet(x - 1, n, -s)
+    rp = _dirichlet(x + 1, n, -s)
+    return math.hypot(0.5 * r0 - c * (rm + rp), sn * (rp - rm)) / half
+
+
+@njit()
+def _scallop(off: np.ndarray, kr: tuple[float, int, bool, float, float, float],
+             kd: tuple[float, int, bool, float, float, float], out: np.ndarray) -> None:
+    """:func:`scallop` into out (float64 (n,))."""
+    for i in range(off.shape[0]):
+        out[i] = _response(off[i, 0], kr) * _response(off[i, 1], kd)
+
+
 @warm_up
 def _warm_up() -> None:
     """The offsets off a map (a cube's, float32 in Fortran order, and float64), of
-    neighbours (the records') and along one axis (a calibration's): each path reaches only
-    some of them."""
+    neighbours (the records') and along one axis (a calibration's), and the window
+    responses (the points of any cells): each path reaches only some of them."""
     inv = _inversion(FftAxis(8, 8))
     cells = np.ones((1, 2), np.int64)
     for power in (np.ones((4, 4), np.float32, order="F"), np.ones((4, 4))):
@@ -260,3 +314,4 @@ def _warm_up() -> None:
     one = np.ones(1)
     _neighbour_offsets(one, np.ones((1, 4)), np.ones(1, np.bool_), inv, inv, np.empty((1, 2)))
     _axis_offsets(one, one, one, inv, np.empty(1))
+    scallop((FftAxis(8, 8), FftAxis(8, 8, False)), np.zeros((1, 2)))

@@ -97,6 +97,12 @@ def _kernel(params: CfarParams) -> np.ndarray:
     return k
 
 
+@lru_cache(maxsize=64)
+def _n_train(params: CfarParams) -> int:
+    """The number of training cells of ``params``' window (:func:`_kernel`'s ones)."""
+    return int(_kernel(params).sum())
+
+
 def map_axes(windowed: Windows, shape: tuple[int, int]) -> tuple[FftAxis, FftAxis]:
     """The two axes of a (n_range, n_doppler) map: ``windowed``'s axes as given, a boolean
     as an unpadded complex axis of the map's length."""
@@ -123,7 +129,7 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
             raise ValueError(f"CFAR window: 2 x (guard {params.guard[axis]} + train "
                              f"{params.train[axis]}) + 1 = {span} {name} cells does not fit "
                              f"the map's {shape[axis]} {name} bins")
-    n_train = int(_kernel(params).sum())
+    n_train = _n_train(params)
     if params.kind == "os" and n_train * shape[0] * shape[1] > OS_MAX_ELEMENTS:
         raise ValueError(f"CFAR window: OS-CFAR sorts {n_train} training cells for each of "
                          f"{shape[0] * shape[1]} cells, more than this host allows "
@@ -132,26 +138,40 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
 
 def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False) -> np.ndarray:
     """Map padded by the CFAR window's half extent, circularly on both axes (``mirrored``:
-    the range axis reflected at both ends, a real ADC's)."""
+    the range axis reflected at both ends, a real ADC's): ``np.pad``'s ``wrap`` (and
+    ``reflect``) of the window's reach, in one gather (C order)."""
     (gr, gd), (tr, td) = params.guard, params.train
-    pr, pd = gr + tr, gd + td
     check_window(params, power.shape)
+    return power[np.ix_(_pad_index(power.shape[0], gr + tr, mirrored),
+                        _pad_index(power.shape[1], gd + td, False))]
+
+
+@lru_cache(maxsize=64)
+def _pad_index(n: int, reach: int, mirrored: bool) -> np.ndarray:
+    """The indices of an axis of n cells padded by ``reach`` <= n - 1 cells each side, int
+    (n + 2 reach,): circular, or reflected at both ends without repeating the edge cell
+    (``mirrored``). Read-only, once per axis."""
+    i = np.arange(-reach, n + reach)
     if mirrored:
-        return np.pad(np.pad(power, ((pr, pr), (0, 0)), mode="reflect"), ((0, 0), (pd, pd)),
-                      mode="wrap")
-    return np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")
+        i = np.abs(i)
+        i = np.where(i > n - 1, 2 * (n - 1) - i, i)
+    else:
+        i %= n
+    i.flags.writeable = False
+    return i
 
 
 @njit()
 def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
                   train_d: int, mirrored: bool) -> np.ndarray:
     """Sum over each cell's CFAR training cells (:func:`_kernel`) of ``power``, float64
-    (n_range, n_doppler), both axes circular (``mirrored``: range reflected at both ends,
-    without repeating the edge cell, as ``np.pad(mode="reflect")``), float64 of that shape.
-    Separable: per range row the Doppler training cells (``side``) and those plus the guard
-    cells (``full``); then per cell the range training rows of ``full`` plus the range
-    guard rows of ``side``. Sums of positive terms only (no cancellation), each added in
-    offset order, negative offsets first."""
+    (n_range, n_doppler) in any memory order, both axes circular (``mirrored``: range
+    reflected at both ends, without repeating the edge cell, as ``np.pad(mode="reflect")``),
+    float64 of that shape. Separable: per range row the Doppler training cells (``side``)
+    and those plus the guard cells (``full``); then per cell the range training rows of
+    ``full`` plus the range guard rows of ``side``. Sums of positive terms only (no
+    cancellation), each added in offset order, negative offsets first; every loop runs
+    along a row, so that it vectorises."""
     nr, nd = power.shape
     pr, pd = guard_r + train_r, guard_d + train_d
     n_rows = nr + 2 * pr
@@ -164,15 +184,20 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             r = -r if r < 0 else (2 * (nr - 1) - r if r > nr - 1 else r)
         else:
             r = (r + nr) % nr
-        for j in range(nd + 2 * pd):        # column (j - pd) mod nd, without a division
-            c = j - pd
-            row[j] = power[r, c + nd if c < 0 else (c - nd if c >= nd else c)]
+        src = power[r]
+        for j in range(pd):                 # columns -pd..-1, 0..nd-1, nd..nd+pd-1
+            row[j] = src[nd - pd + j]
+        for j in range(nd):
+            row[pd + j] = src[j]
+        for j in range(pd):
+            row[pd + nd + j] = src[j]
         # every cell's sums at once, offset by offset (the same additions per cell, in
         # offset order; independent across cells, so they vectorise)
         s = side[i]
         g = full[i]
-        s[:] = 0.0
-        g[:] = 0.0
+        for d in range(nd):
+            s[d] = 0.0
+            g[d] = 0.0
         for o in range(2 * pd + 1):
             if o < pd - guard_d or o > pd + guard_d:
                 for d in range(nd):
@@ -184,32 +209,43 @@ def _training_sum(power: np.ndarray, guard_r: int, guard_d: int, train_r: int,
             g[d] += s[d]
     out = np.empty((nr, nd))
     a = np.empty(nd)
-    b = np.empty(nd)
-    for r in range(nr):
-        a[:] = 0.0
-        b[:] = 0.0
+    for r in range(nr):                     # out = (training rows of full) + (guard rows of side)
+        for d in range(nd):
+            a[d] = 0.0
         for i in range(r, r + pr - guard_r):
-            a += full[i]
+            f = full[i]
+            for d in range(nd):
+                a[d] += f[d]
         for i in range(r + pr + guard_r + 1, r + 2 * pr + 1):
-            a += full[i]
+            f = full[i]
+            for d in range(nd):
+                a[d] += f[d]
+        b = out[r]
+        for d in range(nd):
+            b[d] = 0.0
         for i in range(r + pr - guard_r, r + pr + guard_r + 1):
-            b += side[i]
-        out[r] = a + b
+            f = side[i]
+            for d in range(nd):
+                b[d] += f[d]
+        for d in range(nd):
+            b[d] = a[d] + b[d]
     return out
 
 
 @warm_up
 def _compile_training_sum() -> None:
     """Compile :func:`_training_sum` for the argument types of :func:`cfar_threshold`'s
-    call (``host.kernels.compile_data_dependent``: the FPGA detector's runs never reach it)."""
-    _training_sum(np.zeros((3, 3)), 0, 0, 1, 1, False)
+    calls, maps in C and in Fortran order (a cube's map is Fortran-ordered;
+    ``host.kernels.compile_data_dependent``: the FPGA detector's runs never reach it)."""
+    for power in (np.zeros((3, 3)), np.zeros((3, 3), order="F")):
+        _training_sum(power, 0, 0, 1, 1, False)
 
 
 @lru_cache(maxsize=64)
 def _ca_alpha(pfa: float, n_channels: int, params: CfarParams, windowed: Windows) -> float:
     """CA-CFAR factor of ``params``' window on a map of ``windowed`` axes (``ca_factor`` at
     :func:`effective_cells`), once per configuration."""
-    n_train = float(_kernel(params).sum())
+    n_train = float(_n_train(params))
     return float(ca_factor(pfa, n_channels, n_train * effective_cells(params, windowed)
                            / n_train))
 
@@ -225,9 +261,9 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
     (gr, gd), (tr, td) = params.guard, params.train
     if params.kind == "ca":
         check_window(params, power.shape)
-        sums = _training_sum(np.ascontiguousarray(power, np.float64), gr, gd, tr, td,
+        sums = _training_sum(np.asarray(power, np.float64), gr, gd, tr, td,
                              map_axes(windowed, power.shape)[0].real)
-        noise = np.maximum(sums, 0.0) / int(_kernel(params).sum())
+        noise = np.maximum(sums, 0.0) / _n_train(params)
         return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
     kth = os_kth(_os_padded(power, params, windowed), gr, gd, tr, td, _os_k(params))
     return _os_alpha(params.pfa, n_channels, params) * kth, _os_noise(kth, n_channels, params)
@@ -236,20 +272,20 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
 def _os_padded(power: np.ndarray, params: CfarParams, windowed: Windows) -> np.ndarray:
     """``power`` (float (n_range, n_doppler)) as float64 padded by the window's reach
     (``_pad``), in C order: the OS kernels read rows (a cube's map is often Fortran-ordered)."""
-    return np.ascontiguousarray(_pad(power.astype(np.float64), params,
-                                     map_axes(windowed, power.shape)[0].real))
+    return np.ascontiguousarray(_pad(np.asarray(power), params,
+                                     map_axes(windowed, power.shape)[0].real), np.float64)
 
 
 def _os_k(params: CfarParams) -> int:
     """Rank (1-based) of the OS-CFAR's training cell: ``os_rank`` of the training cells."""
-    n_train = int(_kernel(params).sum())
+    n_train = _n_train(params)
     return max(1, min(n_train, int(round(params.os_rank * n_train))))
 
 
 @lru_cache(maxsize=64)
 def _os_alpha(pfa: float, n_channels: int, params: CfarParams) -> float:
     """OS-CFAR factor of ``params``' window (``os_factor``), once per configuration."""
-    return float(os_factor(pfa, n_channels, int(_kernel(params).sum()), _os_k(params)))
+    return float(os_factor(pfa, n_channels, _n_train(params), _os_k(params)))
 
 
 def _os_noise(kth: np.ndarray, n_channels: int, params: CfarParams) -> np.ndarray:
@@ -261,7 +297,7 @@ def _os_noise(kth: np.ndarray, n_channels: int, params: CfarParams) -> np.ndarra
 @lru_cache(maxsize=64)
 def _os_quantile(n_channels: int, params: CfarParams) -> float:
     """ppf(k / (n + 1)) of Gamma(``n_channels``), the OS-CFAR's k of n training cells."""
-    return stats.gamma(n_channels).ppf(_os_k(params) / (int(_kernel(params).sum()) + 1))
+    return stats.gamma(n_channels).ppf(_os_k(params) / (_n_train(params) + 1))
 
 
 def cfar_detect(power: np.ndarray, n_channels: int, params: CfarParams,

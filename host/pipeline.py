@@ -42,6 +42,7 @@ function for both, ``host.points.points_from_cells``. Settings: ``host.params``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import lru_cache
 
 import numpy as np
 
@@ -52,7 +53,6 @@ from host.cfar import (
     cfar_cells,
     cfar_detect,
     cfar_threshold,
-    detection_mask,
     local_peaks,
     paper_threshold,
     sidelobe_masked,
@@ -81,12 +81,21 @@ def _min_snr(cells: np.ndarray, power: np.ndarray, noise: np.ndarray,
     return power[cells[:, 0], cells[:, 1]] > noise * 10.0 ** (params.min_snr_db / 10.0)
 
 
-def _static_columns(cfg: RadarConfig, windowed: Windows) -> tuple[np.ndarray, np.ndarray]:
+@lru_cache(maxsize=16)
+def _static_columns(cfg: RadarConfig, windowed: Windows
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The Doppler bins the CFAR sees after static removal: (gain float (n_doppler,), the
     noise gain of every bin, ``host.cube.static_noise_gain``; keep int (m,), the bins whose
-    gain is not 0: all but the emptied zero-Doppler bin)."""
+    gain is not 0: all but the emptied zero-Doppler bin; reduced int (n_doppler,), each
+    bin's column in the map of the kept bins, -1 for the others). Read-only, once per
+    radar and windows."""
     gain = static_noise_gain(cfg, windowed[1].hann)
-    return gain, np.flatnonzero(gain > 0.0)
+    keep = np.flatnonzero(gain > 0.0)
+    reduced = np.full(len(gain), -1)
+    reduced[keep] = np.arange(len(keep))
+    for a in (keep, reduced):
+        a.flags.writeable = False
+    return gain, keep, reduced
 
 
 def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Windows,
@@ -101,7 +110,7 @@ def map_cfar(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, windowed: Window
     run = cfar_threshold if thresholds else cfar_detect
     if not static_removed:
         return run(nci, cfg.n_virtual, cf, windowed)
-    gain, keep = _static_columns(cfg, windowed)
+    gain, keep, _ = _static_columns(cfg, windowed)
     first, noise = run(nci[:, keep] / gain[keep], cfg.n_virtual, cf, windowed)
     out = np.full(nci.shape, np.inf) if thresholds else np.zeros(nci.shape, bool)
     out[:, keep] = first * gain[keep] if thresholds else first
@@ -117,9 +126,7 @@ def _static_cfar_cells(nci: np.ndarray, cfg: RadarConfig, cf: CfarParams, window
     emptied zero-Doppler bin left out, the lowered bins divided by their noise gain): the
     cells ``select(mask, nci)`` keeps (int (n, 2), full-map bins) and the noise at them (float
     (n,), scaled back); the same cells and noise as ``map_cfar(..., True)``'s maps give."""
-    gain, keep = _static_columns(cfg, windowed)
-    reduced = np.full(nci.shape[1], -1)
-    reduced[keep] = np.arange(len(keep))
+    gain, keep, reduced = _static_columns(cfg, windowed)
 
     def select_reduced(mask: np.ndarray) -> np.ndarray:
         full = np.zeros(nci.shape, bool)
@@ -149,11 +156,11 @@ def detect_cells(cube: np.ndarray, cfg: RadarConfig, params: DetectionParams
     windowed = fft_axes(cfg, params.range_window, params.doppler_window)
     mirrored = windowed[0].real
     size = GROUPING_SIZE[params.grouping]
-    ok = detection_mask(cfg.n_range_bins, cfg.n_doppler, cfg.detection_bins)
+    lo, hi = cfg.detection_bins             # host.cfar.detection_mask's rows
 
     def select(mask: np.ndarray, peak_map: np.ndarray) -> np.ndarray:
         cells = local_peaks(peak_map, mask, size, mirrored)
-        cells = cells[ok[cells[:, 0], cells[:, 1]]]
+        cells = cells[(cells[:, 0] >= lo) & (cells[:, 0] < hi)]
         if params.sidelobe_margin_db is not None and len(cells):
             cells = cells[~sidelobe_masked(nci, cells, windowed, params.sidelobe_margin_db)]
         return cells

@@ -68,9 +68,9 @@ class PointCloud:
         for name in ELEVATION_FIELDS:
             if getattr(self, name) is None:
                 object.__setattr__(self, name, np.zeros(n))
-        for f in fields(self):
-            if len(getattr(self, f.name)) != n:
-                raise ValueError(f"PointCloud.{f.name}: length {len(getattr(self, f.name))} "
+        for name in _FIELD_NAMES:
+            if len(getattr(self, name)) != n:
+                raise ValueError(f"PointCloud.{name}: length {len(getattr(self, name))} "
                                  f"!= {n}")
 
     def __len__(self) -> int:
@@ -88,8 +88,8 @@ class PointCloud:
         el = np.radians(np.broadcast_to(np.asarray(elevation_deg, dtype=float), r.shape))
         vr = np.asarray(radial_velocity_mps, dtype=float)
         n = r.shape[0]
-        x, y, z = cartesian(r, az, el)
-        vx, vy, _ = cartesian(vr, az, el)
+        # positions and velocities in one call (the angles' sines and cosines once)
+        (x, vx), (y, vy), (z, _) = cartesian(np.stack([r, vr]), az, el)
         return cls(
             range_m=r, azimuth_deg=np.degrees(az), radial_velocity_mps=vr,
             x_m=x, y_m=y, vx_mps=vx, vy_mps=vy, z_m=z, elevation_deg=np.degrees(el),
@@ -183,3 +183,7 @@ class PointCloud:
                              f"a point needs range >= 0 and |azimuth|, |elevation| <= 90 deg")
         return cls.from_polar(rcs_dbsm=rcs, range_bin=rb, doppler_bin=db, ambiguous=amb,
                               frame=frame, elevation_deg=np.array(el, dtype=float), **get)
+
+
+_FIELD_NAMES = tuple(f.name for f in fields(PointCloud))
+"""The fields of :class:`PointCloud`, in order (checked on every cloud made)."""

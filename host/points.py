@@ -23,7 +23,7 @@ import numpy as np
 
 from host.angle import estimate_angles, peak_powers
 from host.calibration import apply_calibration
-from host.cells import Cells
+from host.cells import Cells, scallop
 from host.params import DetectionParams
 from host.pointcloud import PointCloud
 from host.tdm import choose_folds, hypothesis_classes, tx_phasors
@@ -124,10 +124,9 @@ def cloud(cfg: RadarConfig, params: DetectionParams, r: np.ndarray, offsets: np.
     coupling = 2 * velocity / cfg.wavelength_m / cfg.sample_rate_hz * nr
     range_m = (r + dr - coupling) * cfg.range_bin_m - range_bias_m
     ax_r, ax_d = fft_axes(cfg, params.range_window, params.doppler_window)
-    scallop = ax_r.response(dr) * ax_d.response(dd)
     cg = ax_r.coherent_gain * ax_d.coherent_gain
     amp = np.abs(amplitude)
-    amp_adc = amp / (cg * scallop[cell])
+    amp_adc = amp / (cg * scallop((ax_r, ax_d), offsets)[cell])
     rcs = rcs_estimate_dbsm(cfg, amp_adc, range_m[cell], az, params.tx_beamforming)
     return PointCloud.from_polar(
         range_m[cell], az, velocity[cell], 20 * np.log10(np.maximum(amp, 1e-30)), snr_db,

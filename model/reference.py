@@ -95,7 +95,8 @@ class FftAxis:
         or of the rectangular one (D). The three kernels share their phase up to
         exp(+-j phi), phi = pi (n - 1) / n, and sin(pi (x +- 1)) = -sin(pi x): |W| is
         |0.5 R(x) - 0.25 e^{j phi} R(x - 1) - 0.25 e^{-j phi} R(x + 1)| with the real factors
-        R of :func:`_dirichlet_ratio` (four sines, no complex exponential)."""
+        R of :func:`_dirichlet_ratio` (four sines, no complex exponential). Compiled, for the
+        points of a frame's cells: ``host.cells.scallop`` (the same operations)."""
         x = np.asarray(offset, dtype=float) * (self.n_samples / self.n_fft)
         n = self.n_samples
         s = np.sin(np.pi * x)
@@ -242,11 +243,15 @@ def dma_order_to_cube(words: np.ndarray, cfg: RadarConfig) -> np.ndarray:
 def range_doppler_power(cube: np.ndarray) -> np.ndarray:
     """Non-coherently integrated power sum_v |cube|^2, float64 (n_range, n_doppler): summed
     channel by channel in order (what ``np.sum(np.abs(cube) ** 2, axis=0)`` computes, without
-    its two cube-sized temporaries)."""
+    its two cube-sized temporaries; one map-sized buffer, reused)."""
     cube = np.asarray(cube)
-    power = np.abs(cube[0]) ** 2
+    power = np.abs(cube[0])
+    power *= power                      # ** 2 is a square: the same product
+    square = np.empty_like(power)
     for channel in cube[1:]:
-        power += np.abs(channel) ** 2
+        np.abs(channel, out=square)
+        square *= square
+        power += square
     return power
 
 

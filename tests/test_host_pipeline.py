@@ -4,11 +4,12 @@ paper-fpga end to end."""
 import numpy as np
 import pytest
 
+from host.cells import scallop
 from host.cfar import CfarParams, ca_factor, cfar_threshold, effective_cells, os_factor
 from host.evaluate import match_targets
 from host.pipeline import DetectionParams, detect_cells, process_cube, process_frame
 from model.config import get_preset
-from model.reference import radar_cube, range_doppler_power
+from model.reference import FftAxis, radar_cube, range_doppler_power
 from model.scene import Scatterers, table1_scene
 from model.simulate import simulate_frame, simulate_scene
 
@@ -191,3 +192,18 @@ def test_cube_path_is_the_one_it_replaced(preset):
         assert_same_cloud(new, process_cube_reference(cube, scene.config, params))
         compared += len(new)
     assert compared > len(scenes)
+
+
+@pytest.mark.parametrize("axes", [
+    (FftAxis(128, 128), FftAxis(128, 128)),
+    (FftAxis(256, 200), FftAxis(64, 48, False)),
+    (FftAxis(64, 64, False, True), FftAxis(256, 255)),
+])
+def test_scallop_is_the_window_response(axes):
+    """The compiled window responses of the points path are FftAxis.response's values, bit
+    for bit (centres, bin edges, offsets that refinement pushes past them, tiny ones)."""
+    rng = np.random.default_rng(5)
+    off = np.concatenate([rng.uniform(-0.75, 0.75, (2000, 2)),
+                          [[0.0, 0.0], [0.5, -0.5], [1e-13, -1e-13], [-0.75, 0.75]]])
+    ref = axes[0].response(off[:, 0]) * axes[1].response(off[:, 1])
+    assert np.array_equal(scallop(axes, off), ref)
