@@ -34,11 +34,13 @@ DEVICE = ["--85k", "--speed", "8", "--package", "CABGA756"]
 
 @dataclass(frozen=True)
 class Settings:
-    """What a job's result depends on besides its sources: the clock constraint (MHz) and the
-    nextpnr placer seed."""
+    """What a job's result depends on besides its sources: the clock constraint (MHz), the
+    nextpnr placer seed and router (``router1``, nextpnr-ecp5's default, or ``router2``, which
+    resolves the congestion of a large design such as the top in fewer iterations)."""
 
     freq_mhz: float = 100.0
     seed: int = 1
+    router: str = "router1"
 
 
 @dataclass
@@ -67,7 +69,8 @@ def _pnr_args(settings: Settings) -> list[str]:
     """The nextpnr-ecp5 arguments of a job (run in its directory)."""
     return [*DEVICE, "--out-of-context", "--json", "ecp5.json", "--freq",
             f"{settings.freq_mhz:g}", "--seed", str(settings.seed), "--report", "report.json",
-            "--timing-allow-fail", "--threads", "1"]
+            "--timing-allow-fail", "--threads", "1",
+            *(["--router", settings.router] if settings.router != "router1" else [])]
 
 
 def job_key(job: Job, files: list[Path], settings: Settings) -> str:
