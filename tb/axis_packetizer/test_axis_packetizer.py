@@ -19,7 +19,7 @@ from cocotb.triggers import FallingEdge, RisingEdge
 from model import axis_packetizer as pk
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
-from tb import stall_regimes
+from tb import progress, stall_regimes
 
 
 class TB(AxisTB):
@@ -35,6 +35,10 @@ class TB(AxisTB):
         self.lengths: list[int] = []      # cfg_packet_words at each frame's first word
         dut.cfg_packet_words.value = self.packet_words
         cocotb.start_soon(self._watch_lengths())
+        # latency: a packet's first payload word in to its header out (docs/buffers.md); no
+        # frame rule: without input backpressure words are dropped by design, and run-time
+        # lengths change the words per frame
+        progress.watch(self, latency=self.packet_words + 2)
 
     async def _watch_lengths(self) -> None:
         """Record cfg_packet_words at every frame's first input word."""
