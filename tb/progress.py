@@ -11,7 +11,10 @@ Two kinds of limit (docs/verification.md, "Watchdogs that fail fast"):
   it, counted only over the clocks the block alone is to blame for (its sink is not holding
   an offered beat), so the testbench's stall patterns never add to it. The input port fails
   when TVALID waits without TREADY and nothing moves; with ``frame``, the output port fails
-  when a whole input frame has been taken and the block gives no beat of its answer.
+  when a whole input frame has been taken and the block gives no beat of its answer;
+- ``frame`` / ``most`` (beats per frame in and out): the output port fails at once when it
+  gives more beats than the input frames begun allow (a block that repeats its output for
+  ever, which moves beats and so passes the other limits).
 
 Imported by cocotb testbenches only (it awaits cocotb triggers).
 """
@@ -28,7 +31,8 @@ within seconds of wall time."""
 
 
 def watch(tb, stuck: int | None = None, conserving: bool = False, *,
-          latency: int | None = None, frame: tuple[int, int] | None = None) -> None:
+          latency: int | None = None, frame: tuple[int, int] | None = None,
+          most: tuple[int, int] | None = None) -> None:
     """Start the watchdog of ``tb`` (an ``rtlsim.axis.AxisTB``); every rule is off unless
     its argument is given, and every count restarts in reset.
 
@@ -45,14 +49,18 @@ def watch(tb, stuck: int | None = None, conserving: bool = False, *,
     whole than output frames given) and gives no output beat for ``MARGIN * latency``
     consecutive clocks in which its sink is not holding an offered beat.
 
+    ``frame``, or ``most = (beats in, most beats out)`` of one frame where the output per
+    frame varies (words dropped, run-time packet lengths): the test fails at once when the
+    output exceeds that many beats per input frame begun.
+
     ``conserving``: the block never emits more beats than it took (it may drop, never
     create), so output beyond the input fails at once (a block that repeats its output for
     ever)."""
-    cocotb.start_soon(_watch(tb, stuck, conserving, latency, frame))
+    cocotb.start_soon(_watch(tb, stuck, conserving, latency, frame, most or frame))
 
 
 async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
-                 frame: tuple[int, int] | None) -> None:
+                 frame: tuple[int, int] | None, most: tuple[int, int] | None) -> None:
     d = tb.dut
     inp, out = tb._in_prefix, tb._out_prefix
     s_valid, s_ready, m_valid, m_ready = (
@@ -74,6 +82,10 @@ async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
         beats_out += gave
         if conserving and beats_out > beats_in:
             raise AssertionError(f"{beats_out} beats out of {beats_in} in: output created")
+        if most is not None and beats_out > -(-beats_in // most[0]) * most[1]:
+            raise AssertionError(
+                f"{out} runs away: {beats_out} beats out of {beats_in} in, more than "
+                f"{most[1]} per {most[0]} taken")
         still = 0 if took or gave else still + 1
         if stuck is not None and still >= stuck:
             raise AssertionError(f"stream stopped: no beat moved for {stuck} clocks")
