@@ -3,7 +3,7 @@ fails its test within a few thousand clocks, instead of simulating until the 50 
 simulated-time watchdog of ``rtlsim.toolchain`` (minutes to a quarter of an hour of wall
 time per test, where a mutation campaign spends most of its time on hangs).
 
-Two kinds of limit (docs/verification.md, "Watchdogs that fail fast"):
+Three kinds of rule (docs/verification.md, "Watchdogs that fail fast"):
 
 - ``stuck``: no beat on either interface for that many clocks, whatever the testbench does
   (it must exceed the longest pause the tests make);
