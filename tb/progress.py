@@ -3,6 +3,19 @@ fails its test within a few thousand clocks, instead of simulating until the 50 
 simulated-time watchdog of ``rtlsim.toolchain`` (minutes to a quarter of an hour of wall
 time per test, where a mutation campaign spends most of its time on hangs).
 
+Three kinds of rule (docs/verification.md, "Watchdogs that fail fast"):
+
+- ``stuck``: no beat on either interface for that many clocks, whatever the testbench does
+  (it must exceed the longest pause the tests make);
+- ``latency``: the block's documented latency, in clocks; the limit is :data:`MARGIN` times
+  it, counted only over the clocks the block alone is to blame for (its sink is not holding
+  an offered beat), so the testbench's stall patterns never add to it. The input port fails
+  when TVALID waits without TREADY and nothing moves; with ``frame``, the output port fails
+  when a whole input frame has been taken and the block gives no beat of its answer;
+- ``frame`` / ``most`` (beats per frame in and out): the output port fails at once when it
+  gives more beats than the input frames begun allow (a block that repeats its output for
+  ever, which moves beats and so passes the other limits).
+
 Imported by cocotb testbenches only (it awaits cocotb triggers).
 """
 
@@ -11,33 +24,106 @@ from __future__ import annotations
 import cocotb
 from cocotb.triggers import RisingEdge
 
-
-def watch(tb, stuck: int, conserving: bool = False) -> None:
-    """Start the watchdog of ``tb`` (an ``rtlsim.axis.AxisTB``): when no beat has moved on
-    either interface for ``stuck`` consecutive clocks out of reset, the test fails (a block
-    that stops taking input, or takes it and never answers). ``stuck`` must exceed the
-    longest silence a passing test makes: its stall patterns' longest pause (a paused
-    source, a stalled sink), its quiet waits at the end. ``conserving``: the block never
-    emits more beats than it took (it may drop, never create), so output beyond the input
-    fails at once (a block that repeats its output for ever)."""
-    cocotb.start_soon(_watch(tb, stuck, conserving))
+MARGIN = 4
+"""A ``latency`` limit is this many times the block's documented latency: a block that works
+is silent at most one latency (a frame's tail, its pipeline), one that stopped for good fails
+within seconds of wall time."""
 
 
-async def _watch(tb, stuck: int, conserving: bool) -> None:
+def watch(tb, stuck: int | None = None, conserving: bool = False, *,
+          latency: int | None = None, frame: tuple[int, int] | None = None,
+          most: tuple[int, int] | None = None) -> None:
+    """Start the watchdog of ``tb`` (an ``rtlsim.axis.AxisTB``); every rule is off unless
+    its argument is given, and every count restarts in reset.
+
+    ``stuck``: the test fails when no beat has moved on either interface for ``stuck``
+    consecutive clocks (a block that stops taking input, or takes it and never answers);
+    ``stuck`` must exceed the longest silence a passing test makes (its stall patterns'
+    longest pause, its quiet waits at the end).
+
+    ``latency`` (clocks, the block's documented latency): the input port fails when, for
+    ``MARGIN * latency`` consecutive clocks, its TVALID is high without TREADY, no beat
+    moves and the sink is not holding an offered beat (TVALID without TREADY on the output
+    is the testbench's stall, not the block's). With ``frame = (beats in, beats out)`` of one
+    frame, the output port fails when the block owes an answer (more input frames taken
+    whole than output frames given) and gives no output beat for ``MARGIN * latency``
+    consecutive clocks in which its sink is not holding an offered beat.
+
+    ``frame``, or ``most = (beats in, most beats out)`` of one frame where the output per
+    frame varies (words dropped, run-time packet lengths): the test fails at once when the
+    output exceeds that many beats per input frame begun.
+
+    ``conserving``: the block never emits more beats than it took (it may drop, never
+    create), so output beyond the input fails at once (a block that repeats its output for
+    ever)."""
+    cocotb.start_soon(_watch(tb, stuck, conserving, latency, frame, most or frame))
+
+
+async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
+                 frame: tuple[int, int] | None, most: tuple[int, int] | None) -> None:
     d = tb.dut
+    inp, out = tb._in_prefix, tb._out_prefix
     s_valid, s_ready, m_valid, m_ready = (
         getattr(d, f"{prefix}_{name}") for prefix, name in (
-            (tb._in_prefix, "tvalid"), (tb._in_prefix, "tready"),
-            (tb._out_prefix, "tvalid"), (tb._out_prefix, "tready")))
-    still = beats_in = beats_out = 0
+            (inp, "tvalid"), (inp, "tready"), (out, "tvalid"), (out, "tready")))
+    limit = MARGIN * latency if latency is not None else None
+    why = f"{MARGIN} x the block's latency of {latency} clocks"
+    still = waiting = owing = beats_in = beats_out = 0
     while True:
         await RisingEdge(d.clk)
-        took = s_valid.value == 1 and s_ready.value == 1
+        if d.rst.value == 1:
+            still = waiting = owing = beats_in = beats_out = 0
+            continue
+        offered = s_valid.value == 1
+        took = offered and s_ready.value == 1
+        held = m_valid.value == 1 and m_ready.value == 0
         gave = m_valid.value == 1 and m_ready.value == 1
         beats_in += took
         beats_out += gave
         if conserving and beats_out > beats_in:
             raise AssertionError(f"{beats_out} beats out of {beats_in} in: output created")
-        still = 0 if d.rst.value == 1 or took or gave else still + 1
-        if still >= stuck:
+        if most is not None and beats_out > -(-beats_in // most[0]) * most[1]:
+            raise AssertionError(
+                f"{out} runs away: {beats_out} beats out of {beats_in} in, more than "
+                f"{most[1]} per {most[0]} taken")
+        still = 0 if took or gave else still + 1
+        if stuck is not None and still >= stuck:
             raise AssertionError(f"stream stopped: no beat moved for {stuck} clocks")
+        if limit is None:
+            continue
+        waiting = waiting + 1 if offered and not took and not gave and not held else 0
+        if waiting >= limit:
+            raise AssertionError(
+                f"{inp} stalled: TVALID high without TREADY for {limit} clocks, no beat "
+                f"moved and {out} not held by its sink ({why})")
+        owed = frame is not None and beats_in // frame[0] > beats_out // frame[1]
+        owing = owing + 1 if owed and not gave and not held else 0
+        if owing >= limit:
+            raise AssertionError(
+                f"{out} stalled: no output beat for {limit} clocks with its sink not holding "
+                f"one, while {beats_in // frame[0]} input frames were taken and "
+                f"{beats_out // frame[1]} answered ({why})")
+
+
+# ---- documented latencies of the blocks whose testbenches share them -------------------------
+NCI_LATENCY = 4
+"""Clocks from an input word to its cell's sum (docs/detect.md, nci: "Pipeline (4 clocks)")."""
+
+CFAR_PIPELINE = 10
+"""Clocks from a column read to the decision (docs/detect.md, cfar_2d)."""
+
+
+def cfar_latency(c) -> int:
+    """Clocks from a frame's last cell into ``cfar_2d`` (``c`` a ``model.cfar_2d.Cfar2dConfig``)
+    to its last cell out (docs/detect.md, cfar_2d's streaming schedule): the PR+1 passes
+    without input that test the frame's last rows, N_DOPPLER + 2 PD steps each (the Doppler
+    wrap), then :data:`CFAR_PIPELINE`."""
+    return (c.pr + 1) * (c.n_doppler + 2 * c.pd) + CFAR_PIPELINE
+
+
+def fft_latency(n: int, window: bool) -> int:
+    """Clocks from the first sample of an ``n``-point ``fft_axis`` frame in to its first bin
+    out (docs/fft_axis.md, "Latency and throughput"): 2N + 2L + 7M + 2, +3 with the window,
+    L = log2 N butterfly stages, M = ceil(L / 2) - 1 twiddle multipliers (log4(N) - 1)."""
+    stages = n.bit_length() - 1
+    return 2 * n + 2 * stages + 7 * (-(-stages // 2) - 1) + 2 + 3 * int(window)

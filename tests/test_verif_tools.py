@@ -249,6 +249,18 @@ def test_original_operator_ids_are_stable() -> None:
                                    "sticky", "swap"}
 
 
+def test_equivalent_entries_name_their_line() -> None:
+    """Every EQUIVALENT entry's identifier still names the mutant it argues about: its
+    recorded mutated line is the current mutant's (whitespace collapsed, comment left out).
+    An identifier existing is not enough: ``nci:const:2`` (step 2: ``s1_valid_q`` set by
+    reset) outlived ``s1_valid_q`` and named ``framing_q``'s reset line instead."""
+    by_id = {m.ident: m for mod in mutate.TESTS for m in mutate.candidates(mod)}
+    for ident, eq in mutate.EQUIVALENT.items():
+        assert ident in by_id, f"{ident}: no such mutant"
+        after = " ".join(by_id[ident].after.split())
+        assert eq.mutated in after, f"{ident} is now {after!r}, not {eq.mutated!r}"
+
+
 def test_dropfirst_keeps_comparisons_whole() -> None:
     """A comparison binds tighter than ``||``: the first operand dropped is all of it."""
     text = _SNIPPET.replace("assign pos_end = (frames_q == 32'd7);",

@@ -92,7 +92,8 @@ def report(results: list[tuple[Mutant, str, float]]) -> str:
     if surv:
         lines += ["", "Surviving mutants:", ""]
         for m in surv:
-            why = EQUIVALENT.get(m.ident)
+            eq = EQUIVALENT.get(m.ident)
+            why = eq.why if eq else None
             lines += [f"- `{m.ident}`" + (f" (equivalent: {why})" if why else ""),
                       "```diff", m.diff().rstrip(), "```"]
     return "\n".join(lines)

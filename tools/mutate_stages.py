@@ -5,6 +5,7 @@ the surviving mutants known to be equivalent."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -108,136 +109,184 @@ CI_MUTANTS = (
 )
 
 
-EQUIVALENT: dict[str, str] = {
-    "detect_chain:drop:0": (
+class Equivalent(NamedTuple):
+    """A surviving mutant that no test can kill."""
+
+    mutated: str
+    """Its mutated line, whitespace collapsed and the comment left out (the text
+    ``tests/test_verif_tools.py`` finds in the current mutant of that identifier, so an
+    entry whose line moved or changed fails instead of naming another mutant)."""
+    why: str
+    """The reason it is equivalent."""
+
+
+EQUIVALENT: dict[str, Equivalent] = {
+    "detect_chain:drop:0": Equivalent(
+        "assign s_axis_tready = nci_ready;",
         "s_axis_tready without snap_room: the guard is redundant by design; the CFAR holds "
         "2*PR+2 rows and tests row p-PR-1 while row p is written, so the writer leads the "
         "row being decided by at most PR+2 rows < SNAP_ROWS = 2^clog2(PR+3); "
         "detect_records' simulation assertion 'snapshot written without room' never fired "
         "under the chain testbench's long output stalls"),
-    "cfar_2d:rel:9": (
+    "cfar_2d:rel:9": Equivalent(
+        "lo = (q <= PR) ? PR - q : 0;",
         "lo = (q < PR) ? PR - q : 0 with <= instead of <: the two differ only at q == PR, "
         "where the taken arm gives PR - q = 0, the same as the other arm"),
-    "cfar_2d:rel:11": (
+    "cfar_2d:rel:11": Equivalent(
+        "if (hi >= PR) hi = PR;",
         "if (hi > PR) hi = PR with >= instead of >: the two differ only at hi == PR, where "
         "the assignment writes the value hi already has"),
-    "detect_records:noreset:6": (
+    "detect_records:noreset:6": Equivalent(
+        "// (mutant: st_q not reset)",
         "st_q left out of reset: reset leaves the FSM in S_CELL, and every entry to S_REC "
         "(the only state that advances st_q or issues a snapshot word addressed by it) "
         "loads st_q with 0 first, so its reset value is never used"),
-    "corner_turn:drop:4": (
+    "corner_turn:drop:4": Equivalent(
+        "assign rd_start = pending_q;",
         "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
         "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
-    "chirp_pingpong:const:6": (
+    "chirp_pingpong:const:6": Equivalent(
+        "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
         "(at pos_q == 0 ovf_drop reads full_q), and pos_q leaves 0 only by a beat at pos_q "
         "== 0, which loads discard_q; so the reset value is never read"),
-    "chirp_pingpong:const:8": (
+    "chirp_pingpong:const:8": Equivalent(
+        "chirp_sof_q <= 1'b1;",
         "chirp_sof_q reset to 1 instead of 0: it is read only by a commit (the last sample "
         "of a chirp taken from pos_q == 0 without skipping), and that chirp's first beat at "
         "pos_q == 0 loaded chirp_sof_q; so the reset value is never read"),
-    "chirp_pingpong:dropfirst:0": (
+    "chirp_pingpong:dropfirst:0": Equivalent(
+        "assign s_axis_tready = ADC_BACKPRESSURE ? (!full_q[wr_bank_q]) : 1'b1;",
         "s_axis_tready without skip_q (ADC_BACKPRESSURE = 1): a skip starts on a beat taken "
         "with skip_q low, so with full_q[wr_bank_q] low; while skipping nothing is committed "
         "(only a commit sets full_q, the read side only clears it) and wr_bank_q stays, so "
         "full_q[wr_bank_q] stays low and skip_q || !full_q[wr_bank_q] equals !full_q[...]"),
-    "chirp_pingpong:dropfirst:2": (
+    "chirp_pingpong:dropfirst:2": Equivalent(
+        "assign keep = !ovf_drop;",
         "keep without !skip_q: while skipping pos_q stays 0, so ovf_drop reads "
         "full_q[wr_bank_q] and the extra writes go only to address 0 of a bank that is not "
         "full (not being read), which the next chirp's first beat overwrites before that "
         "bank can be committed; commit needs last_pos, false at pos_q 0 (N_RANGE >= 2), and "
         "the counters test skip_q themselves"),
-    "chirp_pingpong:dropfirst:4": (
+    "chirp_pingpong:dropfirst:4": Equivalent(
+        "assign commit = keep && last_pos && s_axis_tlast;",
         "commit without beat: inside the write branch (if (beat)) nothing changes; outside "
         "it commit only writes sof_q/gap_q of the write bank, which is not full (not read) "
         "and gets the same values, or new ones, from that bank's real commit before it is "
         "read (idle clocks with random TLAST do not kill it)"),
-    "chirp_pingpong:dropfirst:5": (
+    "chirp_pingpong:dropfirst:5": Equivalent(
+        "assign ram_wr_en = keep;",
         "ram_wr_en = keep without beat: the extra writes go to {wr_bank_q, pos_q} of a bank "
         "that is not full (keep needs !ovf_drop), and pos_q advances only on a beat, which "
         "writes that address again before the bank is committed"),
-    "chirp_pingpong:noreset:3": (
+    "chirp_pingpong:noreset:3": Equivalent(
+        "// (mutant: discard_q not reset)",
         "discard_q left out of reset (as chirp_pingpong:const:6): read only while "
         "pos_q != 0, after the chirp's first beat at pos_q == 0 loaded it"),
-    "chirp_pingpong:noreset:5": (
+    "chirp_pingpong:noreset:5": Equivalent(
+        "// (mutant: chirp_sof_q not reset)",
         "chirp_sof_q left out of reset (as chirp_pingpong:const:8): read only by a commit, "
         "after the chirp's first beat at pos_q == 0 loaded it"),
-    "chirp_pingpong:sticky:1": (
+    "chirp_pingpong:sticky:1": Equivalent(
+        "skip_q <= !s_axis_tlast;",
         "skip_q <= !s_axis_tlast instead of setting it only on a missing TLAST: the line is "
         "in the branch taken only while skip_q is low, so writing 0 there changes nothing"),
-    "chirp_pingpong:tie:1": (
+    "chirp_pingpong:tie:1": Equivalent(
+        "assign rd_last = (rd_idx_q >= POS_W'(N_RANGE - 1));",
         "rd_last = rd_idx_q >= N_RANGE - 1 instead of ==: rd_idx_q counts up from 0 and "
         "returns to 0 at rd_last, so it never exceeds N_RANGE - 1 and the two agree"),
-    "frame_align:const:8": (
+    "frame_align:const:8": Equivalent(
+        "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
-    "nci:const:2": (
-        "s1_valid_q set (not cleared) by reset: it only enables the accumulator RAM write, so "
-        "reset writes a stale partial sum at a stale address; every accumulator word that TX "
-        "t >= 1 reads was written by TX t-1 of the same Doppler bin after the reset (a row "
-        "of N_DOPPLER beats later), so the stray word is always overwritten before it is "
-        "read (and with NUM_TX = 1 the register drives nothing)"),
-    "mark_fifo:const:8": (
+    "nci:noreset:0": Equivalent(
+        "// (mutant: v_q not reset)",
+        "v_q (a beat in pipeline stage k) left out of reset, the successor of step 2's "
+        "nci:const:2 (s1_valid_q set by reset): v_q only enables the accumulator RAM's "
+        "write and read, so after a reset its stale bits write stale sums at stale "
+        "addresses for at most LAT clocks, before the first beat's own write; every "
+        "accumulator word that TX t >= 1 reads was written by TX t-1 of the same Doppler "
+        "bin after the reset, so a stray word is always overwritten before it is read "
+        "(and with NUM_TX = 1 the register drives nothing)"),
+    "mark_fifo:const:8": Equivalent(
+        "for (int i = 0; i < DEPTH - 0; i++) q[i] <= q[i+1];",
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
         "read): the next statement, q[DEPTH-1] <= '0, overrides that assignment"),
-    "mark_fifo:arith:1": (
+    "mark_fifo:arith:1": Equivalent(
+        "for (int i = 0; i < DEPTH + 1; i++) q[i] <= q[i+1];",
         "the shift loop runs two steps further (i < DEPTH + 1): q[DEPTH-1] <= q[DEPTH] is "
         "overridden by the next statement, q[DEPTH-1] <= '0, and q[DEPTH] <= q[DEPTH+1] "
         "writes outside the array (no register; the simulator drops the write)"),
-    "mark_fifo:rel:2": (
+    "mark_fifo:rel:2": Equivalent(
+        "for (int i = 0; i <= DEPTH; i++) q[i] <= '0;",
         "the reset loop runs one step further (i <= DEPTH): q[DEPTH] <= '0 writes outside "
         "the array (no register; the simulator drops the write)"),
-    "mark_fifo:rel:4": (
+    "mark_fifo:rel:4": Equivalent(
+        "for (int i = 0; i <= DEPTH - 1; i++) q[i] <= q[i+1];",
         "the shift loop runs one step further (i <= DEPTH - 1, as mark_fifo:const:8): "
         "q[DEPTH-1] <= q[DEPTH] is overridden by the next statement, q[DEPTH-1] <= '0"),
-    "mark_fifo:tie:0": (
+    "mark_fifo:tie:0": Equivalent(
+        "assign full = (cnt_q >= CW'(DEPTH));",
         "full = cnt_q >= DEPTH instead of ==: cnt_q never exceeds DEPTH (a push while full "
         "is refused unless a pop leaves in the same cycle), so the two agree"),
-    "frame_align:noreset:4": (
+    "frame_align:noreset:4": Equivalent(
+        "// (mutant: discard_q not reset)",
         "discard_q left out of reset (as frame_align:const:8): it is read only in FILL, and "
         "FILL is entered only from PASS through the arm that writes discard_q"),
-    "frame_align:tie:0": (
+    "frame_align:tie:0": Equivalent(
+        "assign chirp_end = smp_q >= SMP_W'(N_RANGE - 1);",
         "chirp_end = smp_q >= N_RANGE - 1 instead of ==: smp_q never exceeds N_RANGE - 1 "
         "(frame_align's proof asserts smp_q <= N_RANGE - 1), so the two agree"),
-    "chirp_pingpong:tie:0": (
+    "chirp_pingpong:tie:0": Equivalent(
+        "assign last_pos = (pos_q >= POS_W'(N_RANGE - 1));",
         "last_pos = pos_q >= N_RANGE - 1 instead of ==: pos_q never exceeds N_RANGE - 1 "
         "(chirp_pingpong's proof asserts pos_q <= N_RANGE - 1), so the two agree"),
-    "frame_align:count:6": (
+    "frame_align:count:6": Equivalent(
+        "if (dmg_cnt_q != '1 && !s_axis_tlast) dmg_cnt_q <= dmg_cnt_q + 32'd1;",
         "frames_damaged not counted when s_axis_tlast is high as a fill ends: in FILL the "
         "input holds the first sample of the next chirp (s_axis_tready low, AXI keeps it "
         "stable), and the input contract (the proof's assumption) puts TLAST only on sample "
         "N_RANGE-1 >= 1, so s_axis_tlast is 0 whenever the counter can count"),
-    "frame_align:count:2": (
+    "frame_align:count:2": Equivalent(
+        "if (out_beat && chirp_end && fill_cnt_q != '1 && !s_axis_tlast) "
+        "fill_cnt_q <= fill_cnt_q + 32'd1;",
         "chirps_filled not counted when s_axis_tlast is high as a fill chirp ends: as "
         "frame_align:count:6, in FILL the input holds the first sample of the next chirp "
         "(FILL is entered on a valid first sample, its TREADY is low, so AXI holds TVALID and "
         "the payload), and the input contract (the proof's assumption) puts TLAST only on "
         "sample N_RANGE-1 >= 1: s_axis_tlast is 0 whenever the counter can count "
         "(the proof's bounded base case finds no counterexample either)"),
-    "frame_align:dropfirst:16": (
+    "frame_align:dropfirst:16": Equivalent(
+        "discard_q <= !sof;",
         "discard_q <= !sof instead of gap && !sof: discard_q is written only when need_fill, "
         "and need_fill with !sof needs gap (its arms: frame_begun && (sof || gap), and "
         "!frame_begun && gap && !sof), so the two values agree"),
-    "frame_align:drop:6": (
+    "frame_align:drop:6": Equivalent(
+        "assign need_discard = at_first && !frame_begun && !sof;",
         "need_discard without !gap: differs only when gap && !sof && !frame_begun on a first "
         "sample, where need_fill is true too; PASS tests need_fill first and TREADY/TVALID "
         "are gated by need_fill || need_discard, so nothing changes"),
-    "frame_align:dropfirst:5": (
+    "frame_align:dropfirst:5": Equivalent(
+        "assign need_fill = at_first && ((frame_begun && (sof || gap)) || (gap &&",
         "need_fill's second arm without !frame_begun (gap && !sof): it differs only when "
         "frame_begun && gap, where the first arm, frame_begun && (sof || gap), is true "
         "already"),
-    "frame_align:swap:0": (
+    "frame_align:swap:0": Equivalent(
+        "typedef enum logic [1:0] {FILL, PASS, DISCARD} state_t;",
         "state_t's encoding changed (FILL = 0, PASS = 1): every use names the state, reset "
         "and the default arm load PASS by name, and the fourth code is unreachable either "
         "way; no port shows the encoding"),
-    "frame_align:tie:1": (
+    "frame_align:tie:1": Equivalent(
+        "assign frame_end = chirp_end && (chirp_q >= CHP_W'(FRAME_CHIRPS - 1));",
         "frame_end with chirp_q >= FRAME_CHIRPS - 1 instead of ==: chirp_q never exceeds "
         "FRAME_CHIRPS - 1 (frame_align's proof asserts chirp_q <= FRAME_CHIRPS - 1), so the "
         "two agree"),
-    "frame_store_gearbox:drop:9": (
+    "frame_store_gearbox:drop:9": Equivalent(
+        "if (s_axis_tvalid) full_q <= 1'b1;",
         "split: full_q set on s_axis_tvalid alone: when TVALID is high without TREADY, "
         "full_q is already 1 and is not cleared in that cycle (the clear needs the last "
         "part leaving, which makes TREADY high), so the register is unchanged"),
 }
-"""Surviving mutants that are equivalent (no test can kill them), with the reason; keyed by
-``module:op:index`` of the current sources (docs/verification.md lists them)."""
+"""Surviving mutants that are equivalent (no test can kill them), with their mutated line
+and the reason; keyed by ``module:op:index`` of the current sources (docs/verification.md
+lists them)."""

@@ -19,7 +19,7 @@ from cocotb.triggers import FallingEdge, RisingEdge
 from model import axis_packetizer as pk
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
-from tb import stall_regimes
+from tb import progress, stall_regimes
 
 
 class TB(AxisTB):
@@ -35,6 +35,14 @@ class TB(AxisTB):
         self.lengths: list[int] = []      # cfg_packet_words at each frame's first word
         dut.cfg_packet_words.value = self.packet_words
         cocotb.start_soon(self._watch_lengths())
+        # latency: a packet's first payload word in to its header out (docs/buffers.md);
+        # no owed-frame rule: without input backpressure words are dropped by design and
+        # run-time lengths change the words per frame, so only their most: the payload and
+        # a header and CRC word per packet of the shortest length change_lengths sets
+        shortest = self.shortest_length() if self.header else self.frame_words
+        progress.watch(self, latency=self.packet_words + 2,
+                       most=(self.frame_words,
+                             self.frame_words + 2 * -(-self.frame_words // shortest)))
 
     async def _watch_lengths(self) -> None:
         """Record cfg_packet_words at every frame's first input word."""
@@ -49,10 +57,14 @@ class TB(AxisTB):
                     self.lengths.append(int(d.cfg_packet_words.value))
                 n += 1
 
+    def shortest_length(self) -> int:
+        """The shortest legal cfg_packet_words (at most MAX_PACKETS_PER_FRAME packets)."""
+        return max(2, -(-self.frame_words // pk.MAX_PACKETS_PER_FRAME))
+
     async def change_lengths(self, seed: int) -> None:
         """cfg_packet_words to a random legal length every few to few hundred clocks."""
         rng = np.random.default_rng(seed)
-        lo = max(2, -(-self.frame_words // pk.MAX_PACKETS_PER_FRAME))
+        lo = self.shortest_length()
         while True:
             await self.cycles(int(rng.integers(3, 300)))
             await FallingEdge(self.dut.clk)

@@ -17,6 +17,7 @@ from cocotbext.axi import AxiStreamFrame
 from model import cfar_2d as cm
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 KIND_NAMES = cm.KINDS
 N_CHANNELS = 4  # virtual channels of the test maps (Gamma(4) noise)
@@ -37,6 +38,9 @@ class TB(AxisTB):
         self.set_kind(self.cfg.kind, False)
         self.in_bytes = (self.cfg.pow_w + 7) // 8
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+        cells = self.cfg.n_range * self.cfg.n_doppler
+        progress.watch(self, conserving=True, latency=progress.cfar_latency(self.cfg),
+                       frame=(cells, cells))
 
     def set_kind(self, kind: str, local_max: bool) -> None:
         """Drive cfg_kind (its code, built or not) and cfg_local_max, and cfg_scale with the

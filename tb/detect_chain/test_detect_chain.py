@@ -20,6 +20,7 @@ from model import detect_records as dr
 from model.axis_packetizer import pack_iq, words_to_bytes
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 
 class TB(AxisTB):
@@ -36,6 +37,12 @@ class TB(AxisTB):
         self.set_local_max(False)
         dut.cfg_max_detections.value = self.cfg.max_detections
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+        c = self.cfg
+        # a frame's last word in to its record frame's last word out: the NCI pipeline, the
+        # CFAR's passes over the last rows, the FRAME_WORDS of records, trailer and fill
+        progress.watch(self, latency=progress.NCI_LATENCY + progress.cfar_latency(c.cfar)
+                       + c.frame_words,
+                       frame=(c.num_tx * c.n_range * c.n_doppler, c.frame_words))
 
     def set_local_max(self, on: bool) -> None:
         """cfg_kind = the default kind (KIND), cfg_local_max = ``on``, the scale table."""

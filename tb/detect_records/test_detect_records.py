@@ -25,6 +25,7 @@ from model import cfar_2d as cm
 from model import detect_records as dr
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 GUARD, TRAIN = (1, 1), (1, 2)
 
@@ -50,6 +51,10 @@ class TB(AxisTB):
         dut.snap_data.value = 0
         dut.cfg_max_detections.value = self.max_det
         cocotb.start_soon(self._watch_limits())
+        # latency: a frame's records, trailer and zero fill are FRAME_WORDS words
+        # (docs/detect.md, the record format), so a working block owes no answer for longer
+        progress.watch(self, latency=self.frame_words,
+                       frame=(self.n_range * self.n_doppler, self.frame_words))
 
     async def _watch_limits(self) -> None:
         """Record cfg_max_detections at every frame's first cell beat."""

@@ -24,6 +24,7 @@ from model.axis_packetizer import bytes_to_words, words_to_bytes
 from model.fft_rom import stale_files
 from rtlsim.axis import AxisTB, bursty_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 
 class TB(AxisTB):
@@ -44,6 +45,8 @@ class TB(AxisTB):
         self.default_scale = self.scale_sch == ff.default_scale_sch(self.n)
         self.clear_monitor()
         cocotb.start_soon(self._monitor())
+        progress.watch(self, latency=progress.fft_latency(self.n, self.window),
+                       frame=(self.n_in, self.n_out))
 
     # ------------------------------------------------------------------ monitor
     def clear_monitor(self) -> None:

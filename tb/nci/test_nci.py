@@ -16,6 +16,7 @@ from model import nci as nci_model
 from model.axis_packetizer import words_to_bytes
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 
 class TB(AxisTB):
@@ -32,6 +33,9 @@ class TB(AxisTB):
         self.out_bytes = (self.pow_w + 7) // 8
         self.frame_words = self.num_tx * self.n_range * self.n_doppler
         self.rng = np.random.default_rng(int(os.environ.get("SEED", "1")))
+        # a frame: NUM_TX x N_RANGE x N_DOPPLER words in, N_RANGE x N_DOPPLER cells out
+        progress.watch(self, latency=progress.NCI_LATENCY,
+                       frame=(self.frame_words, self.n_range * self.n_doppler))
 
     def random_frame(self) -> np.ndarray:
         """Random lanes, a quarter of them at the extremes (-32768 squares to 2^30)."""
