@@ -11,7 +11,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import with_timeout
+from cocotb.triggers import RisingEdge, with_timeout
 from cocotbext.axi import AxiStreamFrame
 
 from model import cfar_2d as cm
@@ -67,6 +67,33 @@ class TB(AxisTB):
                                                                     32767)
         return pack_iq(x.reshape(-1, c.num_rx))
 
+    def watch_frame_start(self) -> list[int]:
+        """The input beats taken (``in_beats``: the meter must run) at each ``frame_start``
+        pulse, appended as they come."""
+        seen: list[int] = []
+
+        async def monitor() -> None:
+            while True:
+                await RisingEdge(self.dut.clk)
+                if self.dut.frame_start.value == 1:
+                    seen.append(self.in_beats)
+
+        cocotb.start_soon(monitor())
+        return seen
+
+    def check_frame_starts(self, seen: list[int], n_frames: int) -> None:
+        """One ``frame_start`` per frame, each after the input word that completes the NCI of
+        the frame's first cell of range row 1 (word (r=1, t=NUM_TX-1, d=0), docs/detect.md):
+        the settings may change only then."""
+        c = self.cfg
+        per_frame = c.num_tx * c.n_range * c.n_doppler
+        first = (2 * c.num_tx - 1) * c.n_doppler + 1
+        assert len(seen) == n_frames, f"{len(seen)} frame_start pulses for {n_frames} frames"
+        for k, beats in enumerate(seen):
+            assert beats >= k * per_frame + first, (
+                f"frame {k}: frame_start after {beats} input words, before word "
+                f"{k * per_frame + first - 1} (range row 1) was taken")
+
     async def send_frame(self, words: np.ndarray) -> None:
         nd = self.cfg.n_doppler
         for v in range(len(words) // nd):
@@ -118,11 +145,13 @@ async def test_frames(dut):
     tb = TB(dut)
     tb.start_meter()
     await tb.reset()
+    starts = tb.watch_frame_start()
     c = tb.cfg
     frames = [tb.random_frame(0), tb.random_frame(3),
               tb.random_frame(c.max_detections + 4), tb.random_frame(2)]
     got = await run_frames(tb, frames)
     dec = tb.check(got, frames)
+    tb.check_frame_starts(starts, len(frames))
     counts = [(len(d.records), d.trailer.detections, d.trailer.truncated) for d in dec]
     tb.log.info("records/detections/truncated per frame: %s; %d input words in %d clocks",
                 counts, tb.in_beats, tb.out_last - tb.in_first + 1)
