@@ -24,6 +24,8 @@ from __future__ import annotations
 import cocotb
 from cocotb.triggers import RisingEdge
 
+from model.fft_axis import multipliers_per_lane
+
 MARGIN = 4
 """A ``latency`` limit is this many times the block's documented latency: a block that works
 is silent at most one latency (a frame's tail, its pipeline), one that stopped for good fails
@@ -124,6 +126,7 @@ def cfar_latency(c) -> int:
 def fft_latency(n: int, window: bool) -> int:
     """Clocks from the first sample of an ``n``-point ``fft_axis`` frame in to its first bin
     out (docs/fft_axis.md, "Latency and throughput"): 2N + 2L + 7M + 2, +3 with the window,
-    L = log2 N butterfly stages, M = ceil(L / 2) - 1 twiddle multipliers (log4(N) - 1)."""
+    L = log2 N butterfly stages, M the twiddle multipliers of one lane
+    (``model.fft_axis.multipliers_per_lane``)."""
     stages = n.bit_length() - 1
-    return 2 * n + 2 * stages + 7 * (-(-stages // 2) - 1) + 2 + 3 * int(window)
+    return 2 * n + 2 * stages + 7 * multipliers_per_lane(n) + 2 + 3 * int(window)

@@ -299,6 +299,9 @@ async def test_throughput_latency(dut) -> None:
     periods = [b - a for a, b in zip(firsts, firsts[1:], strict=False)]
     assert all(p == n for p in periods), f"frame periods {periods}, expected {n}"
     assert outs[-1] - outs[0] == (frames - 1) * n + n_out - 1, "output not continuous"
+    expected = progress.fft_latency(n, tb.window)
+    assert firsts[0] - ins[0] == expected, (
+        f"latency {firsts[0] - ins[0]} clocks, docs/fft_axis.md's formula says {expected}")
     res = {
         "N": n, "NUM_CH": tb.ch, "INVERSE": int(tb.inverse), "WINDOW": int(tb.window),
         "period": periods[0],
