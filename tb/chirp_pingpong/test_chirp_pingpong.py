@@ -36,6 +36,16 @@ class TB(AxisTB):
         sof = idx % (chirps_per_frame * self.n_range) == 0
         return words, tlast, sof
 
+    async def start_output_stalled(self) -> bool:
+        """Reset, then stall the range FFT for good (the overflow corners while the ADC
+        cannot stall): False, and the test skips, when built with ADC_BACKPRESSURE=1."""
+        if self.backpressure:
+            self.log.info("needs ADC_BACKPRESSURE=0: skipped")
+            return False
+        await self.reset()
+        self.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
+        return True
+
     async def send(self, words, tlast, sof) -> None:
         """Queue the stream, one AXI frame per TLAST-delimited run."""
         ends = list(np.nonzero(tlast)[0] + 1)
@@ -213,12 +223,9 @@ async def test_overflow_while_resynchronising(dut):
     (the corner where ``!skip_q`` guards the drop counter: mutant
     ``chirp_pingpong:dropfirst:7``)."""
     tb = TB(dut)
-    if tb.backpressure:
-        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+    if not await tb.start_output_stalled():
         return
-    await tb.reset()
     n = tb.n_range
-    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
     words, tlast, sof = tb.stream(6, chirps_per_frame=6)
     tlast = tlast.copy()
     tlast[4 * n - 1] = False      # chirp 3 (banks full): missing TLAST, skips chirp 4
@@ -245,15 +252,12 @@ async def test_counters_saturate(dut):
     overflow drops and a framing error instead of wrapping to 0 (a saturation term dropped:
     mutant chirp_pingpong:drop:10)."""
     tb = TB(dut)
-    if tb.backpressure:
-        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+    if not await tb.start_output_stalled():
         return
-    await tb.reset()
     top = (1 << 32) - 1
     for name in ("drop_cnt_q", "chirp_drop_q", "framing_cnt_q"):
         getattr(dut, name).value = top
     n = tb.n_range
-    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
     words, tlast, sof = tb.stream(5, chirps_per_frame=5)
     tlast = tlast.copy()
     tlast[4 * n - 1] = False      # as test_overflow_while_resynchronising: 2 chirps dropped
@@ -269,12 +273,9 @@ async def test_overflow_flag_stays(dut):
     """status_overflow is sticky: a later chirp ended by an early TLAST (a framing error, not
     an overflow) leaves it set (mutant chirp_pingpong:sticky:2 clears it there)."""
     tb = TB(dut)
-    if tb.backpressure:
-        tb.log.info("needs ADC_BACKPRESSURE=0: skipped")
+    if not await tb.start_output_stalled():
         return
-    await tb.reset()
     n = tb.n_range
-    tb.set_backpressure_generator(itertools.repeat(True))    # range FFT stalled
     words, tlast, sof = tb.stream(3, chirps_per_frame=3)     # chirp 2 dropped: banks full
     await tb.send(words, tlast, sof)
     await tb.source.wait()
