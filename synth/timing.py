@@ -56,6 +56,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", default="1", help="nextpnr seeds, comma-separated (default 1)")
     ap.add_argument("--router", default="router1", choices=("router1", "router2"),
                     help="nextpnr router (default router1; router2 for the top's congestion)")
+    ap.add_argument("--placer", default="heap", choices=("heap", "static", "sa"),
+                    help="nextpnr placer (default heap; static spreads cells by density)")
     ap.add_argument("--no-xcup", action="store_true", help="skip the synth_xilinx depth")
     args = ap.parse_args(argv)
 
@@ -73,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     def one(run: tuple[Job, int]) -> Row:
         job, seed = run
         res = run_job(job, files_for(job.top, files), out / "jobs",
-                      Settings(args.freq, seed, args.router), args.timeout, xcup=not args.no_xcup)
+                      Settings(args.freq, seed, args.router, args.placer), args.timeout, xcup=not args.no_xcup)
         row = Row(job.name, job.label, seconds=res.seconds, error=res.error)
         if not res.error:
             row = job_row(job.name, job.label, res.dir)
@@ -87,7 +89,8 @@ def main(argv: list[str] | None = None) -> int:
         rows = list(pool.map(one, runs))
     header = (f"# make timing: set {args.set}, ECP5 {' '.join(DEVICE)} out of context, "
               f"--freq {args.freq:g}, seeds {args.seeds}"
-              + (f", --router {args.router}" if args.router != "router1" else ""))
+              + (f", --router {args.router}" if args.router != "router1" else "")
+              + (f", --placer {args.placer}" if args.placer != "heap" else ""))
     md = write_report(rows, out, args.freq, header)
     print(md.read_text())
     return 1 if any(r.error for r in rows) else 0

@@ -35,12 +35,15 @@ DEVICE = ["--85k", "--speed", "8", "--package", "CABGA756"]
 @dataclass(frozen=True)
 class Settings:
     """What a job's result depends on besides its sources: the clock constraint (MHz), the
-    nextpnr placer seed and router (``router1``, nextpnr-ecp5's default, or ``router2``, which
-    resolves the congestion of a large design such as the top in fewer iterations)."""
+    nextpnr placer seed, router (``router1``, nextpnr-ecp5's default, or ``router2``, which
+    resolves the congestion of a large design such as the top in fewer iterations) and placer
+    (``heap``, the default analytic placer, ``static``, the electrostatic one that spreads
+    cells by density, or ``sa``)."""
 
     freq_mhz: float = 100.0
     seed: int = 1
     router: str = "router1"
+    placer: str = "heap"
 
 
 @dataclass
@@ -70,7 +73,8 @@ def _pnr_args(settings: Settings) -> list[str]:
     return [*DEVICE, "--out-of-context", "--json", "ecp5.json", "--freq",
             f"{settings.freq_mhz:g}", "--seed", str(settings.seed), "--report", "report.json",
             "--timing-allow-fail", "--threads", "1",
-            *(["--router", settings.router] if settings.router != "router1" else [])]
+            *(["--router", settings.router] if settings.router != "router1" else []),
+            *(["--placer", settings.placer] if settings.placer != "heap" else [])]
 
 
 def job_key(job: Job, files: list[Path], settings: Settings) -> str:

@@ -44,6 +44,7 @@ def test_job_key_changes_with_sources_and_settings(tmp_path: Path) -> None:
     assert k == job_key(job, [f], Settings())
     assert k != job_key(job, [f], Settings(seed=2))
     assert k != job_key(job, [f], Settings(router="router2"))
+    assert k != job_key(job, [f], Settings(placer="static"))
     assert k != job_key(Job("x", "a", {"N": 2}), [f], Settings())
     f.write_text("module a; wire w; endmodule\n")
     assert k != job_key(job, [f], Settings())
