@@ -134,7 +134,8 @@ async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
             raise AssertionError(
                 f"{out} stalled: no output beat for {limit} clocks with its sink not holding "
                 f"one, while {taken} input frames were taken and {answered} answered"
-                f"{' since the output was last held up' if lossy else ''} ({why})")
+                f"{' (those owed when it was last held up forgiven)' if lossy else ''} "
+                f"({why})")
 
 
 # ---- documented latencies of the blocks whose testbenches share them -------------------------
