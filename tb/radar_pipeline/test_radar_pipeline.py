@@ -24,9 +24,9 @@ from cocotb.triggers import RisingEdge
 from host.pipeline import process_cube
 from host.stream import StreamDecoder
 from model.axis_packetizer import (
-    MAX_PACKETS_PER_FRAME,
     packets_per_frame,
     parse_header,
+    shortest_packet_words,
     words_to_bytes,
 )
 from model.config import RadarConfig, get_preset
@@ -116,15 +116,14 @@ def watched(dut) -> PipelineTB:
     shortest legal length (the top's PACKET_WORDS_MIN) for the bound."""
     tb = PipelineTB(dut)
     fw = tb.frame_words
-    shortest = max(2, -(-fw // MAX_PACKETS_PER_FRAME))
     frame_in = frame_beats(tb)
 
     def words(packet: int) -> int:
         return fw + 2 * packets_per_frame(fw, packet) * tb.header
 
     progress.watch(tb, latency=pipeline_latency(tb), frame=(frame_in, words(tb.packet_words)),
-                   most=(frame_in, words(shortest)), start=True, stalls=MEM_STALLS,
-                   lossy=True)
+                   most=(frame_in, words(shortest_packet_words(fw))), start=True,
+                   stalls=MEM_STALLS, lossy=True)
     return tb
 
 
