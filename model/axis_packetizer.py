@@ -76,6 +76,13 @@ def packets_per_frame(frame_words: int, packet_words: int) -> int:
     return -(-frame_words // packet_words)
 
 
+def shortest_packet_words(frame_words: int) -> int:
+    """The shortest packet length :func:`check_geometry` accepts for a frame of
+    ``frame_words`` words: 2, or fewer words would make more than MAX_PACKETS_PER_FRAME
+    packets (the top's PACKET_WORDS_MIN)."""
+    return max(2, -(-frame_words // MAX_PACKETS_PER_FRAME))
+
+
 def check_geometry(frame_words: int, packet_words: int) -> None:
     """Raise ValueError for a packet geometry the RTL refuses (same limits as its $fatal)."""
     if not 2 <= packet_words <= 65535:

@@ -16,10 +16,17 @@ Three kinds of rule (docs/verification.md, "Watchdogs that fail fast"):
   gives more beats than the input frames begun allow (a block that repeats its output for
   ever, which moves beats and so passes the other limits).
 
+For a block that drops frames by design while it is held up (``radar_pipeline``: its ADC
+input never waits, the chirp ping-pong drops), ``start``, ``stalls`` and ``lossy`` adapt the
+output rules: frames counted from a frame start, other ports' stalls are the testbench's too,
+and frames owed when the output was last held up are forgiven.
+
 Imported by cocotb testbenches only (it awaits cocotb triggers).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import cocotb
 from cocotb.triggers import RisingEdge
@@ -34,7 +41,8 @@ within seconds of wall time."""
 
 def watch(tb, stuck: int | None = None, conserving: bool = False, *,
           latency: int | None = None, frame: tuple[int, int] | None = None,
-          most: tuple[int, int] | None = None) -> None:
+          most: tuple[int, int] | None = None, start: bool = False,
+          stalls: Sequence[str] = (), lossy: bool = False) -> None:
     """Start the watchdog of ``tb`` (an ``rtlsim.axis.AxisTB``); every rule is off unless
     its argument is given, and every count restarts in reset.
 
@@ -57,30 +65,47 @@ def watch(tb, stuck: int | None = None, conserving: bool = False, *,
 
     ``conserving``: the block never emits more beats than it took (it may drop, never
     create), so output beyond the input fails at once (a block that repeats its output for
-    ever)."""
-    cocotb.start_soon(_watch(tb, stuck, conserving, latency, frame, most or frame))
+    ever).
+
+    ``start``: input beats count only from the first beat with TUSER[0] (frame start) after
+    reset on (a source that keeps streaming through a reset enters mid-frame, and the block
+    discards up to the next frame start). ``stalls``: handshake prefixes of other ports
+    whose sink is the testbench (``m_axi_mem_aw`` for ``m_axi_mem_awvalid`` /
+    ``awready``): their VALID without READY holds the block up as the output's sink does.
+    ``lossy``: the block drops frames by design while it is held up, so every such clock
+    forgives the frames owed so far (the owed rule counts frames taken from then on against
+    the beats given from then on)."""
+    cocotb.start_soon(_watch(tb, stuck, conserving, latency, frame, most or frame, start,
+                             stalls, lossy))
 
 
 async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
-                 frame: tuple[int, int] | None, most: tuple[int, int] | None) -> None:
+                 frame: tuple[int, int] | None, most: tuple[int, int] | None, start: bool,
+                 stalls: Sequence[str], lossy: bool) -> None:
     d = tb.dut
     inp, out = tb._in_prefix, tb._out_prefix
     s_valid, s_ready, m_valid, m_ready = (
         getattr(d, f"{prefix}_{name}") for prefix, name in (
             (inp, "tvalid"), (inp, "tready"), (out, "tvalid"), (out, "tready")))
+    sof = getattr(d, f"{inp}_tuser") if start else None
+    others = [(getattr(d, f"{p}valid"), getattr(d, f"{p}ready")) for p in stalls]
     limit = MARGIN * latency if latency is not None else None
     why = f"{MARGIN} x the block's latency of {latency} clocks"
-    still = waiting = owing = beats_in = beats_out = 0
+    still = waiting = owing = beats_in = beats_out = forgiven_in = forgiven_out = 0
+    aligned = not start
     while True:
         await RisingEdge(d.clk)
         if d.rst.value == 1:
-            still = waiting = owing = beats_in = beats_out = 0
+            still = waiting = owing = beats_in = beats_out = forgiven_in = forgiven_out = 0
+            aligned = not start
             continue
         offered = s_valid.value == 1
         took = offered and s_ready.value == 1
-        held = m_valid.value == 1 and m_ready.value == 0
+        held = (m_valid.value == 1 and m_ready.value == 0) or any(
+            v.value == 1 and r.value == 0 for v, r in others)
         gave = m_valid.value == 1 and m_ready.value == 1
-        beats_in += took
+        aligned = aligned or (took and int(sof.value) & 1 == 1)
+        beats_in += took and aligned
         beats_out += gave
         if conserving and beats_out > beats_in:
             raise AssertionError(f"{beats_out} beats out of {beats_in} in: output created")
@@ -98,13 +123,19 @@ async def _watch(tb, stuck: int | None, conserving: bool, latency: int | None,
             raise AssertionError(
                 f"{inp} stalled: TVALID high without TREADY for {limit} clocks, no beat "
                 f"moved and {out} not held by its sink ({why})")
-        owed = frame is not None and beats_in // frame[0] > beats_out // frame[1]
-        owing = owing + 1 if owed and not gave and not held else 0
+        if frame is None:
+            continue
+        if lossy and held:
+            forgiven_in, forgiven_out = beats_in // frame[0], beats_out
+        taken = beats_in // frame[0] - forgiven_in
+        answered = (beats_out - forgiven_out) // frame[1]
+        owing = owing + 1 if taken > answered and not gave and not held else 0
         if owing >= limit:
             raise AssertionError(
                 f"{out} stalled: no output beat for {limit} clocks with its sink not holding "
-                f"one, while {beats_in // frame[0]} input frames were taken and "
-                f"{beats_out // frame[1]} answered ({why})")
+                f"one, while {taken} input frames were taken and {answered} answered"
+                f"{' (those owed when it was last held up forgiven)' if lossy else ''} "
+                f"({why})")
 
 
 # ---- documented latencies of the blocks whose testbenches share them -------------------------

@@ -59,7 +59,7 @@ class TB(AxisTB):
 
     def shortest_length(self) -> int:
         """The shortest legal cfg_packet_words (at most MAX_PACKETS_PER_FRAME packets)."""
-        return max(2, -(-self.frame_words // pk.MAX_PACKETS_PER_FRAME))
+        return pk.shortest_packet_words(self.frame_words)
 
     async def change_lengths(self, seed: int) -> None:
         """cfg_packet_words to a random legal length every few to few hundred clocks."""

@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import cocotb
@@ -22,8 +23,14 @@ from cocotb.triggers import RisingEdge
 
 from host.pipeline import process_cube
 from host.stream import StreamDecoder
-from model.axis_packetizer import parse_header, words_to_bytes
+from model.axis_packetizer import (
+    packets_per_frame,
+    parse_header,
+    shortest_packet_words,
+    words_to_bytes,
+)
 from model.config import RadarConfig, get_preset
+from model.detect_chain import DetectConfig
 from model.radar_pipeline import (
     PipelineParams,
     chain_gain,
@@ -36,13 +43,88 @@ from model.simulate import simulate_frame, simulate_scene
 from rtlsim.axis import chirp_bursts, random_pause
 from rtlsim.pipeline import PipelineTB, StallSwitch, assert_packets_equal
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
-from rtlsim.toolchain import rtl_sources, run_cocotb
+from rtlsim.toolchain import param, rtl_sources, run_cocotb
+from tb import progress
 
 SMALL4 = RadarConfig(name="small4", num_tx=4, num_rx=4, n_range=32, n_doppler=32,
                      sample_rate_hz=10e6, chirp_period_s=4e-6, design_max_range_m=50.0)
 SMALL4_TARGETS = (PointTarget(12.0, -20.0, -8.0, 5.0), PointTarget(30.0, 15.0, 11.0, 20.0))
 CONFIGS = {"paper-fpga": (get_preset("paper-fpga"), PipelineParams(packet_words=1024)),
            "small4": (SMALL4, PipelineParams(packet_words=256))}
+
+
+MEM_STALLS = ("m_axi_mem_aw", "m_axi_mem_w", "m_axi_mem_ar")
+"""The external frame store's request channels (FRAME_STORE = 1): the testbench's ``AxiRam``
+refusing one holds the top up as a stalled DMA does (idle, never refused, on chip)."""
+
+
+def pipeline_latency(tb: PipelineTB) -> int:
+    """Clocks from a frame's last ADC sample to its first DMA word: the documented latencies
+    of the blocks on the way, added. The ping-pong's chirp, N_SAMPLES + 2, and frame_align's
+    register (docs/buffers.md 1, 4); the range FFT (``progress.fft_latency``,
+    docs/fft_axis.md); the corner turn, 3 clocks after a frame's last word on chip
+    (docs/buffers.md 2), about a frame plus a strip in external memory (docs/frame_store.md:
+    2 F here, F the cube's words); static removal, a vector + 5 (docs/buffers.md 6); the
+    Doppler FFT; in mode 1 the whole frame through the detector first (F words at one a
+    clock, the CFAR's Doppler wrap N_RBINS 2 PD, the NCI, the CFAR's passes over the last
+    rows, the record frame's FRAME_WORDS: docs/detect.md); then the packetizer, a packet's
+    first payload word to its header, PACKET_WORDS + 2 (docs/buffers.md 3)."""
+    window = bool(param("WINDOW", 1))
+    cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
+    clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + progress.fft_latency(tb.n_range, window)
+              + (2 * cells if param("FRAME_STORE", 0) else 3)
+              + (tb.n_doppler + 5 if param("STATIC_REMOVAL", 0) else 0)
+              + progress.fft_latency(tb.n_doppler, window) + tb.packet_words + 2)
+    if tb.output_mode == 1:
+        cfar = DetectConfig(num_tx=tb.num_tx, num_rx=tb.num_rx, n_range=tb.n_range_bins,
+                            n_doppler=tb.n_doppler, guard=(param("GUARD_R"), param("GUARD_D")),
+                            train=(param("TRAIN_R"), param("TRAIN_D"))).cfar
+        clocks += (cells + tb.n_range_bins * 2 * cfar.pd + progress.NCI_LATENCY
+                   + progress.cfar_latency(cfar) + tb.frame_words)
+    return clocks
+
+
+def frame_beats(tb: PipelineTB) -> int:
+    """ADC beats of one frame: NUM_TX N_LOOPS chirps of N_SAMPLES."""
+    return tb.num_tx * param("N_LOOPS", tb.n_doppler) * param("N_SAMPLES", tb.n_range)
+
+
+async def poll(tb: PipelineTB, ready: Callable[[], bool], what: str) -> None:
+    """Wait clock by clock until ``ready()`` (a condition on the top's internal state), at
+    most ``progress.MARGIN`` x (two frames' ADC beats + :func:`pipeline_latency`) clocks: the
+    frame a test polls for enters at half rate or faster (chirp bursts, 20 % gaps) and then
+    crosses the pipeline. Else AssertionError naming ``what``."""
+    limit = progress.MARGIN * (2 * frame_beats(tb) + pipeline_latency(tb))
+    for _ in range(limit):
+        if ready():
+            return
+        await tb.cycles(1)
+    raise AssertionError(f"waited {limit} clocks for {what}")
+
+
+def watched(dut) -> PipelineTB:
+    """A :class:`PipelineTB` on ``dut`` with ``tb/progress.py``'s port watchdog beside the
+    test (docs/verification.md, "Watchdogs that fail fast"). The ADC input never waits, so
+    only the output rules apply: once a whole ADC frame (NUM_TX N_LOOPS N_SAMPLES beats,
+    counted from a frame start: after a mid-frame reset the top discards up to the next)
+    is in and fewer frames' DMA words have left, the DMA port must give a beat within
+    4 x :func:`pipeline_latency` clocks in which neither it nor the memory (:data:`MEM_STALLS`)
+    is held by its sink; frames owed when the top was last held up are forgiven (it drops
+    chirps by design then); more DMA words than the ADC frames begun allow fails at once.
+    A frame's DMA words: the payload and, with HEADER, a header and CRC word per packet, of
+    PACKET_WORDS for the owed rule (run-time lengths are shorter, never longer) and of the
+    shortest legal length (the top's PACKET_WORDS_MIN) for the bound."""
+    tb = PipelineTB(dut)
+    fw = tb.frame_words
+    frame_in = frame_beats(tb)
+
+    def words(packet: int) -> int:
+        return fw + 2 * packets_per_frame(fw, packet) * tb.header
+
+    progress.watch(tb, latency=pipeline_latency(tb), frame=(frame_in, words(tb.packet_words)),
+                   most=(frame_in, words(shortest_packet_words(fw))), start=True,
+                   stalls=MEM_STALLS, lossy=True)
+    return tb
 
 
 def config_of(tb: PipelineTB) -> tuple[str, RadarConfig, PipelineParams]:
@@ -103,7 +185,7 @@ async def frames_back_to_back_with_dma_stalls(dut) -> None:
     """Three frames back to back, each chirp at one ADC sample per clock with a chirp-long
     gap between chirps, random DMA stalls (30 %): bit-exact packets, clean status, host
     decode and detections identical to the model backend."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     frames = adc_frames(name, cfg, 3)
     got = await tb.stream_under_stalls(frames, cfg, chain, name,
@@ -122,7 +204,7 @@ async def frames_back_to_back_with_dma_stalls(dut) -> None:
 @cocotb.test()
 async def adc_gaps_at_the_real_sample_rate(dut) -> None:
     """ADC valid about one clock in five (19.33 MSPS at 100 MHz) and DMA stalls."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
@@ -137,7 +219,7 @@ async def dma_overload_then_recovery(dut) -> None:
     frame store fills, the ADC ping-pong drops chirps, frame_align zero-fills the damaged
     frames; flags and counters say so, the host reports those frames as damaged, and the
     frames after the stall come out clean and bit-exact."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
@@ -162,7 +244,7 @@ async def reset_mid_stream(dut) -> None:
     """A reset in the middle of frame 0 while the ADC keeps streaming (a real ADC does not
     stop): frame_align discards the rest of frame 0 up to the next frame start, and frames 1
     and 2 come out clean, bit-exact, with frame ids from 0."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
@@ -210,7 +292,7 @@ async def fft_overflow_and_framing_counters(dut) -> None:
     ``fft_overflow_count`` clocks with any overflow event; the flags stay set (sticky)
     through a clean frame, ``framing_error_count`` is the sum of the blocks' counters, and a
     reset clears all of them."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     if name != "small4":
         return
@@ -282,7 +364,7 @@ async def block_framing_flags_reach_the_top(dut) -> None:
     (mutants ``radar_pipeline:merge:4..6``) leaves the status at 0."""
     from cocotb.triggers import FallingEdge
 
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, _, _ = config_of(tb)
     if name != "small4":
         return
@@ -310,7 +392,7 @@ async def throughput_latency(dut) -> None:
     (RP_BENCH_JSON)."""
     import time
 
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = config_of(tb)
     n = 3
     frames = adc_frames(name, cfg, n, seed=3)

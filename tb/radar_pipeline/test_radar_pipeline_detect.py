@@ -19,7 +19,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import SMALL4, adc_frames
+from test_radar_pipeline import SMALL4, adc_frames, poll, watched
 
 from model.axis_packetizer import depacketize
 from model.config import RadarConfig, get_preset
@@ -56,7 +56,7 @@ def crowded_frame(cfg: RadarConfig, k: int) -> np.ndarray:
 
 
 def setup(dut) -> tuple[PipelineTB, str, RadarConfig, PipelineParams]:
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name = os.environ["RP_DETECT_SET"]
     cfg, chain = ALL_SETS[name]
     assert tb.output_mode == 1 and tb.frame_words == chain.frame_words(cfg)
@@ -152,8 +152,9 @@ async def settings_written_mid_frame(dut) -> None:
         await tb.send_frame(adc)
     det = tb.dut.g_detect.u_detect
     row = cfg.n_doppler
-    while not (row + 8 < int(det.cin_q.value) < cfg.n_range * row // 2):
-        await tb.cycles(1)
+    await poll(tb, lambda: row + 8 < int(det.cin_q.value) < cfg.n_range * row // 2,
+               f"the CFAR inside frame 0 (input cell count cin_q in {row + 9}.."
+               f"{cfg.n_range * row // 2 - 1})")
     before = int(det.cin_q.value)
     await tb.write32(regs.address("SETTINGS"),
                      regs.encode("SETTINGS", max_detections=limit, clutter_removal=0,

@@ -15,7 +15,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import SMALL4, assert_recovered, decode
+from test_radar_pipeline import SMALL4, assert_recovered, decode, watched
 from test_radar_pipeline import adc_frames as scene_frames
 
 from model.radar_pipeline import PipelineParams
@@ -56,7 +56,7 @@ async def stalled_frames(tb: PipelineTB, external: bool, chain: PipelineParams,
 async def external_store_bit_exact_with_axi_stalls(dut) -> None:
     """Three frames, ADC chirp bursts, 30 % DMA stalls, random stalls on all five AXI
     channels: packets bit-exact with the model, clean status, no memory error."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     # the on-chip corner turn's packets: FRAME_STORE changes nothing downstream
     _, got = await stalled_frames(tb, True, replace(CHAIN, frame_store=False), "frame store")
     assert int(dut.status_mem_error.value) == 0 and int(dut.mem_error_count.value) == 0
@@ -68,7 +68,7 @@ async def slow_memory_drops_whole_chirps(dut) -> None:
     """The memory stalls 95 % of the time for three frame times while the ADC keeps going:
     the store back-pressures, the ping-pong drops whole chirps (flagged), frame_align marks
     the frames damaged; after the memory recovers the last frame is clean and bit-exact."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     slow = StallSwitch()
     attach_ram(tb, lambda i: slow.pauses(0.95, 40 + i))
     frames = scene_frames("small4", SMALL4, 6, seed=7)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import cocotb
 import numpy as np
-from test_radar_pipeline import SMALL4, adc_frames
+from test_radar_pipeline import SMALL4, adc_frames, poll, watched
 
 from host import regs
 from model.axis_packetizer import packets_per_frame
@@ -110,7 +110,7 @@ async def every_register(tb: PipelineTB, rng: random.Random) -> None:
 
 @cocotb.test()
 async def registers_through_axi_lite(dut) -> None:
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     rng = random.Random(seed())
     tb.attach_regs(lambda: random_pause(AXIL_STALL, rng.randrange(1 << 30)))
     tb.set_idle_generator(chirp_bursts(SMALL4.n_range, SMALL4.n_range))
@@ -154,8 +154,8 @@ async def registers_through_axi_lite(dut) -> None:
     for adc in more:
         await tb.send_frame(adc)
     fw = SMALL4.num_tx * SMALL4.n_range * SMALL4.n_doppler
-    while not (int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1):
-        await tb.cycles(1)
+    await poll(tb, lambda: int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1,
+               "frame 4 streaming into the packetizer (frames_out 4, pk_mid_q 1)")
     await tb.cycles(fw // 4)
     assert int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1
     await write(tb, "PACKET", words=new_words)

@@ -13,7 +13,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import assert_model_detections, decode
+from test_radar_pipeline import assert_model_detections, decode, watched
 
 from model.config import RadarConfig
 from model.radar_pipeline import PipelineParams, run_chain
@@ -63,7 +63,7 @@ async def profile_frames_bit_exact(dut) -> None:
     a real ADC's Q halves driven with noise (ignored): packets bit-exact with the model,
     clean status, every chirp counted, the host's decoded cubes the model's, and (where the
     map holds the host CFAR's window) its detections on them the model backend's."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     name, cfg, chain = set_of(tb)
     n = FRAMES[name]
     sc = Scene(preset="full", targets=TARGETS).scatterers()

@@ -11,12 +11,11 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import SMALL4, decode
+from test_radar_pipeline import SMALL4, decode, watched
 from test_radar_pipeline_frame_store import CHAIN as FS_CHAIN
 from test_radar_pipeline_frame_store import stalled_frames, store_params
 
 from model.radar_pipeline import PipelineParams, dma_packets
-from rtlsim.pipeline import PipelineTB
 from rtlsim.pipeline_rtl import PIPELINE_SOURCES
 from rtlsim.toolchain import param, rtl_sources, run_cocotb
 
@@ -28,7 +27,7 @@ async def static_removal_bit_exact(dut) -> None:
     """Three frames, ADC chirp bursts, 30 % DMA stalls (and AXI stalls with the external
     store): packets bit-exact with the model, clean status; without the removal the same
     frames' packets differ."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     frames, got = await stalled_frames(tb, bool(param("FRAME_STORE", 0)), CHAIN,
                                        "static removal")
     plain = dma_packets(frames, SMALL4, replace(CHAIN, static_removal=False))

@@ -19,7 +19,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from test_radar_pipeline import decode
+from test_radar_pipeline import decode, watched
 
 from model.axis_packetizer import depacketize
 from model.config import RadarConfig
@@ -59,7 +59,7 @@ def adc_frames(n: int, seed: int) -> list[np.ndarray]:
 def setup(dut) -> tuple[PipelineTB, PipelineParams]:
     """The testbench of the set ``RP_TX3_SET``; with the external store an ``AxiRam`` whose
     five channels stall 30 % of the time."""
-    tb = PipelineTB(dut)
+    tb = watched(dut)
     chain = SETS[os.environ["RP_TX3_SET"]]
     assert (tb.num_tx, tb.frame_words) == (3, chain.frame_words(TX3))
     if chain.output_mode == 1:
