@@ -19,6 +19,9 @@
 #                                          registered; table in $(OUT)/timing/timing.md
 #   make timing TIMING_SET=top             the paper-fpga radar_pipeline top (TIMING_SET=all: both)
 #   TIMING_J=2 TIMING_TIMEOUT=3600 TIMING_FREQ=100 TIMING_SEEDS=1,2,3 TIMING_ONLY=range_fft
+#   TIMING_PLACER=heap|static|sa TIMING_ROUTER=router1|router2   nextpnr's placer and router;
+#                                          the top: TIMING_PLACER=static TIMING_TIMEOUT=7200
+#                                          (docs/synth.md, Timing, note 13)
 
 SYNTH_SET  ?= paper-fpga
 SYNTH_ONLY ?=
@@ -30,6 +33,8 @@ TIMING_TIMEOUT ?= 3600
 TIMING_FREQ ?= 100
 TIMING_SEEDS ?= 1
 TIMING_ONLY ?=
+TIMING_PLACER ?= heap
+TIMING_ROUTER ?= router1
 
 .PHONY: synth-estimate synth-vivado timing
 
@@ -45,4 +50,4 @@ synth-vivado: $(STAMP)
 timing: $(STAMP)
 	$(RUN) python -m synth.timing --set $(TIMING_SET) --out $(OUT)/timing -j $(TIMING_J) \
 	  --timeout $(TIMING_TIMEOUT) --freq $(TIMING_FREQ) --seeds $(TIMING_SEEDS) \
-	  $(if $(TIMING_ONLY),--only $(TIMING_ONLY))
+	  --placer $(TIMING_PLACER) --router $(TIMING_ROUTER) $(if $(TIMING_ONLY),--only $(TIMING_ONLY))
