@@ -75,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     def one(run: tuple[Job, int]) -> Row:
         job, seed = run
         res = run_job(job, files_for(job.top, files), out / "jobs",
-                      Settings(args.freq, seed, args.router, args.placer), args.timeout, xcup=not args.no_xcup)
+                      Settings(args.freq, seed, args.router, args.placer), args.timeout,
+                      xcup=not args.no_xcup)
         row = Row(job.name, job.label, seconds=res.seconds, error=res.error)
         if not res.error:
             row = job_row(job.name, job.label, res.dir)
