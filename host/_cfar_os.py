@@ -257,19 +257,69 @@ def os_detect(padded: np.ndarray, alpha: float, guard_r: int, guard_d: int, trai
 
 
 @njit()
+def _kth_keyed(buf: np.ndarray, n: int, k: int, f: np.ndarray, keys: np.ndarray) -> float:
+    """The k-th smallest (k 0-based) of buf[:n] (float64) by 16-bit keys, rearranging buf;
+    NaN (buf unchanged) when a value is NaN or has its sign bit set (then :func:`_kth_near`
+    decides). The keys of :func:`_keys` (unscaled; non-negative values: the float32 bits'
+    top half), non-decreasing in the value, so the k-th value has the k-th key K, found by
+    a binary search on counts of keys <= t (vectorised); it is then the j-th smallest of
+    the few values with key K, j = k - #(key < K) (:func:`_select`). f float32 (n,), keys
+    int16 (n,): scratch."""
+    for i in range(n):
+        f[i] = np.float32(buf[i])
+    b = f.view(np.int32)
+    lo = np.int32(0)
+    hi = np.int32(0)
+    for i in range(n):
+        lo = min(lo, b[i])
+        hi = max(hi, b[i])
+    if lo < 0 or hi > 0x7F800000:         # a sign bit or a NaN
+        return np.nan
+    for i in range(n):
+        keys[i] = np.int16(b[i] >> 16)
+    lo, hi = np.int32(0), np.int32(0x7F80)   # the least t with #(key <= t) > k
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        t = np.int16(mid)
+        c = np.int32(0)
+        for i in range(n):
+            c += np.int32(keys[i] <= t)
+        if c > k:
+            hi = mid
+        else:
+            lo = mid + 1
+    key = np.int16(lo)
+    m = 0
+    less = 0
+    for i in range(n):
+        less += keys[i] < key
+    for i in range(n):                      # the values of key K, to the front
+        if keys[i] == key:
+            buf[m] = buf[i]
+            m += 1
+    return _select(buf, m, k - less, np.nan)
+
+
+@njit()
 def os_kth_at(padded: np.ndarray, rows: np.ndarray, cols: np.ndarray, guard_r: int,
               guard_d: int, train_r: int, train_d: int, k: int) -> np.ndarray:
-    """:func:`os_kth` at the cells (rows[i], cols[i]) only, float64 (len(rows),)."""
+    """:func:`os_kth` at the cells (rows[i], cols[i]) only, float64 (len(rows),): by keys
+    (:func:`_kth_keyed`; cells far apart give :func:`_kth_near` poor guesses)."""
     pr, pd = guard_r + train_r, guard_d + train_d
     n = (2 * pr + 1) * (2 * pd + 1) - (2 * guard_r + 1) * (2 * guard_d + 1)
     buf = np.empty(n)
     side = np.empty(n)
+    f = np.empty(n, np.float32)
+    keys = np.empty(n, np.int16)
     out = np.empty(len(rows))
-    guess = np.nan                           # the previous cell's: often a neighbour
+    guess = np.nan                           # the previous cell's
     for i in range(len(rows)):
         _gather(padded, rows[i], cols[i], guard_r, guard_d, train_r, train_d, buf)
-        guess = _kth_near(buf, n, k - 1, guess, side)
-        out[i] = guess
+        value = _kth_keyed(buf, n, k - 1, f, keys)
+        if value != value:
+            value = _kth_near(buf, n, k - 1, guess, side)
+        guess = value
+        out[i] = value
     return out
 
 
