@@ -208,7 +208,8 @@ def os_detect(padded: np.ndarray, alpha: float, guard_r: int, guard_d: int, trai
     counted as key(fl(alpha x)) <= key(p), at least the number with fl(alpha x) < p: a cell
     where that is below k - (n - m) cannot reach k (the noise: nearly every cell). Then the
     others (cells near targets) count fl(alpha x) < p exactly, in float64, row by row until
-    the count reaches k or cannot."""
+    the count reaches k or cannot: whole rows first, those the first pass did not see
+    first (where a cell that fails mostly fails)."""
     pr, pd = guard_r + train_r, guard_d + train_d
     nr, nd = padded.shape[0] - 2 * pr, padded.shape[1] - 2 * pd
     width = 2 * pd + 1
@@ -221,6 +222,12 @@ def os_detect(padded: np.ndarray, alpha: float, guard_r: int, guard_d: int, trai
         rows += 1
         m += width
     need = k - (n - m)
+    order = np.empty(2 * pr + 1, np.int64)    # the exact count's rows: whole rows first,
+    for i in range(train_r):                  # the bottom ones (not in the first pass) first
+        order[i] = 2 * pr - i
+        order[train_r + i] = i
+    for i in range(2 * guard_r + 1):
+        order[2 * train_r + i] = train_r + i
     count = np.zeros(lanes, np.int16)
     out = np.zeros((nr, nd), np.bool_)
     for r in range(nr):
@@ -238,7 +245,7 @@ def os_detect(padded: np.ndarray, alpha: float, guard_r: int, guard_d: int, trai
                 continue
             c = 0
             left = n                            # training cells not counted yet
-            for i in range(2 * pr + 1):
+            for i in order:
                 if c >= k or c + left < k:      # decided: the rest cannot change it
                     break
                 row = padded[r + i]
