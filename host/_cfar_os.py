@@ -275,8 +275,8 @@ def _kth_keyed(buf: np.ndarray, n: int, k: int, f: np.ndarray, keys: np.ndarray)
     for i in range(n):
         f[i] = np.float32(buf[i])
     b = f.view(np.int32)
-    lo = np.int32(0)
-    hi = np.int32(0)
+    lo = b[0]
+    hi = b[0]
     for i in range(n):
         lo = min(lo, b[i])
         hi = max(hi, b[i])
@@ -284,7 +284,8 @@ def _kth_keyed(buf: np.ndarray, n: int, k: int, f: np.ndarray, keys: np.ndarray)
         return np.nan
     for i in range(n):
         keys[i] = np.int16(b[i] >> 16)
-    lo, hi = np.int32(0), np.int32(0x7F80)   # the least t with #(key <= t) > k
+    lo >>= 16                               # the least t with #(key <= t) > k: between
+    hi >>= 16                               # the smallest and the largest key
     while lo < hi:
         mid = (lo + hi) >> 1
         t = np.int16(mid)

@@ -1,9 +1,9 @@
 """Private backend of ``host.cfar``: the compiled peak grouping (``host.cfar.local_peaks``)
 and sidelobe masking (``host.cfar.sidelobe_masked``) of detected cells, one pass over the
 cells each instead of a numpy pass per neighbour (a frame has tens of cells: the passes'
-overhead was most of the time). The same comparisons on the same values as the numpy code
+overhead was most of the time). The same decisions on the same values as the numpy code
 they replaced: float32 maps compared as float32, their products with the float64 sidelobe
-envelopes taken in float64.
+envelopes taken in float64 (``tests/test_sidelobe_cells.py``).
 """
 
 from __future__ import annotations
