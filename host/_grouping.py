@@ -1,9 +1,9 @@
 """Private backend of ``host.cfar``: the compiled peak grouping (``host.cfar.local_peaks``)
 and sidelobe masking (``host.cfar.sidelobe_masked``) of detected cells, one pass over the
 cells each instead of a numpy pass per neighbour (a frame has tens of cells: the passes'
-overhead was most of the time). The same comparisons on the same values as the numpy code
+overhead was most of the time). The same decisions on the same values as the numpy code
 they replaced: float32 maps compared as float32, their products with the float64 sidelobe
-envelopes taken in float64.
+envelopes taken in float64 (``tests/test_sidelobe_cells.py``).
 """
 
 from __future__ import annotations
@@ -49,6 +49,18 @@ def local_peak_cells(power: np.ndarray, mask: np.ndarray, size_r: int, size_d: i
 
 
 @njit()
+def _doubled(env: np.ndarray, reverse: bool) -> np.ndarray:
+    """env (float64 (f,)) twice over, float64 (2 f,): element j is env[j mod f], or
+    (``reverse``) env[-j mod f], so that an index stepping through a circular axis runs
+    straight through it."""
+    f = env.shape[0]
+    out = np.empty(2 * f)
+    for j in range(2 * f):
+        out[j] = env[(f - j % f) % f] if reverse else env[j % f]
+    return out
+
+
+@njit()
 def sidelobe_cells(power: np.ndarray, cells: np.ndarray, env_r: np.ndarray,
                    env_d: np.ndarray, mirrored: bool) -> np.ndarray:
     """``host.cfar.sidelobe_masked`` of cells (int (n, 2)) of ``power`` (float (n_range,
@@ -56,30 +68,45 @@ def sidelobe_cells(power: np.ndarray, cells: np.ndarray, env_r: np.ndarray,
     the cell's column (``mirrored``: also with (r + r'), the mirror image's) or of power[r,
     d'] env_d[(d - d') mod len] over its row (float64 products; a NaN among them counts as
     numpy's maximum does: it is the maximum) exceeds the cell's power; env_r, env_d:
-    float64 envelopes times the margin."""
+    float64 envelopes times the margin, at least as long as the map's axes. The largest
+    exceeds p exactly when no product is NaN and one exceeds p: two flags per column and
+    row (they vectorise), with the envelopes doubled (:func:`_doubled`) so that their
+    circular index runs straight."""
     nr, nd = power.shape
     fr, fd = env_r.shape[0], env_d.shape[0]
+    if nr > fr or nd > fd:
+        raise ValueError("sidelobe_cells: an envelope shorter than the map's axis")
+    er = _doubled(env_r, True)              # er[q - r + fr] = env_r[(r - q) mod fr]
+    em = _doubled(env_r, False)             # em[r + q] = env_r[(r + q) mod fr]
+    ed = _doubled(env_d, True)
     out = np.zeros(cells.shape[0], np.bool_)
     for i in range(cells.shape[0]):
         r, d = cells[i, 0], cells[i, 1]
         p = np.float64(power[r, d])
-        col = -np.inf
-        k, km = r % fr, r % fr          # (r - q) and (r + q) mod fr, stepped without a division
+        above = False
+        nan = False
+        col = power[:, d]
+        o = fr - r % fr
         for q in range(nr):
-            v = np.float64(power[q, d]) * env_r[k]
-            if mirrored:
-                w = np.float64(power[q, d]) * env_r[km]
-                v = w if (w > v or w != w) and v == v else v
-            col = v if (v > col or v != v) and col == col else col
-            k = k - 1 if k else fr - 1
-            km = km + 1 if km < fr - 1 else 0
-        row = -np.inf
-        k = d % fd
+            v = np.float64(col[q]) * er[o + q]
+            above |= v > p
+            nan |= v != v
+        if mirrored:
+            o = r % fr
+            for q in range(nr):
+                w = np.float64(col[q]) * em[o + q]
+                above |= w > p
+                nan |= w != w
+        masked = above and not nan
+        above = False
+        nan = False
+        row = power[r]
+        o = fd - d % fd
         for q in range(nd):
-            v = np.float64(power[r, q]) * env_d[k]
-            row = v if (v > row or v != v) and row == row else row
-            k = k - 1 if k else fd - 1
-        out[i] = col > p or row > p
+            v = np.float64(row[q]) * ed[o + q]
+            above |= v > p
+            nan |= v != v
+        out[i] = masked or (above and not nan)
     return out
 
 

@@ -36,7 +36,7 @@ from functools import lru_cache
 import numpy as np
 from scipy import stats
 
-from host._cfar_os import os_detect, os_kth, os_kth_at, os_scaled
+from host._cfar_os import os_detect, os_kth, os_kth_at, os_pad
 from host._grouping import local_peak_cells, sidelobe_cells
 from host.kernels import njit, warm_up
 from model.cfar_stats import (  # noqa: F401 - re-exported: host code imports them from here
@@ -134,16 +134,6 @@ def check_window(params: CfarParams, shape: tuple[int, int]) -> None:
         raise ValueError(f"CFAR window: OS-CFAR sorts {n_train} training cells for each of "
                          f"{shape[0] * shape[1]} cells, more than this host allows "
                          f"({OS_MAX_ELEMENTS:.0e} values); use fewer training cells or CA")
-
-
-def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False) -> np.ndarray:
-    """Map padded by the CFAR window's half extent, circularly on both axes (``mirrored``:
-    the range axis reflected at both ends, a real ADC's): ``np.pad``'s ``wrap`` (and
-    ``reflect``) of the window's reach, in one gather (C order)."""
-    (gr, gd), (tr, td) = params.guard, params.train
-    check_window(params, power.shape)
-    return power[np.ix_(_pad_index(power.shape[0], gr + tr, mirrored),
-                        _pad_index(power.shape[1], gd + td, False))]
 
 
 @lru_cache(maxsize=64)
@@ -270,10 +260,15 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
 
 
 def _os_padded(power: np.ndarray, params: CfarParams, windowed: Windows) -> np.ndarray:
-    """``power`` (float (n_range, n_doppler)) as float64 padded by the window's reach
-    (``_pad``), in C order: the OS kernels read rows (a cube's map is often Fortran-ordered)."""
-    return np.ascontiguousarray(_pad(np.asarray(power), params,
-                                     map_axes(windowed, power.shape)[0].real), np.float64)
+    """``power`` (float (n_range, n_doppler)) as float64 padded by the CFAR window's half
+    extent (``host._cfar_os.os_pad``), circularly on both axes (a real ADC's range axis
+    reflected at both ends, without repeating the edge cell: ``np.pad``'s ``wrap`` and
+    ``reflect``), in C order: the OS kernels read rows."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    check_window(params, power.shape)
+    return os_pad(np.asarray(power), _pad_index(power.shape[0], gr + tr,
+                                                 map_axes(windowed, power.shape)[0].real),
+                  _pad_index(power.shape[1], gd + td, False))
 
 
 def _os_k(params: CfarParams) -> int:
@@ -345,9 +340,7 @@ def _os_mask(power: np.ndarray, n_channels: int, params: CfarParams, windowed: W
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     padded = _os_padded(power, params, windowed)
     (gr, gd), (tr, td) = params.guard, params.train
-    scaled = os_scaled(padded, _os_alpha(params.pfa, n_channels, params), np.empty(
-        padded.shape, np.float32 if power.dtype == np.float32 else np.float64))
-    return os_detect(scaled, np.ascontiguousarray(power, scaled.dtype), gr, gd, tr, td,
+    return os_detect(padded, _os_alpha(params.pfa, n_channels, params), gr, gd, tr, td,
                      _os_k(params)), padded
 
 

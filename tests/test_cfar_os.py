@@ -2,15 +2,16 @@
 (``tests/oracles/cfar.py``): the same thresholds and noise estimates bit for bit
 (``host.cfar.cfar_threshold``), and the same detections with the same noise at them
 (``host.cfar.cfar_detect``, which counts instead of selecting), on circular and mirrored
-(real ADC) range axes, windows that reach the map's edges, several ranks, and maps full of
-ties (integer powers, constant regions)."""
+(real ADC) range axes, windows that reach the map's edges, several ranks, maps full of
+ties (integer powers, constant regions), and maps with negative values (the key-based
+searches' fallback)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from host._cfar_os import NEAR_RANKS, _kth_near, _select
+from host._cfar_os import NEAR_RANKS, _kth_keyed, _kth_near, _select
 from host.cfar import CfarParams, cfar_detect, cfar_threshold
 from model.reference import FftAxis
 from tests.oracles.cfar import os_threshold_reference
@@ -100,3 +101,41 @@ def test_kth_near_with_any_guess():
                 for guess in (np.nan, -1e9, 1e9, *s[::max(1, n // 9)], s[k] + 1e-3,
                               s[k] - 1e-3):
                     assert _kth_near(data.copy(), n, k, guess, np.empty(n)) == s[k]
+
+
+def test_os_cfar_with_negative_values():
+    """A map with negative values (not a power map: the 16-bit keys' selection falls back to
+    the search from a guess) detects and estimates as the oracle."""
+    rng = np.random.default_rng(5)
+    power = _map(rng, (40, 48), False) - 3.0
+    axes = _axes((40, 48), False)
+    params = CfarParams(pfa=1e-3, guard=(1, 2), train=(3, 4), kind="os")
+    want_t, want_n = os_threshold_reference(power, 4, params)
+    mask, at = cfar_detect(power, 4, params, axes)
+    np.testing.assert_array_equal(mask, power > want_t)
+    assert mask.any()
+    np.testing.assert_array_equal(at[mask], want_n[mask])
+
+
+def test_kth_keyed():
+    """The k-th smallest by 16-bit keys: values over 60 decades, integer ties, values equal
+    in float32 but not in float64 (one key), infinities; NaN, buffer untouched, for data
+    with a NaN, a negative value or -0.0."""
+    rng = np.random.default_rng(3)
+    for trial in range(400):
+        n = int(rng.integers(1, 300))
+        x = rng.gamma(4, 1.0, n) * 10.0 ** rng.uniform(-30, 30)
+        if trial % 4 == 1:
+            x = np.floor(rng.uniform(0, 4, n))
+        elif trial % 4 == 2:
+            x = 7.0 * (1.0 + 1e-12 * rng.integers(0, 3, n))
+        elif trial % 4 == 3:
+            x[rng.integers(0, n, 3)] = np.inf
+        k = int(rng.integers(0, n))
+        got = _kth_keyed(x.copy(), n, k, np.empty(n, np.float32), np.empty(n, np.int16))
+        assert got == np.sort(x)[k]
+    for bad in (np.nan, -1.0, -0.0):
+        x = np.array([3.0, bad, 1.0, 2.0])
+        buf = x.copy()
+        assert np.isnan(_kth_keyed(buf, 4, 1, np.empty(4, np.float32), np.empty(4, np.int16)))
+        np.testing.assert_array_equal(buf, x)

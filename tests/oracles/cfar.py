@@ -8,7 +8,16 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
-from host.cfar import CfarParams, _kernel, _pad, os_factor
+from host.cfar import CfarParams, _kernel, os_factor
+
+
+def _pad(power: np.ndarray, params: CfarParams, mirrored: bool = False) -> np.ndarray:
+    """``power`` (float (n_range, n_doppler)) padded by the CFAR window's half extent,
+    circularly on both axes (``mirrored``: the range axis reflected at both ends, a real
+    ADC's), by ``np.pad`` (what ``host._cfar_os.os_pad`` gathers)."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    out = np.pad(power, ((gr + tr, gr + tr), (0, 0)), mode="reflect" if mirrored else "wrap")
+    return np.pad(out, ((0, 0), (gd + td, gd + td)), mode="wrap")
 
 
 def _shifted_sum(x: np.ndarray, offsets: range | list[int], axis: int, pad: int,
@@ -31,7 +40,7 @@ def training_sum_reference(power: np.ndarray, params: CfarParams, mirrored: bool
                            ) -> np.ndarray:
     """Sum over each cell's CFAR training cells of ``power`` (float (n_range, n_doppler)),
     float64 of that shape: training rows of the full Doppler extent plus guard rows of the
-    Doppler training cells only, on the map padded by ``host.cfar._pad``."""
+    Doppler training cells only, on the map padded by :func:`_pad`."""
     padded = _pad(np.asarray(power, np.float64), params, mirrored)
     (gr, gd), (tr, td) = params.guard, params.train
     pr, pd = gr + tr, gd + td
