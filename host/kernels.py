@@ -21,6 +21,19 @@ cache directory, when its first kernel is registered, before any is loaded) the 
 of those modules are deleted there (:func:`refresh_cache`); the next calls compile them
 afresh. A module that registers kernels must be named in :data:`KERNEL_MODULES` (:func:`njit`
 refuses others).
+
+Cached = compiled. numba links a copy of every kernel a kernel calls into the caller's code
+(and its cache file), optimised again with the caller, and the process's JIT linker
+resolves a call the caller does not inline to the callee's code loaded first. A compiling
+process always has the callee's own code loaded first (typing the caller compiles it); a
+process loading the caller from the cache alone ran the copy. With ``fastmath`` the two are
+not the same instructions (the peak search's ``_fine_search``: which square of a bin's
+re^2 + im^2 a fused multiply-add takes), so the angles and what follows differed in the
+last bit between a first run and the next (issue 29: 1,200 of 4,080 arrays). So a
+kernel's load from the cache loads first, from the cache, every kernel whose copy its code
+holds (:func:`_load_callees`): cached runs give the compiling runs' bits, in any order of
+calls (the cached runs' bits changed, the compiling runs' did not;
+``tests/test_kernels_cache.py``).
 """
 
 from __future__ import annotations
@@ -49,6 +62,7 @@ STAMP = "host-kernels.sha256"
 from."""
 
 _KERNELS: dict[str, Any] = {}
+"""The registered kernels by module and name (two modules may use one name)."""
 _WARM_UPS: list[Callable[[], None]] = []
 _CHECKED: set[str] = set()
 
@@ -64,13 +78,59 @@ def njit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
                              f"must be listed in KERNEL_MODULES")
         kernel = numba.njit(cache=True, **options)(fn) if COMPILED else fn
         if COMPILED:
+            _callees_first(kernel)
             path = getattr(getattr(kernel, "_cache", None), "_cache_path", None)
             if isinstance(path, str) and path not in _CHECKED:
                 _CHECKED.add(path)
                 refresh_cache(Path(path), _module_files())
-        _KERNELS[fn.__name__] = kernel
+        _KERNELS[f"{fn.__module__}.{fn.__name__}"] = kernel
         return kernel
     return wrap
+
+
+def _callees_first(kernel: Any) -> None:
+    """Make ``kernel``'s loads from numba's disk cache load the kernels it calls first
+    (module docstring, "Cached = compiled"): its cache's rebuild step, which adds the
+    cached object code to the process, is wrapped."""
+    impl = getattr(getattr(kernel, "_cache", None), "_impl", None)
+    rebuild = getattr(impl, "rebuild", None)
+    if rebuild is None:
+        return
+
+    def rebuild_after_callees(target_context: Any, payload: Any) -> Any:
+        _load_callees(kernel, payload[0])
+        return rebuild(target_context, payload)
+    impl.rebuild = rebuild_after_callees
+
+
+def _load_callees(kernel: Any, libdata: Any) -> None:
+    """Load from the cache every overload of each other kernel whose symbol the cached
+    library ``libdata`` (numba's serialised form: name, "object", (object code, bitcode))
+    names (the copies linked into it), as a compiling process has them loaded."""
+    _, kind, data = libdata
+    if kind != "object":
+        return
+    for other in _KERNELS.values():
+        if other is not kernel and _mangled_prefix(other).encode() in data[0]:
+            _load_cached(other)
+
+
+def _mangled_prefix(kernel: Any) -> str:
+    """The start of the symbol numba gives ``kernel``'s compiled code (Itanium mangling of
+    its module and name, then its ABI tags)."""
+    parts = kernel.py_func.__module__.split(".") + kernel.py_func.__qualname__.split(".")
+    return "_ZN" + "".join(f"{len(p)}{p}" for p in parts) + "B"
+
+
+def _load_cached(kernel: Any) -> None:
+    """Load every overload of ``kernel`` that numba's disk cache holds for this process
+    (its code and CPU); overloads already loaded are kept."""
+    cache = kernel._cache
+    codegen = kernel.targetctx.codegen()
+    for key in cache._cache_file._load_index():
+        sig = key[0]
+        if key == cache._index_key(sig, codegen):
+            kernel.compile(sig)
 
 
 def _module_files() -> list[Path]:
@@ -123,12 +183,12 @@ def uncompiled_kernels() -> list[str]:
         return []
     _load_kernels()
     missing = []
-    for name, kernel in sorted(_KERNELS.items()):
+    for key, kernel in _KERNELS.items():
         cache_file = getattr(getattr(kernel, "_cache", None), "_cache_file", None)
         index = getattr(cache_file, "_index_path", None)
         if isinstance(index, str) and not os.path.exists(index):
-            missing.append(name)
-    return missing
+            missing.append(key.rsplit(".", 1)[1])
+    return sorted(missing)
 
 
 def warm_up(fn: Callable[[], None]) -> Callable[[], None]:

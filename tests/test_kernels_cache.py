@@ -10,6 +10,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from host import kernels
@@ -96,3 +97,48 @@ def test_every_kernel_module_is_listed() -> None:
     kernels._load_kernels()
     assert {k.__module__ if not hasattr(k, "py_func") else k.py_func.__module__
             for k in kernels._KERNELS.values()} == set(kernels.KERNEL_MODULES)
+
+
+ANGLES = """\
+import sys
+import numpy as np
+from host._angle_peaks import class_peaks
+from host._angle_relax import first_components
+rng = np.random.default_rng(5)
+x = rng.standard_normal((64, 8)) + 1j * rng.standard_normal((64, 8))
+ph = np.exp(1j * rng.uniform(0.0, 6.3, (64, 2)))
+power, sin = class_peaks(x, np.arange(64), ph, 1024)
+xc, a1, p1, maybe, split = first_components(x, ph, sin, np.full(64, 0.1), 12.0, 20.0, -10.0)
+np.savez(sys.argv[1], power=power, sin=sin, xc=xc, a1=a1, p1=p1, maybe=maybe, split=split)
+"""
+
+
+@pytest.mark.skipif(not kernels.COMPILED, reason="numba not installed: nothing is cached")
+def test_cached_kernels_give_the_compiled_bits(tmp_path: Path) -> None:
+    """A process that compiles the angle kernels and one that loads them from the cache give
+    the same bits (``host.kernels`` module docstring, "Cached = compiled"): the peak search
+    calls ``_fine_search``, whose copy inside its caller's cached code differs in the last
+    bit from its own compiled code, which a compiling process runs. A private cache
+    (NUMBA_CACHE_DIR), so other processes' caches are not touched."""
+    script = tmp_path / "angles.py"
+    script.write_text(ANGLES)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join(
+        [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    outs = []
+    for mode in ("compiled", "cached"):
+        outs.append(tmp_path / f"{mode}.npz")
+        subprocess.run([sys.executable, str(script), str(outs[-1])], env=env, check=True,
+                       timeout=600)
+    compiled, cached = np.load(outs[0]), np.load(outs[1])
+    for name in compiled.files:
+        assert compiled[name].tobytes() == cached[name].tobytes(), name
+
+
+@pytest.mark.skipif(not kernels.COMPILED, reason="numba not installed: nothing is cached")
+def test_kernel_symbols_have_the_mangled_prefix() -> None:
+    """The prefix :func:`host.kernels._load_callees` finds a callee's copy by is the start of
+    the kernel's compiled symbol (numba's mangling), so cached callers still load it."""
+    from host._angle_peaks import _interpolated_sin
+    _interpolated_sin(3, 1.0, 2.0, 1.0, 16)
+    for cres in _interpolated_sin.overloads.values():
+        assert cres.fndesc.mangled_name.startswith(kernels._mangled_prefix(_interpolated_sin))
