@@ -153,24 +153,43 @@ module fft_twiddle_props #(
   input wire logic [9:0]  in_data,
   input wire logic        in_vld,
   input wire logic [3:0]  in_pos,
-  input wire logic        in_ov
+  input wire logic        in_ov,
+  input wire logic [3:0]  in_pos_ahead
 );
   localparam int W = 5, LOG2N = 4;
   logic [2*W-1:0]   out_data;
   logic             out_vld, out_ov;
   logic [LOG2N-1:0] out_pos;
 
+  // in_pos_ahead is free; in_pos is its value two enabled cycles earlier (what the
+  // butterfly before the twiddle gives: its head's index leaves two advances later), and no
+  // valid sample enters before two enabled cycles have passed (the butterfly's two output
+  // registers are reset)
+  logic [LOG2N-1:0] pa1_q, pa2_q;
+  logic [1:0]       n_en_q = 2'd0;
+  always_ff @(posedge clk) begin
+    if (en) begin
+      pa1_q <= in_pos_ahead;
+      pa2_q <= pa1_q;
+      if (n_en_q != 2'd2) n_en_q <= n_en_q + 2'd1;
+    end
+  end
+  always_comb assume (in_pos == pa2_q);
+  always_comb assume (!in_vld || n_en_q == 2'd2);
+
   fft_twiddle #(.NUM_CH(1), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N), .INVERSE(1'b0)) dut (
-    .clk, .rst, .en, .in_data, .in_vld, .in_pos, .in_ov, .out_data, .out_vld, .out_pos,
-    .out_ov);
+    .clk, .rst, .en, .in_data, .in_vld, .in_pos, .in_ov, .in_pos_ahead, .out_data, .out_vld,
+    .out_pos, .out_ov);
 
   initial assume (rst);
-  localparam int LAT = 7;   // fft_twiddle's stages
+  localparam int LAT = 5;   // fft_twiddle's stages
   f_vld_pipe #(.LAT(LAT), .POS_W(LOG2N), .FAIR(FAIR)) u_pipe (
     .clk, .rst, .en, .in_vld, .in_pos, .out_vld, .out_pos);
 
   // the overflow flag travels with its sample: an input flag always comes out set;
-  // position 0 has twiddle 1 (cos 1, sin 0): the sample leaves unchanged, without overflow
+  // a position whose twiddle exponent i0 * (b1 + 2 b0) is 0 (i0 = pos[1:0] or the pair
+  // {pos[2], pos[3]} zero) has twiddle 1 (cos 1, sin 0): the sample leaves unchanged, without
+  // overflow (its coefficient looked up from its own position, two advances ahead)
   logic       past = 1'b0;
   logic [LAT-1:0] ov_q, p0_q;
   logic [LAT-1:0][9:0] d_q;
@@ -178,7 +197,7 @@ module fft_twiddle_props #(
     past <= 1'b1;
     if (en) begin
       ov_q <= {ov_q[LAT-2:0], in_ov};
-      p0_q <= {p0_q[LAT-2:0], in_pos == '0};
+      p0_q <= {p0_q[LAT-2:0], in_pos[1:0] == 2'd0 || in_pos[3:2] == 2'd0};
       d_q  <= {d_q[LAT-2:0], in_data};
     end
   end

@@ -155,7 +155,7 @@ module fft_axis #(
   for (genvar s = 0; s < LOG2N; s++) begin : g_stage
     logic [DW-1:0]    bo_data;
     logic             bo_vld, bo_ov;
-    logic [LOG2N-1:0] bo_pos;
+    logic [LOG2N-1:0] bo_pos, bo_pos_ahead;
 
     fft_sdf_bf #(
       .NUM_CH(NUM_CH), .W(W), .LOG2N(LOG2N), .D(N >> (s + 1)),
@@ -163,7 +163,8 @@ module fft_axis #(
     ) u_bf (
       .clk, .rst, .en(adv),
       .in_data(st_data[s]), .in_vld(st_vld[s]), .in_pos(st_pos[s]), .in_ov(st_ov[s]),
-      .out_data(bo_data), .out_vld(bo_vld), .out_pos(bo_pos), .out_ov(bo_ov)
+      .out_data(bo_data), .out_vld(bo_vld), .out_pos(bo_pos), .out_ov(bo_ov),
+      .out_pos_ahead(bo_pos_ahead)
     );
 
     if (s % 2 == 1 && s + 1 < LOG2N) begin : g_tw
@@ -173,6 +174,7 @@ module fft_axis #(
       ) u_tw (
         .clk, .rst, .en(adv),
         .in_data(bo_data), .in_vld(bo_vld), .in_pos(bo_pos), .in_ov(bo_ov),
+        .in_pos_ahead(bo_pos_ahead),
         .out_data(st_data[s+1]), .out_vld(st_vld[s+1]), .out_pos(st_pos[s+1]),
         .out_ov(st_ov[s+1])
       );
@@ -181,6 +183,10 @@ module fft_axis #(
       assign st_vld[s+1]  = bo_vld;
       assign st_pos[s+1]  = bo_pos;
       assign st_ov[s+1]   = bo_ov;
+      /* verilator lint_off UNUSEDSIGNAL */
+      logic unused_ahead;   // only a twiddle looks ahead
+      assign unused_ahead = ^bo_pos_ahead;
+      /* verilator lint_on UNUSEDSIGNAL */
     end
   end
 

@@ -36,7 +36,10 @@ module fft_sdf_bf #(
   output logic [NUM_CH*2*W-1:0] out_data,
   output logic                  out_vld,
   output logic [LOG2N-1:0]      out_pos,
-  output logic                  out_ov
+  output logic                  out_ov,
+  // Index of the sample out_pos shows two advances later (the delay line's head), for a
+  // twiddle that looks its coefficient up ahead of the data.
+  output logic [LOG2N-1:0]      out_pos_ahead
 );
 
   localparam int DW = NUM_CH * 2 * W;
@@ -195,6 +198,7 @@ module fft_sdf_bf #(
   assign out_vld  = out_vld_q;
   assign out_pos  = out_pos_q;
   assign out_ov   = out_ov_q;
+  assign out_pos_ahead = head_pos;   // -> pos1_q -> out_pos_q
 endmodule
 
 `default_nettype wire

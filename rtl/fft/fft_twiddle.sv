@@ -3,9 +3,12 @@
 // W_M^(i0*(b1+2*b0)) in the quarter-wave ROM from the sample's index tag and multiplies every
 // lane with registered inputs and products (DSP48E2 friendly; three real products per lane,
 // Gauss, four for W = 27), exact sums, convergent rounding, saturation.
-// Seven register stages: ROM index; quarter-wave ROM words; coefficients (quadrant, Gauss
-// pre-adds) and data pre-add; every multiplier's own operands; products; exact sums; rounded
-// and saturated result.
+// The coefficient runs two advances ahead of its sample: the ROM index is formed from
+// in_pos_ahead, the index of the sample that enters two advances later (the preceding
+// butterfly's delay-line head), and the quarter-wave ROM words are registered by the time that
+// sample enters, so the data needs no delay to wait for them. Five register stages from
+// in_data: coefficients (quadrant, Gauss pre-adds) and data pre-add; every multiplier's own
+// operands; products; exact sums; rounded and saturated result.
 // The operand stage gives each lane's products their own copy of the shared coefficients and
 // of the data (one fan-out each), so a place and route puts them beside the multiplier
 // (on an ECP5 a product wider than 18 bits is two MULT18X18D and the sum of their partial
@@ -35,7 +38,9 @@ module fft_twiddle #(
   input  logic                  in_vld,
   input  logic [LOG2N-1:0]      in_pos,
   input  logic                  in_ov,
-  // Sample out, 7 advances later.
+  // Index of the sample that enters two advances later (in_pos then).
+  input  logic [LOG2N-1:0]      in_pos_ahead,
+  // Sample out, 5 advances later.
   output logic [NUM_CH*2*W-1:0] out_data,
   output logic                  out_vld,
   output logic [LOG2N-1:0]      out_pos,
@@ -56,20 +61,20 @@ module fft_twiddle #(
     $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
   end
 
-  // ---------------------------------------------------------------- stage 1: ROM index
-  // e = i0 * m, m = {in_pos[LOG2M-2], in_pos[LOG2M-1]} (b1 + 2*b0), as a shift-add (no
-  // multiplier); ROM index e * 2^(ROM_LOG2 - LOG2M)
+  // ------------------------------------------------ two advances ahead: ROM index
+  // e = i0 * m, m = {pos[LOG2M-2], pos[LOG2M-1]} (b1 + 2*b0), as a shift-add (no
+  // multiplier); ROM index e * 2^(ROM_LOG2 - LOG2M); pos = in_pos_ahead
   logic [ROM_LOG2-1:0] idx_q;
   always_ff @(posedge clk) begin
     logic [ROM_LOG2-1:0] i0;
     if (en) begin
-      i0 = ROM_LOG2'(in_pos[LOG2M-3:0]);
-      idx_q <= ROM_LOG2'(((in_pos[LOG2M-1] ? i0 : '0) + (in_pos[LOG2M-2] ? i0 << 1 : '0))
-                         << (ROM_LOG2 - LOG2M));
+      i0 = ROM_LOG2'(in_pos_ahead[LOG2M-3:0]);
+      idx_q <= ROM_LOG2'(((in_pos_ahead[LOG2M-1] ? i0 : '0)
+                          + (in_pos_ahead[LOG2M-2] ? i0 << 1 : '0)) << (ROM_LOG2 - LOG2M));
     end
   end
 
-  // ---------------------------------------------------------------- stage 2: ROM words
+  // ------------------------------------------------ one advance ahead: ROM words
   // C = COS(k), S = SIN(k) = COS(k - 1024): quarter-wave ROM (generated, combinational),
   // registered
   logic [COEF_W-1:0] rom_cos, rom_sin, cos2_q, sin2_q;
@@ -81,21 +86,38 @@ module fft_twiddle #(
     end
   end
 
-  // ---------------------------------------------------------------- stages 3, 4: operands
-  logic [DW-1:0]        da_q, db_q, d1_q, d4_q;   // data in stages 1, 2, 3, 4
-  logic [LOG2N-1:0]     pos_q [7];
-  logic                 ov_q  [6];
-  logic [6:0]           vld_q;
+  // ---------------------------------------------------------------- stages 1, 2: operands
+  logic [DW-1:0]        d1_q, d2_q;   // data in stages 1, 2
+  logic [LOG2N-1:0]     pos_q [5];
+  logic                 ov_q  [4];
+  logic [4:0]           vld_q;
 
-  // ---------------------------------------------------------------- stage 7: round, sat
-  logic [DW-1:0] y_d, y7_q;
-  logic          y_ov, ov7_q;
+  // The coefficients of stage 1 (shared by the lanes) and their per-lane copies of stage 2:
+  // NCF words (Gauss: C, d - C, -C - d; four products: C, S), lane ch's word i at
+  // ch * NCF + i.
+  localparam int NCF = GAUSS ? 3 : 2;
+  logic signed [COEF_W-1:0] cf1_q [NCF];
+  logic signed [COEF_W-1:0] cf2_q [NUM_CH * NCF];
 
-  // Products (stage 5) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
-  // the inverse has S -> -S), full precision before the rounding (stage 6): two forms,
+  // keep: the per-lane copies hold the same bits, which Yosys' opt_merge would merge back
+  // into one register feeding every lane's multipliers
+  (* keep *) always_ff @(posedge clk) begin
+    if (en) begin
+      for (int ch = 0; ch < NUM_CH; ch++) begin
+        for (int i = 0; i < NCF; i++) cf2_q[ch * NCF + i] <= cf1_q[i];
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------- stage 5: round, sat
+  logic [DW-1:0] y_d, y5_q;
+  logic          y_ov, ov5_q;
+
+  // Products (stage 3) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
+  // the inverse has S -> -S), full precision before the rounding (stage 4): two forms,
   // same bits.
   logic signed [PRW+1:0] yr_full [NUM_CH], yi_full [NUM_CH];
-  logic signed [PRW+1:0] yr6_q [NUM_CH], yi6_q [NUM_CH];
+  logic signed [PRW+1:0] yr4_q [NUM_CH], yi4_q [NUM_CH];
 
   if (GAUSS) begin : g_gauss
     // Three real products per lane (Gauss): with d = -S (forward) or +S (inverse)
@@ -104,11 +126,8 @@ module fft_twiddle #(
     // shared by every lane); the data pre-add re + im is W+1 <= 27 bits (DSP48E2 A port).
     // Both sums are additions of a product to k1 (k3 takes the negated coefficient), the form
     // a DSP48E2 post-adder with its P register takes (C port = k1).
-    logic signed [COEF_W-1:0] c1_q, p1_q, m1_q;   // C, d - C, -C - d
     logic signed [W:0]        a1_q [NUM_CH];      // re + im
-    // stage 4: each lane's operands (the coefficients copied per lane)
-    logic signed [COEF_W-1:0] c4_q [NUM_CH], p4_q [NUM_CH], m4_q [NUM_CH];
-    logic signed [W:0]        a4_q [NUM_CH];
+    logic signed [W:0]        a2_q [NUM_CH];      // stage 2: each lane's operands
     logic signed [PRW:0]      k1_q [NUM_CH];
     logic signed [PRW-1:0]    k2_q [NUM_CH];
     logic signed [PRW-1:0]    k3_q [NUM_CH];
@@ -119,28 +138,16 @@ module fft_twiddle #(
 
     always_ff @(posedge clk) begin
       if (en) begin
-        c1_q <= signed'(cos2_q);
-        p1_q <= COEF_W'(INVERSE ? ss - cc : -ss - cc);
-        m1_q <= COEF_W'(INVERSE ? -cc - ss : ss - cc);
+        cf1_q[0] <= signed'(cos2_q);                           // C
+        cf1_q[1] <= COEF_W'(INVERSE ? ss - cc : -ss - cc);     // d - C
+        cf1_q[2] <= COEF_W'(INVERSE ? -cc - ss : ss - cc);     // -C - d
         for (int ch = 0; ch < NUM_CH; ch++) begin
-          a1_q[ch] <= (W+1)'(signed'(db_q[ch*2*W +: W]))
-                    + (W+1)'(signed'(db_q[ch*2*W + W +: W]));
-          a4_q[ch] <= a1_q[ch];
-          k1_q[ch] <= (PRW+1)'(a4_q[ch]) * (PRW+1)'(c4_q[ch]);
-          k2_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(p4_q[ch]);
-          k3_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(m4_q[ch]);
-        end
-      end
-    end
-
-    // keep: the per-lane copies hold the same bits, which Yosys' opt_merge would merge back
-    // into one register feeding every lane's multipliers
-    (* keep *) always_ff @(posedge clk) begin
-      if (en) begin
-        for (int ch = 0; ch < NUM_CH; ch++) begin
-          c4_q[ch] <= c1_q;
-          p4_q[ch] <= p1_q;
-          m4_q[ch] <= m1_q;
+          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
+                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+          a2_q[ch] <= a1_q[ch];
+          k1_q[ch] <= (PRW+1)'(a2_q[ch]) * (PRW+1)'(cf2_q[ch*NCF]);
+          k2_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+          k3_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 2]);
         end
       end
     end
@@ -153,8 +160,6 @@ module fft_twiddle #(
     end
   end else begin : g_four
     // Four real products per lane (W = 27: the pre-add would not fit the 27-bit A port).
-    logic signed [COEF_W-1:0] c1_q, s1_q;
-    logic signed [COEF_W-1:0] c4_q [NUM_CH], s4_q [NUM_CH];   // stage 4: per lane
     logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
     logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
     logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
@@ -162,23 +167,13 @@ module fft_twiddle #(
 
     always_ff @(posedge clk) begin
       if (en) begin
-        c1_q <= signed'(cos2_q);
-        s1_q <= signed'(sin2_q);
+        cf1_q[0] <= signed'(cos2_q);   // C
+        cf1_q[1] <= signed'(sin2_q);   // S
         for (int ch = 0; ch < NUM_CH; ch++) begin
-          prc_r_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(c4_q[ch]);
-          prs_i_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(s4_q[ch]);
-          prc_i_q[ch] <= PRW'(signed'(d4_q[ch*2*W + W +: W])) * PRW'(c4_q[ch]);
-          prs_r_q[ch] <= PRW'(signed'(d4_q[ch*2*W +: W])) * PRW'(s4_q[ch]);
-        end
-      end
-    end
-
-    // keep: per-lane copies of the same bits (see g_gauss)
-    (* keep *) always_ff @(posedge clk) begin
-      if (en) begin
-        for (int ch = 0; ch < NUM_CH; ch++) begin
-          c4_q[ch] <= c1_q;
-          s4_q[ch] <= s1_q;
+          prc_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF]);
+          prs_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+          prc_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF]);
+          prs_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
         end
       end
     end
@@ -198,20 +193,18 @@ module fft_twiddle #(
 
   always_ff @(posedge clk) begin
     if (en) begin
-      da_q     <= in_data;
-      db_q     <= da_q;
-      d1_q     <= db_q;
-      d4_q     <= d1_q;
+      d1_q     <= in_data;
+      d2_q     <= d1_q;
       pos_q[0] <= in_pos;
       ov_q[0]  <= in_ov;
-      for (int k = 1; k < 7; k++) pos_q[k] <= pos_q[k-1];
-      for (int k = 1; k < 6; k++) ov_q[k] <= ov_q[k-1];
+      for (int k = 1; k < 5; k++) pos_q[k] <= pos_q[k-1];
+      for (int k = 1; k < 4; k++) ov_q[k] <= ov_q[k-1];
       for (int ch = 0; ch < NUM_CH; ch++) begin
-        yr6_q[ch] <= yr_full[ch];
-        yi6_q[ch] <= yi_full[ch];
+        yr4_q[ch] <= yr_full[ch];
+        yi4_q[ch] <= yi_full[ch];
       end
-      y7_q     <= y_d;
-      ov7_q    <= ov_q[5] | y_ov;
+      y5_q     <= y_d;
+      ov5_q    <= ov_q[3] | y_ov;
     end
   end
 
@@ -220,8 +213,8 @@ module fft_twiddle #(
     y_d  = '0;
     y_ov = 1'b0;
     for (int ch = 0; ch < NUM_CH; ch++) begin
-      yr = fft_pkg::round_conv(64'(yr6_q[ch]), COEF_FRAC);
-      yi = fft_pkg::round_conv(64'(yi6_q[ch]), COEF_FRAC);
+      yr = fft_pkg::round_conv(64'(yr4_q[ch]), COEF_FRAC);
+      yi = fft_pkg::round_conv(64'(yi4_q[ch]), COEF_FRAC);
       y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
       y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
       y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));
@@ -232,14 +225,14 @@ module fft_twiddle #(
     if (rst) begin
       vld_q <= '0;
     end else if (en) begin
-      vld_q <= {vld_q[5:0], in_vld};
+      vld_q <= {vld_q[3:0], in_vld};
     end
   end
 
-  assign out_data = y7_q;
-  assign out_vld  = vld_q[6];
-  assign out_pos  = pos_q[6];
-  assign out_ov   = ov7_q;
+  assign out_data = y5_q;
+  assign out_vld  = vld_q[4];
+  assign out_pos  = pos_q[4];
+  assign out_ov   = ov5_q;
 endmodule
 
 `default_nettype wire
