@@ -146,6 +146,12 @@ CFAR_PIPELINE = 10
 """Clocks from a column read to the decision (docs/detect.md, cfar_2d)."""
 
 
+def packetizer_latency(packet_words: int) -> int:
+    """Clocks from a packet's first payload word into ``axis_packetizer`` to its header out
+    (docs/buffers.md 3): the packet is held whole, PACKET_WORDS + 2."""
+    return packet_words + 2
+
+
 def cfar_latency(c) -> int:
     """Clocks from a frame's last cell into ``cfar_2d`` (``c`` a ``model.cfar_2d.Cfar2dConfig``)
     to its last cell out (docs/detect.md, cfar_2d's streaming schedule): the PR+1 passes

@@ -40,9 +40,10 @@ class TB(AxisTB):
         # run-time lengths change the words per frame, so only their most: the payload and
         # a header and CRC word per packet of the shortest length change_lengths sets
         shortest = self.shortest_length() if self.header else self.frame_words
-        progress.watch(self, latency=self.packet_words + 2,
+        progress.watch(self, latency=progress.packetizer_latency(self.packet_words),
                        most=(self.frame_words,
-                             self.frame_words + 2 * -(-self.frame_words // shortest)))
+                             self.frame_words
+                             + 2 * pk.packets_per_frame(self.frame_words, shortest)))
 
     async def _watch_lengths(self) -> None:
         """Record cfg_packet_words at every frame's first input word."""

@@ -68,13 +68,14 @@ def pipeline_latency(tb: PipelineTB) -> int:
     Doppler FFT; in mode 1 the whole frame through the detector first (F words at one a
     clock, the CFAR's Doppler wrap N_RBINS 2 PD, the NCI, the CFAR's passes over the last
     rows, the record frame's FRAME_WORDS: docs/detect.md); then the packetizer, a packet's
-    first payload word to its header, PACKET_WORDS + 2 (docs/buffers.md 3)."""
+    first payload word to its header (``progress.packetizer_latency``)."""
     window = bool(param("WINDOW", 1))
     cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
     clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + progress.fft_latency(tb.n_range, window)
               + (2 * cells if param("FRAME_STORE", 0) else 3)
               + (tb.n_doppler + 5 if param("STATIC_REMOVAL", 0) else 0)
-              + progress.fft_latency(tb.n_doppler, window) + tb.packet_words + 2)
+              + progress.fft_latency(tb.n_doppler, window)
+              + progress.packetizer_latency(tb.packet_words))
     if tb.output_mode == 1:
         cfar = DetectConfig(num_tx=tb.num_tx, num_rx=tb.num_rx, n_range=tb.n_range_bins,
                             n_doppler=tb.n_doppler, guard=(param("GUARD_R"), param("GUARD_D")),
