@@ -228,6 +228,8 @@ def os_detect(padded: np.ndarray, alpha: float, guard_r: int, guard_d: int, trai
         order[train_r + i] = i
     for i in range(2 * guard_r + 1):
         order[2 * train_r + i] = train_r + i
+    # int16 counts: n < 2^15, since the map holds the window (cells > n) and
+    # host.cfar.check_window bounds n x cells by OS_MAX_ELEMENTS (so n < 14 143)
     count = np.zeros(lanes, np.int16)
     out = np.zeros((nr, nd), np.bool_)
     for r in range(nr):
