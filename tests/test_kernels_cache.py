@@ -127,8 +127,11 @@ def test_cached_kernels_give_the_compiled_bits(tmp_path: Path) -> None:
     outs = []
     for mode in ("compiled", "cached"):
         outs.append(tmp_path / f"{mode}.npz")
-        subprocess.run([sys.executable, str(script), str(outs[-1])], env=env, check=True,
-                       timeout=600)
+        run = subprocess.run([sys.executable, str(script), str(outs[-1])],
+                             env=dict(env, NUMBA_DEBUG_CACHE="1"), check=True, timeout=600,
+                             capture_output=True, text=True)
+        loads = run.stdout.count("data loaded from")    # numba's cache log: loads from disk
+        assert (loads > 0) == (mode == "cached"), f"{mode} run: {loads} kernels from the cache"
     compiled, cached = np.load(outs[0]), np.load(outs[1])
     for name in compiled.files:
         assert compiled[name].tobytes() == cached[name].tobytes(), name
