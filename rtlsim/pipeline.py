@@ -24,9 +24,11 @@ tests outside one).
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Coroutine, Iterator, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
+from cocotb.triggers import SimTimeoutError, with_timeout
 
 from model.axis_packetizer import packets_per_frame
 from model.chirp_pingpong import adc_frame_to_stream
@@ -36,6 +38,11 @@ from model.radar_pipeline import PipelineParams, dma_packets
 from model.radar_regs_map import REGISTERS
 from rtlsim.axis import CLK_PERIOD_NS, AxisTB, chirp_bursts
 from rtlsim.toolchain import param
+
+T = TypeVar("T")
+AXIL_ACCESS_CLOCKS = 1000
+"""Bound of one register access: the tests' AXI4-Lite stalls (each channel paused with
+probability 0.4 a clock) finish one in tens of clocks; a hung handshake fails here."""
 
 STATUS_SIGNALS = ("status_adc_overflow", "status_dma_overflow", "status_fft_overflow",
                   "status_framing_error", "adc_chirps_dropped", "dma_words_dropped",
@@ -137,12 +144,25 @@ class PipelineTB(AxisTB):
 
     async def read32(self, address: int) -> int:
         """One 32-bit register read at byte ``address`` (after :meth:`attach_regs`); with
-        ``host.regs.decode`` / ``address`` it reads a register by name."""
-        return int(await self.axil.read_dword(address))
+        ``host.regs.decode`` / ``address`` it reads a register by name. Fails the test when
+        no response comes within :data:`AXIL_ACCESS_CLOCKS`."""
+        return int(await self._bounded(self.axil.read_dword(address), "read", address))
 
     async def write32(self, address: int, value: int) -> None:
-        """One 32-bit register write at byte ``address`` (after :meth:`attach_regs`)."""
-        await self.axil.write_dword(address, int(value))
+        """One 32-bit register write at byte ``address`` (after :meth:`attach_regs`); fails
+        the test when no response comes within :data:`AXIL_ACCESS_CLOCKS`."""
+        await self._bounded(self.axil.write_dword(address, int(value)), "write", address)
+
+    async def _bounded(self, access: Coroutine[Any, Any, T], what: str, address: int) -> T:
+        """``access`` (one AXI4-Lite transfer), failed with a message naming the register
+        after :data:`AXIL_ACCESS_CLOCKS` clocks instead of waiting for ever."""
+        try:
+            return await with_timeout(access, AXIL_ACCESS_CLOCKS * CLK_PERIOD_NS, "ns")
+        except SimTimeoutError:
+            raise AssertionError(
+                f"AXI4-Lite {what} at 0x{address:03x}: no response within "
+                f"{AXIL_ACCESS_CLOCKS} clocks (the register block or its handshake hangs)"
+            ) from None
 
     def attach_memory(self, size: int, pauses: Callable[[int], Iterator[bool]]):
         """A cocotbext-axi ``AxiRam`` of ``size`` bytes on the external frame store's port
