@@ -255,7 +255,8 @@ def _row(quantity: str, chain: str, snr: list[float], res: list[dict[str, Any]],
            "rmse": [float(f"{v:.5g}") for v in rmse], "crb": [float(f"{v:.5g}") for v in crb],
            "excess_db": _excess(rmse, crb), "trials": res[0]["trials"]}
     if quantity == "azimuth":      # the array's bound for the one-cell snapshot
-        bound = [dt.tone_frequency_crb(10 ** ((s + gain) / 10), n) * to_unit for s in snr]
+        cells = tuple((ax.window(), ax.n_fft) for ax in fft_axes(cfg))
+        bound = [dt.cell_snapshot_crb(10 ** (s / 10), n, cells) * to_unit for s in snr]
         row["crb_array"] = [float(f"{v:.5g}") for v in bound]
         row["excess_array_db"] = _excess(rmse, bound)
     else:                          # the bound of the three cells the interpolator reads

@@ -1,4 +1,5 @@
-"""campaign.maps: the synthetic cells are the float chain's (Hann-windowed FFT) cells."""
+"""campaign.maps: the synthetic cells are the float chain's (Hann-windowed FFT) cells; the
+host's angle estimator on them reaches the array's bound for the cell snapshot."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ import numpy as np
 import pytest
 
 from campaign import maps
-from campaign.curves import cell_gain_db
+from campaign import trials as tr
+from campaign.curves import Plan, cell_gain_db, estimation_rows
 from model.cfar_stats import HANN_POWER_CORRELATION
 from model.config import PRESETS
 from model.reference import hann_periodic
@@ -63,3 +65,16 @@ def test_conditional_pfa_of_every_detector_is_the_configured_one() -> None:
     for (path, kind), s in zip(DETECTORS, r["pfa_sum"], strict=True):
         assert s / r["cells"] == pytest.approx(1e-2, rel=0.3 if kind == "os" else 0.15), \
             (path, kind)
+
+
+def test_float_azimuth_reaches_the_cell_snapshot_bound() -> None:
+    """The estimation trial's float azimuth (``host.angle`` on the detected cell of targets
+    at random sub-bin offsets) at -32 dB per sample (cell SNR 12.6 dB at a bin centre):
+    within 0.4 dB (MSE) of ``crb_array``, the bound averaged over the offsets' scalloping
+    (1500 trials: +-0.16 dB); the bound of a bin-centred target is 0.98 dB below it."""
+    res = tr.estimation({"snr_db": -32.0, "azimuth_deg": 10.0,
+                         "chains": ["float", "quantised"]}, range(1500), 1, 7)
+    row = next(r for r in estimation_rows(Plan(snr=(-32.0, -32.0, 1.0)),
+                                          {"est:-32.0": res}, PRESETS["full"])
+               if r["quantity"] == "azimuth" and r["chain"] == "float")
+    assert abs(row["excess_array_db"][0]) < 0.4, row

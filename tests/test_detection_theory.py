@@ -110,3 +110,27 @@ def test_three_cell_bound_against_least_squares_estimates() -> None:
     assert dt.cell_snr_gain(w, n, np.zeros(1))[0] == pytest.approx(2 * n / 3)
     hann = (hann_periodic(256), 256)
     assert dt.three_cell_crb(1.0, hann, hann, 64) > dt.tone_frequency_crb(1.0, 256, 256 * 64)
+
+
+def test_cell_snapshot_bound_against_ml_estimates_between_bins() -> None:
+    """The ML (periodogram-peak) frequency across 16 elements of one cell of a 32 x 32
+    Hann-windowed 2-D DFT, the tone at offsets uniform in +-0.5 bin on both axes, reaches
+    :func:`cell_snapshot_crb`; the bound of a tone at the cell's centre is 11 % (0.98 dB of
+    variance) lower, which the estimate does not reach."""
+    rng = np.random.default_rng(5)
+    n, m, snr, trials, f0 = 16, 32, 0.2, 4000, 0.1
+    w, t, v = hann_periodic(m), np.arange(m), np.arange(n)
+    off = rng.uniform(-0.5, 0.5, (trials, 2))
+    cell = np.prod(np.exp(2j * np.pi * off[:, :, None] * t / m) @ w, axis=1)   # (trials,)
+    noise = np.sqrt(np.sum(w ** 2) ** 2 / 2)
+    x = (np.sqrt(snr) * cell * np.exp(2j * np.pi * rng.random(trials)))[:, None] \
+        * np.exp(2j * np.pi * f0 * v) + noise * (rng.standard_normal((trials, n)) + 1j
+                                                * rng.standard_normal((trials, n)))
+    grid = f0 + np.linspace(-0.01, 0.01, 2001)
+    est = grid[np.argmax(np.abs(x @ np.exp(-2j * np.pi * np.outer(v, grid))), axis=1)]
+    rmse = np.sqrt(np.mean((est - f0) ** 2))
+    bound = dt.cell_snapshot_crb(snr, n, ((w, m), (w, m)))
+    assert rmse == pytest.approx(bound, rel=0.04)
+    centre = dt.tone_frequency_crb(snr * (2 * m / 3) ** 2, n)
+    assert bound / centre == pytest.approx(1.12, abs=0.01)
+    assert dt.cell_snapshot_crb(0.0, n, ((w, m),)) == float("inf")
