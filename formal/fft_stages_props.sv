@@ -145,18 +145,21 @@ module fft_sdf_bf_props #(
 endmodule
 
 module fft_twiddle_props #(
-  parameter int FAIR = 0
+  parameter int FAIR = 0,
+  // W = 8 with MUL_W = 8: the products split (x = hi * 2^7 + lo, fft_twiddle MUL_W)
+  parameter int W = 5,
+  parameter int MUL_W = 27
 ) (
-  input wire logic        clk,
-  input wire logic        rst,
-  input wire logic        en,
-  input wire logic [9:0]  in_data,
-  input wire logic        in_vld,
-  input wire logic [3:0]  in_pos,
-  input wire logic        in_ov,
-  input wire logic [3:0]  in_pos_ahead
+  input wire logic          clk,
+  input wire logic          rst,
+  input wire logic          en,
+  input wire logic [2*W-1:0] in_data,
+  input wire logic          in_vld,
+  input wire logic [3:0]    in_pos,
+  input wire logic          in_ov,
+  input wire logic [3:0]    in_pos_ahead
 );
-  localparam int W = 5, LOG2N = 4;
+  localparam int LOG2N = 4;
   logic [2*W-1:0]   out_data;
   logic             out_vld, out_ov;
   logic [LOG2N-1:0] out_pos;
@@ -177,7 +180,8 @@ module fft_twiddle_props #(
   always_comb assume (in_pos == pa2_q);
   always_comb assume (!in_vld || n_en_q == 2'd2);
 
-  fft_twiddle #(.NUM_CH(1), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N), .INVERSE(1'b0)) dut (
+  fft_twiddle #(.NUM_CH(1), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N), .INVERSE(1'b0),
+                .MUL_W(MUL_W)) dut (
     .clk, .rst, .en, .in_data, .in_vld, .in_pos, .in_ov, .in_pos_ahead, .out_data, .out_vld,
     .out_pos, .out_ov);
 
@@ -192,7 +196,7 @@ module fft_twiddle_props #(
   // overflow (its coefficient looked up from its own position, two advances ahead)
   logic       past = 1'b0;
   logic [LAT-1:0] ov_q, p0_q;
-  logic [LAT-1:0][9:0] d_q;
+  logic [LAT-1:0][2*W-1:0] d_q;
   always_ff @(posedge clk) begin
     past <= 1'b1;
     if (en) begin

@@ -9,7 +9,7 @@ the files its top elaborates (:func:`files_for`). docs/synth.md describes the se
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from model.fft_axis import multipliers_per_lane
@@ -32,7 +32,9 @@ class Job:
 
     Every job reads its part of the file list (:func:`files_for`); ``uram`` adds ``-uram`` (the big
     buffers: corner turn, packetizer, top); ``expect_dsp``
-    is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests.
+    is the DSP48E2 count the architecture calls for (docs/fft_axis.md), checked by the tests;
+    ``ecp5_params`` are added to ``params`` in the timing flow's ECP5 mapping only
+    (:mod:`synth.timing`; its xcup depth, the estimate and Vivado keep ``params``).
     """
 
     name: str
@@ -45,11 +47,14 @@ class Job:
     instances: int = 1
     # counted in the sum-of-blocks row (the mode-0 chain; not the detector)
     in_sum: bool = True
+    ecp5_params: dict[str, int] = field(default_factory=dict)
 
     @property
     def label(self) -> str:
-        """Human-readable parameter list, e.g. ``N=64 NUM_CH=4``."""
-        return " ".join(f"{k}={v}" for k, v in self.params.items())
+        """Human-readable parameter list, e.g. ``N=64 NUM_CH=4`` (``MUL_W=18 (ECP5)`` after
+        it for an ECP5-only parameter)."""
+        return " ".join([*(f"{k}={v}" for k, v in self.params.items()),
+                         *(f"{k}={v} (ECP5)" for k, v in self.ecp5_params.items())])
 
 
 def _fft_dsp(n: int, lanes: int, window: bool, data_w: int = 16, guard_w: int = 4) -> int:

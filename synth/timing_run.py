@@ -5,7 +5,9 @@ sources and settings.
 
 Steps of a job, each a subprocess under ``nice`` inside one wall-clock budget:
 1. ``ports``: Yosys elaborates the block at its parameters and lists its ports;
-2. the wrapper text (:func:`wrapper`): a register on every input and every output;
+2. the wrapper text (:func:`wrapper`): a register on every input and every output (the block
+   with ``job.ecp5_params`` added for ``ecp5``, ``wrap.sv``; without them for ``xcup``,
+   ``wrap_xcup.sv``, when there are any);
 3. ``ecp5``: ``synth_ecp5`` of the wrapper, netlist JSON for nextpnr;
 4. ``pnr``: ``nextpnr-ecp5 --85k --speed 8 --out-of-context --freq F --report``;
 5. ``xcup``: ``synth_xilinx -family xcup`` of the same wrapper, netlist JSON for
@@ -22,13 +24,14 @@ import re
 import shutil
 import subprocess
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from synth.jobs import Job
 from synth.yosys_run import _wait, yosys_command
 
 WRAP = "timing_wrap"
+XCUP_WRAP = "wrap_xcup.sv"   # the wrapper without the ECP5-only parameters (Job.ecp5_params)
 DEVICE = ["--85k", "--speed", "8", "--package", "CABGA756"]
 
 
@@ -127,15 +130,19 @@ def scripts(job: Job, files: list[Path], cwd: Path, abs_paths: bool = False) -> 
     reads = "read_verilog -sv -DSYNTHESIS " + " ".join(
         str(f) if abs_paths else os.path.relpath(f, cwd) for f in files)
     sets = " ".join(f"-set {k} {v}" for k, v in job.params.items())
-    front = [f"{reads} wrap.sv", f"hierarchy -check -top {WRAP}", "proc -norom"]
+
+    def front(wrap: str) -> list[str]:
+        return [f"{reads} {wrap}", f"hierarchy -check -top {WRAP}", "proc -norom"]
+
     xflags = "-family xcup -flatten -noiopad -noclkbuf" + (" -uram" if job.uram else "")
     return {
         "ports": "\n".join([reads, f"chparam {sets} {job.top}" if sets else "",
                             f"hierarchy -check -top {job.top}",
                             "tee -q -o ports.txt portlist -m", ""]),
-        "ecp5": "\n".join([*front, f"synth_ecp5 -top {WRAP} -json ecp5.json",
+        "ecp5": "\n".join([*front("wrap.sv"), f"synth_ecp5 -top {WRAP} -json ecp5.json",
                            "tee -q -o ecp5_stat.json stat -json", ""]),
-        "xcup": "\n".join([*front, f"synth_xilinx -top {WRAP} {xflags}",
+        "xcup": "\n".join([*front(XCUP_WRAP if job.ecp5_params else "wrap.sv"),
+                           f"synth_xilinx -top {WRAP} {xflags}",
                            "write_json xcup.json", ""]),
     }
 
@@ -177,7 +184,11 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         for name in ("ports", "ecp5", "xcup"):
             (d / f"{name}.ys").write_text(sc[name])
         _step("ports", [*yosys, "-q", "ports.ys"], d, t_end, res)
-        (d / "wrap.sv").write_text(wrapper(job, parse_ports((d / "ports.txt").read_text())))
+        ports = parse_ports((d / "ports.txt").read_text())
+        (d / "wrap.sv").write_text(wrapper(
+            replace(job, params={**job.params, **job.ecp5_params}), ports))
+        if job.ecp5_params:
+            (d / XCUP_WRAP).write_text(wrapper(job, ports))
         _step("ecp5", [*yosys, "-q", "ecp5.ys"], d, t_end, res)
         _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
         if xcup:

@@ -14,7 +14,7 @@ import pytest
 from synth.jobs import Job
 from synth.timing import main, timing_sets
 from synth.timing_report import lut_depth, parse_nextpnr, short_cell
-from synth.timing_run import Settings, job_key, parse_ports, wrapper
+from synth.timing_run import Settings, job_key, parse_ports, scripts, wrapper
 
 PORTS = """module mark_fifo (
 input [0:0] clk,
@@ -46,8 +46,26 @@ def test_job_key_changes_with_sources_and_settings(tmp_path: Path) -> None:
     assert k != job_key(job, [f], Settings(router="router2"))
     assert k != job_key(job, [f], Settings(placer="static"))
     assert k != job_key(Job("x", "a", {"N": 2}), [f], Settings())
+    assert k != job_key(Job("x", "a", {"N": 1}, ecp5_params={"M": 2}), [f], Settings())
     f.write_text("module a; wire w; endmodule\n")
     assert k != job_key(job, [f], Settings())
+
+
+def test_ecp5_params_reach_the_ecp5_mapping_only(tmp_path: Path) -> None:
+    """The FFTs and the top map their twiddle products to 18-bit operands on the ECP5
+    (MUL_W = 18, docs/fft_axis.md) in the ECP5 wrapper only; the xcup depth reads a wrapper
+    without it; other blocks keep one wrapper."""
+    sets = timing_sets()
+    for job in sets["paper-fpga"] + sets["top"]:
+        want = {"MUL_W": 18} if job.top in ("fft_axis", "radar_pipeline") else {}
+        assert job.ecp5_params == want, job.name
+        assert "MUL_W" not in job.params
+    fft = next(j for j in sets["paper-fpga"] if j.top == "fft_axis")
+    assert fft.label.endswith(" MUL_W=18 (ECP5)")
+    sc = scripts(fft, [], tmp_path)
+    assert " wrap.sv\n" in sc["ecp5"] and " wrap_xcup.sv\n" in sc["xcup"]
+    other = next(j for j in sets["paper-fpga"] if j.top == "corner_turn")
+    assert " wrap.sv\n" in scripts(other, [], tmp_path)["xcup"]
 
 
 def test_parse_nextpnr_report() -> None:

@@ -30,7 +30,11 @@ module fft_axis #(
   parameter int unsigned SCALE_SCH = 32'hFFF,
   // Extra fraction bits carried inside the pipeline, 0..16; DATA_W+1+GUARD_W <= 27 so each
   // real multiplier fits one DSP48E2 (27 x 18).
-  parameter int GUARD_W = 4
+  parameter int GUARD_W = 4,
+  // Widest signed data operand of one twiddle multiplier, 8..27 (fft_twiddle): 27 the
+  // DSP48E2 A port (one multiplier per real product), 18 an ECP5 MULT18X18D (wider operands
+  // split in two registered partial products); same latency and bits.
+  parameter int MUL_W = 27
 ) (
   // Clock and synchronous active-high reset.
   input  logic clk, rst,
@@ -170,7 +174,8 @@ module fft_axis #(
     if (s % 2 == 1 && s + 1 < LOG2N) begin : g_tw
       // twiddle after the radix-2^2 pair (s-1, s), sub-transform length N >> (s-1)
       fft_twiddle #(
-        .NUM_CH(NUM_CH), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N - s + 1), .INVERSE(INVERSE)
+        .NUM_CH(NUM_CH), .W(W), .LOG2N(LOG2N), .LOG2M(LOG2N - s + 1), .INVERSE(INVERSE),
+        .MUL_W(MUL_W)
       ) u_tw (
         .clk, .rst, .en(adv),
         .in_data(bo_data), .in_vld(bo_vld), .in_pos(bo_pos), .in_ov(bo_ov),

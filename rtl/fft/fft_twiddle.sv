@@ -15,6 +15,11 @@
 // products in fabric, all in the product's cycle, with the routes to and from the
 // multipliers; on a DSP48E2 the two operand stages are the A1/A2 and B1/B2 registers, one
 // slice per product).
+// MUL_W < 27 (a MULT18X18D: 18): when the data operands (W+1 bits with Gauss, the pre-add;
+// re and im sign-extended to it) are wider than MUL_W, each is split into an unsigned low
+// part of MUL_W-1 bits and a signed high part, x = hi * 2^(MUL_W-1) + lo; both partial
+// products are registered in the product stage and added, shifted, in the exact sums: the
+// same stages and bits, and on an ECP5 no fabric sum of partial products before a register.
 `default_nettype none
 
 module fft_twiddle #(
@@ -27,7 +32,10 @@ module fft_twiddle #(
   // log2 of the sub-transform length M this twiddle belongs to, 3..LOG2N.
   parameter int LOG2M = 6,
   // 1: inverse transform (conjugate twiddles).
-  parameter bit INVERSE = 0
+  parameter bit INVERSE = 0,
+  // Widest signed data operand of one multiplier, 8..27: 27 a DSP48E2 A port (no split at
+  // any W), 18 a MULT18X18D (wider operands are split in two products, see above).
+  parameter int MUL_W = 27
 ) (
   input  logic clk,
   input  logic rst,
@@ -56,9 +64,20 @@ module fft_twiddle #(
   // Three real multipliers per lane (Gauss) when the pre-added operand re + im (W+1 bits)
   // fits a DSP48E2 A port (27 bits), else four. Same exact products, so the same bits.
   localparam bit GAUSS = (W + 1 <= 27);
+  // The data operand of every product: W+1 bits with Gauss (re + im; re, im sign-extended),
+  // W without; split at bit MUL_W-1 when wider than MUL_W.
+  localparam int XW = GAUSS ? W + 1 : W;
+  localparam bit SPLIT = XW > MUL_W;
+  localparam int LO_W = MUL_W - 1;                 // low part bits (unsigned)
+  localparam int HI_W = SPLIT ? XW - LO_W : 1;     // high part bits (signed)
+  localparam int LPW = MUL_W + COEF_W;             // low partial product width
+  localparam int HPW = HI_W + COEF_W;              // high partial product width
 
   if (LOG2M < 3 || LOG2M > LOG2N || LOG2N > ROM_LOG2) begin : g_bad_log2m
     $fatal(1, "%m: LOG2M=%0d must be in 3..LOG2N and LOG2N <= %0d", LOG2M, ROM_LOG2);
+  end
+  if (MUL_W < 8 || MUL_W > 27) begin : g_bad_mul_w
+    $fatal(1, "%m: MUL_W=%0d must be in 8..27", MUL_W);
   end
 
   // ------------------------------------------------ two advances ahead: ROM index
@@ -126,11 +145,6 @@ module fft_twiddle #(
     // shared by every lane); the data pre-add re + im is W+1 <= 27 bits (DSP48E2 A port).
     // Both sums are additions of a product to k1 (k3 takes the negated coefficient), the form
     // a DSP48E2 post-adder with its P register takes (C port = k1).
-    logic signed [W:0]        a1_q [NUM_CH];      // re + im
-    logic signed [W:0]        a2_q [NUM_CH];      // stage 2: each lane's operands
-    logic signed [PRW:0]      k1_q [NUM_CH];
-    logic signed [PRW-1:0]    k2_q [NUM_CH];
-    logic signed [PRW-1:0]    k3_q [NUM_CH];
     logic signed [COEF_W:0]   cc, ss;
 
     assign cc = (COEF_W+1)'(signed'(cos2_q));
@@ -141,51 +155,126 @@ module fft_twiddle #(
         cf1_q[0] <= signed'(cos2_q);                           // C
         cf1_q[1] <= COEF_W'(INVERSE ? ss - cc : -ss - cc);     // d - C
         cf1_q[2] <= COEF_W'(INVERSE ? -cc - ss : ss - cc);     // -C - d
-        for (int ch = 0; ch < NUM_CH; ch++) begin
-          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
-                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
-          a2_q[ch] <= a1_q[ch];
-          k1_q[ch] <= (PRW+1)'(a2_q[ch]) * (PRW+1)'(cf2_q[ch*NCF]);
-          k2_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
-          k3_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 2]);
-        end
       end
     end
 
-    always_comb begin
-      for (int ch = 0; ch < NUM_CH; ch++) begin
-        yr_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k3_q[ch]);
-        yi_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k2_q[ch]);
+    if (!SPLIT) begin : g_mul
+      logic signed [W:0]        a1_q [NUM_CH];      // re + im
+      logic signed [W:0]        a2_q [NUM_CH];      // stage 2: each lane's operands
+      logic signed [PRW:0]      k1_q [NUM_CH];
+      logic signed [PRW-1:0]    k2_q [NUM_CH];
+      logic signed [PRW-1:0]    k3_q [NUM_CH];
+
+      always_ff @(posedge clk) begin
+        if (en) begin
+          for (int ch = 0; ch < NUM_CH; ch++) begin
+            a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
+                      + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+            a2_q[ch] <= a1_q[ch];
+            k1_q[ch] <= (PRW+1)'(a2_q[ch]) * (PRW+1)'(cf2_q[ch*NCF]);
+            k2_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+            k3_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 2]);
+          end
+        end
+      end
+
+      always_comb begin
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          yr_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k3_q[ch]);
+          yi_full[ch] = (PRW+2)'(k1_q[ch]) + (PRW+2)'(k2_q[ch]);
+        end
       end
     end
   end else begin : g_four
     // Four real products per lane (W = 27: the pre-add would not fit the 27-bit A port).
-    logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
-    logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
-    logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
-    logic signed [PRW-1:0] prs_r_q [NUM_CH];   // re*S
-
     always_ff @(posedge clk) begin
       if (en) begin
         cf1_q[0] <= signed'(cos2_q);   // C
         cf1_q[1] <= signed'(sin2_q);   // S
-        for (int ch = 0; ch < NUM_CH; ch++) begin
-          prc_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF]);
-          prs_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
-          prc_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF]);
-          prs_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+      end
+    end
+
+    if (!SPLIT) begin : g_mul
+      logic signed [PRW-1:0] prc_r_q [NUM_CH];   // re*C
+      logic signed [PRW-1:0] prs_i_q [NUM_CH];   // im*S
+      logic signed [PRW-1:0] prc_i_q [NUM_CH];   // im*C
+      logic signed [PRW-1:0] prs_r_q [NUM_CH];   // re*S
+
+      always_ff @(posedge clk) begin
+        if (en) begin
+          for (int ch = 0; ch < NUM_CH; ch++) begin
+            prc_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF]);
+            prs_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+            prc_i_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF]);
+            prs_r_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
+          end
         end
+      end
+
+      always_comb begin
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          if (INVERSE) begin   // x * (C + jS)
+            yr_full[ch] = (PRW+2)'(prc_r_q[ch]) - (PRW+2)'(prs_i_q[ch]);
+            yi_full[ch] = (PRW+2)'(prc_i_q[ch]) + (PRW+2)'(prs_r_q[ch]);
+          end else begin       // x * (C - jS)
+            yr_full[ch] = (PRW+2)'(prc_r_q[ch]) + (PRW+2)'(prs_i_q[ch]);
+            yi_full[ch] = (PRW+2)'(prc_i_q[ch]) - (PRW+2)'(prs_r_q[ch]);
+          end
+        end
+      end
+    end
+  end
+
+  if (SPLIT) begin : g_split
+    // Products p of lane ch at ch * NP + p (Gauss: k1, k2, k3 with data operands re + im, re,
+    // im; four: re*C, im*S, im*C, re*S), each (h << LO_W) + l from its data operand's low (l)
+    // and high (h) parts, both registered; the sums as in g_gauss / g_four.
+    localparam int NP = GAUSS ? 3 : 4;
+    logic signed [W:0]     a1_q [NUM_CH];      // Gauss: re + im
+    logic signed [W:0]     a2_q [NUM_CH];      // stage 2: each lane's operand
+    logic signed [LPW-1:0] l_q [NUM_CH * NP];
+    logic signed [HPW-1:0] h_q [NUM_CH * NP];
+
+    always_ff @(posedge clk) begin
+      logic signed [XW-1:0]     x;
+      logic signed [COEF_W-1:0] c;
+      if (en) begin
+        for (int ch = 0; ch < NUM_CH; ch++) begin
+          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
+                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+          a2_q[ch] <= a1_q[ch];
+          for (int p = 0; p < NP; p++) begin
+            // component: Gauss p = 1 re, 2 im; four p = 0, 3 re, 1, 2 im
+            x = GAUSS && p == 0 ? XW'(a2_q[ch])
+              : XW'(signed'(d2_q[ch*2*W + ((GAUSS ? p == 2 : p == 1 || p == 2) ? W : 0) +: W]));
+            c = cf2_q[ch*NCF + (GAUSS ? p : p % 2)];
+            l_q[ch*NP + p] <= LPW'(signed'({1'b0, x[LO_W-1:0]})) * LPW'(c);
+            h_q[ch*NP + p] <= HPW'(signed'(x[XW-1:LO_W])) * HPW'(c);
+          end
+        end
+      end
+    end
+
+    // the partial products sign-extended to the sums' width
+    logic signed [PRW+1:0] h [NUM_CH * NP], l [NUM_CH * NP];
+    always_comb begin
+      for (int i = 0; i < NUM_CH * NP; i++) begin
+        h[i] = (PRW+2)'(h_q[i]);
+        l[i] = (PRW+2)'(l_q[i]);
       end
     end
 
     always_comb begin
       for (int ch = 0; ch < NUM_CH; ch++) begin
-        if (INVERSE) begin   // x * (C + jS)
-          yr_full[ch] = (PRW+2)'(prc_r_q[ch]) - (PRW+2)'(prs_i_q[ch]);
-          yi_full[ch] = (PRW+2)'(prc_i_q[ch]) + (PRW+2)'(prs_r_q[ch]);
-        end else begin       // x * (C - jS)
-          yr_full[ch] = (PRW+2)'(prc_r_q[ch]) + (PRW+2)'(prs_i_q[ch]);
-          yi_full[ch] = (PRW+2)'(prc_i_q[ch]) - (PRW+2)'(prs_r_q[ch]);
+        if (GAUSS) begin     // yr = k1 + k3, yi = k1 + k2
+          yr_full[ch] = ((h[ch*NP] + h[ch*NP + 2]) <<< LO_W) + l[ch*NP] + l[ch*NP + 2];
+          yi_full[ch] = ((h[ch*NP] + h[ch*NP + 1]) <<< LO_W) + l[ch*NP] + l[ch*NP + 1];
+        end else if (INVERSE) begin
+          yr_full[ch] = ((h[ch*NP] - h[ch*NP + 1]) <<< LO_W) + l[ch*NP] - l[ch*NP + 1];
+          yi_full[ch] = ((h[ch*NP + 2] + h[ch*NP + 3]) <<< LO_W) + l[ch*NP + 2] + l[ch*NP + 3];
+        end else begin
+          yr_full[ch] = ((h[ch*NP] + h[ch*NP + 1]) <<< LO_W) + l[ch*NP] + l[ch*NP + 1];
+          yi_full[ch] = ((h[ch*NP + 2] - h[ch*NP + 3]) <<< LO_W) + l[ch*NP + 2] - l[ch*NP + 3];
         end
       end
     end

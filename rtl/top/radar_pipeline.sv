@@ -75,6 +75,9 @@ module radar_pipeline #(
   // Doppler FFT scaling schedule: default halves every other stage (1/sqrt(N) for even
   // log2 N) so thermal noise stays above 1 LSB in the 16-bit output (see model/pipeline.py).
   parameter int unsigned DOPPLER_SCALE_SCH = 32'h555,
+  // Widest data operand of one twiddle multiplier of both FFTs (fft_axis MUL_W): 27 for the
+  // DSP48E2, 18 for the ECP5 MULT18X18D; same latency and bits.
+  parameter int MUL_W = 27,
   // 1: a header word before each packet's payload (frame id, sequence, flags); 0: none.
   parameter bit HEADER = 1'b1,
   // Packet banks of the output buffer, power of two, 2..16 (2 = the paper's double buffer).
@@ -347,7 +350,7 @@ module radar_pipeline #(
 
   fft_axis #(
     .N(N_RANGE), .N_IN(N_SAMPLES), .N_OUT(N_RBINS), .NUM_CH(NUM_RX), .DATA_W(DATA_W),
-    .INVERSE(1'b0), .WINDOW(WINDOW), .SCALE_SCH(RANGE_SCALE_SCH)
+    .INVERSE(1'b0), .WINDOW(WINDOW), .SCALE_SCH(RANGE_SCALE_SCH), .MUL_W(MUL_W)
   ) u_range_fft (
     .clk, .rst,
     .s_axis_tdata(fa_tdata), .s_axis_tvalid(fa_tvalid), .s_axis_tready(fa_tready),
@@ -479,7 +482,7 @@ module radar_pipeline #(
 
   fft_axis #(
     .N(N_DOPPLER), .N_IN(N_LOOPS), .NUM_CH(NUM_RX), .DATA_W(DATA_W), .INVERSE(1'b0),
-    .WINDOW(WINDOW), .SCALE_SCH(DOPPLER_SCALE_SCH)
+    .WINDOW(WINDOW), .SCALE_SCH(DOPPLER_SCALE_SCH), .MUL_W(MUL_W)
   ) u_doppler_fft (
     .clk, .rst,
     .s_axis_tdata(sr_tdata), .s_axis_tvalid(sr_tvalid), .s_axis_tready(sr_tready),
