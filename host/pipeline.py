@@ -232,15 +232,16 @@ def hermitian_asymmetry(cube: np.ndarray) -> float:
 def _asymmetry_sums(y: np.ndarray) -> tuple[float, float]:
     """(sum |Y[r, d] - conj(Y[-r, -d])|^2, sum |Y|^2) over y, complex (n_range, n_doppler),
     indices modulo the axes, summed in double precision: one pass, no temporaries (numpy's
-    flip, roll and differences took twice as long)."""
+    flip, roll and differences took twice as long); -r mod n as n - r for r > 0 (an
+    integer division per value took a fifth of the pass)."""
     nr, nd = y.shape
     diff = 0.0
     energy = 0.0
     for d in range(nd):                 # range innermost: a cube's contiguous axis
-        dm = (nd - d) % nd
+        dm = nd - d if d else 0
         for r in range(nr):
             a = y[r, d]
-            b = y[(nr - r) % nr, dm]
+            b = y[nr - r if r else 0, dm]
             dr = np.float64(a.real) - np.float64(b.real)
             di = np.float64(a.imag) + np.float64(b.imag)
             diff += dr * dr + di * di
