@@ -3,7 +3,7 @@ for the same job) on the real TI frame of ``tests/data/openradar`` (2 TX x 4 RX,
 128 samples; docs/profiles.md "Compared with OpenRadar").
 
     make bench-openradar          # creates OpenRadar's virtualenv, then runs this
-    python -m benchmarks.bench_openradar --peer-python out/openradar-venv/bin/python [--repeat 20]
+    python -m benchmarks.bench_openradar --peer-python out/openradar-venv/bin/python [--repeat 40]
 
 OpenRadar (``openradar==1.0.1``) runs in its own virtualenv (``out/openradar-venv``, made by
 the Make target: on numpy 2 it needs scikit-learn, which it does not declare, and a
@@ -30,14 +30,17 @@ reports a return spread over range bins once per range bin), the angle differenc
 Bartlett angle (the strongest of our points in a cell, and every point), our points that are
 not part of a cluster it finds (no peer detection within the bins, or none also within the
 array's angle resolution); host time per frame of each, timed in the same run (``--repeat``
-runs after a warm-up, in ``--rounds`` rounds that alternate between the chains, so a change
-of the machine's load falls on all; median) with the load average, and each process' CPU
-time per frame (on a machine loaded by other jobs the wall time is mostly waiting for a
-core). Both run one thread: ours does, and the peer's numpy is held to one BLAS thread
-(``--peer-threads``; with its default, one per core, it ran 2-3 times slower on the machine
-loaded by other jobs: a median of 52 ms against 24 ms at load 16, a loss that is no speed of
-ours). Each goal of issue 29 is reported, met or missed, for each setting of ours; none is
-asserted in tests.
+runs, in ``--rounds`` rounds that alternate between the chains, so a change of the
+machine's load falls on all; median, and the quartiles) with the load average, and each
+process' CPU time per frame (on a machine loaded by other jobs the wall time is mostly
+waiting for a core). Each chain times each setting in a round as the peer runner does: one
+untimed frame, then the timed ones (the first frame after the other chain's process ran
+finds the caches cold: 0.5-0.9 ms more of ours, a third more, which fell on half of one
+setting's runs when ours ran the settings in turn without it). Both run one thread: ours
+does, and the peer's numpy is held to one BLAS thread (``--peer-threads``; with its default,
+one per core, it ran 2-3 times slower on the machine loaded by other jobs: a median of 52 ms
+against 24 ms at load 16, a loss that is no speed of ours). Each goal of issue 29 is
+reported, met or missed, for each setting of ours; none is asserted in tests.
 Last, the CFAR's CPU time on the frame's map: the OS-CFAR (compiled, ``host._cfar_os``) against
 the numpy implementation it replaced, and the CA-CFAR; and how far a mean of log powers sits
 below a mean of powers over the frame's noise (:func:`log_power_gap`: what makes the peer's
@@ -188,6 +191,12 @@ def median_ms(times_s: list[float] | np.ndarray) -> float:
     return float(np.median(times_s)) * 1e3
 
 
+def quartiles(times_s: list[float]) -> str:
+    """'a-b': the first and third quartiles of times (s) in ms, one decimal."""
+    q1, q3 = np.percentile(np.asarray(times_s) * 1e3, [25, 75])
+    return f"{q1:.1f}-{q3:.1f}"
+
+
 def spread(x: np.ndarray) -> str:
     """'median a, max b' of angle differences, deg, or '-' if none."""
     return f"median {np.median(x):.2f}, max {x.max():.2f} deg (n={len(x)})" if len(x) else "-"
@@ -287,6 +296,9 @@ def table(peer_doc: dict[str, Any], runs: list[Run], threshold_db: float,
         f"{'detections (points; peer: grouped)':<36}{counts}"
         f"{len(db['detections']['range_bin']):>14}{len(demo['detections']['range_bin']):>12}",
         f"{'host time per frame, ms':<36}{times}{t_db:>14.2f}{t_demo:>12.2f}",
+        f"{'... its quartiles, ms':<36}"
+        + "".join(f"{quartiles(r.times_s):>10}" for r in runs)
+        + f"{quartiles(db['times_s']):>14}{quartiles(demo['times_s']):>12}",
     ]
     cpu_db = median_ms(db["cpu_s"]) if db.get("cpu_s") else None
     if cpu_db and all(r.cpu_s for r in runs):
@@ -398,7 +410,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="a 2-lane DCA1000 .bin of the profile (frame 0 is used)")
     ap.add_argument("--threshold-db", type=float, default=15.0,
                     help="the peer's CFAR threshold compared with (default 15)")
-    ap.add_argument("--repeat", type=int, default=20, help="timed runs per chain")
+    ap.add_argument("--repeat", type=int, default=40, help="timed runs per chain")
     ap.add_argument("--rounds", type=int, default=10,
                     help="the timed runs alternate between the chains in this many rounds")
     ap.add_argument("--peer-threads", type=int, default=1,
@@ -434,8 +446,9 @@ def main(argv: list[str] | None = None) -> int:
                 setting[key] = peer_doc.get("settings", {}).get(name, {}).get(
                     key, []) + setting[key]
         peer_doc = doc
-        for _ in range(n):
-            for name, p in params.items():
+        for name, p in params.items():      # as the peer runner: a warm-up, then n timed
+            capture_frame_cloud(capture.frame(0), cfg, p, 0, True)
+            for _ in range(n):
                 t0, c0 = time.perf_counter(), time.process_time()
                 capture_frame_cloud(capture.frame(0), cfg, p, 0, True)
                 times[name].append(time.perf_counter() - t0)

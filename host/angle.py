@@ -294,8 +294,8 @@ def estimate_angles(x: np.ndarray, noise_per_channel: np.ndarray, params: AngleP
             pair = _kept_components(s_p[kept], a_p[kept], np.full(int(kept.sum()), 2),
                                     noise[c[kept]], n)
     snr1 = 10 * np.log10(np.maximum(p1, 1e-300) * n / noise)
-    parts = [AngleArrays(np.flatnonzero(~more & ~split), s1[~more & ~split],
-                         a1[~more & ~split], snr1[~more & ~split])]
+    single = ~more & ~split
+    parts = [AngleArrays(np.flatnonzero(single), s1[single], a1[single], snr1[single])]
     multi = np.flatnonzero(more)
     if len(multi):
         got = _relax(xc[multi], noise[multi], params)

@@ -229,6 +229,7 @@ def _compile_training_sum() -> None:
     ``host.kernels.compile_data_dependent``: the FPGA detector's runs never reach it)."""
     for power in (np.zeros((3, 3)), np.zeros((3, 3), order="F")):
         _training_sum(power, 0, 0, 1, 1, False)
+        _ca_mask(power, np.zeros((3, 3)), 1.0, 1.0, np.empty((3, 3), np.bool_))
 
 
 @lru_cache(maxsize=64)
@@ -250,13 +251,33 @@ def cfar_threshold(power: np.ndarray, n_channels: int, params: CfarParams,
         raise ValueError(f"power: expected a 2-D (range, Doppler) map, got shape {power.shape}")
     (gr, gd), (tr, td) = params.guard, params.train
     if params.kind == "ca":
-        check_window(params, power.shape)
-        sums = _training_sum(np.asarray(power, np.float64), gr, gd, tr, td,
-                             map_axes(windowed, power.shape)[0].real)
-        noise = np.maximum(sums, 0.0) / _n_train(params)
+        noise = np.maximum(_ca_sums(power, params, windowed), 0.0) / _n_train(params)
         return _ca_alpha(params.pfa, n_channels, params, windowed) * noise, noise
     kth = os_kth(_os_padded(power, params, windowed), gr, gd, tr, td, _os_k(params))
     return _os_alpha(params.pfa, n_channels, params) * kth, _os_noise(kth, n_channels, params)
+
+
+def _ca_sums(power: np.ndarray, params: CfarParams, windowed: Windows) -> np.ndarray:
+    """The CA-CFAR's training sums of ``power`` (float (n_range, n_doppler)): float64 of
+    its shape (:func:`_training_sum`)."""
+    (gr, gd), (tr, td) = params.guard, params.train
+    check_window(params, power.shape)
+    return _training_sum(np.asarray(power, np.float64), gr, gd, tr, td,
+                         map_axes(windowed, power.shape)[0].real)
+
+
+@njit()
+def _ca_mask(power: np.ndarray, sums: np.ndarray, alpha: float, n_train: float,
+             mask: np.ndarray) -> None:
+    """mask = power > alpha (max(sums, 0) / n_train) (float64 maps of one shape, bool mask
+    (n_range, n_doppler)): :func:`cfar_detect`'s CA-CFAR mask, the same operations as
+    :func:`cfar_threshold`'s (NaN sums give NaN noise, no detection), in one pass."""
+    nr, nd = power.shape
+    for r in range(nr):
+        for d in range(nd):
+            s = sums[r, d]
+            noise = (s if s >= 0.0 or s != s else 0.0) / n_train
+            mask[r, d] = power[r, d] > alpha * noise
 
 
 def _os_padded(power: np.ndarray, params: CfarParams, windowed: Windows) -> np.ndarray:
@@ -323,9 +344,13 @@ def cfar_cells(power: np.ndarray, n_channels: int, params: CfarParams, windowed:
     (int (n, 2); a host's peak grouping and reported range bins): the OS-CFAR then finds
     its order statistic at those cells only."""
     if params.kind == "ca":
-        mask, noise_map = cfar_detect(power, n_channels, params, windowed)
+        sums = _ca_sums(power, params, windowed)
+        mask = np.empty(power.shape, bool)
+        _ca_mask(np.asarray(power, np.float64), sums,
+                 _ca_alpha(params.pfa, n_channels, params, windowed),
+                 float(_n_train(params)), mask)
         cells = select(mask)
-        return cells, noise_map[cells[:, 0], cells[:, 1]]
+        return cells, np.maximum(sums[cells[:, 0], cells[:, 1]], 0.0) / _n_train(params)
     mask, padded = _os_mask(power, n_channels, params, windowed)
     cells = select(mask)
     return cells, _os_noise_at(padded, np.ascontiguousarray(cells[:, 0]),

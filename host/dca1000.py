@@ -150,8 +150,10 @@ class Dca1000Capture:
         if self.n_frames == 0:
             raise ValueError(f"{self.path}: {size} bytes hold no whole frame of radar "
                              f"{cfg.name!r} ({self.frame_bytes} bytes per frame)")
-        self._words = np.memmap(self.path, dtype=WORD, mode="r",
-                                shape=(self.n_frames, frame_words(cfg, fmt)))
+        # a plain array over the mapping (it keeps the map open): indexing a np.memmap
+        # makes a memmap object per frame, a few microseconds of Python each
+        self._words = np.asarray(np.memmap(self.path, dtype=WORD, mode="r",
+                                           shape=(self.n_frames, frame_words(cfg, fmt))))
 
     def frame(self, index: int) -> np.ndarray:
         """Frame ``index`` (see :func:`words_to_frame`); IndexError outside 0..n_frames-1."""

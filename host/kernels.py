@@ -54,8 +54,8 @@ COMPILED = numba is not None
 """Whether the kernels are compiled (numba importable)."""
 
 KERNEL_MODULES = ("host._angle_kept", "host._angle_peaks", "host._angle_relax",
-                  "host._cfar_os", "host._grouping", "host.cells", "host.cfar", "host.dca1000",
-                  "host.pipeline", "host.record_points", "host.tdm")
+                  "host._cfar_os", "host._grouping", "host.cells", "host.cfar", "host.cube",
+                  "host.dca1000", "host.pipeline", "host.record_points", "host.tdm")
 """Every module that registers kernels (:func:`njit`): their sources key the caches."""
 STAMP = "host-kernels.sha256"
 """The file, in a cache directory, holding the :func:`sources_hash` its caches were made

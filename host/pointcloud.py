@@ -97,7 +97,8 @@ class PointCloud:
             snr_db=np.asarray(snr_db, dtype=float), rcs_dbsm=np.asarray(rcs_dbsm, dtype=float),
             range_bin=np.asarray(range_bin, dtype=int), doppler_bin=np.asarray(doppler_bin,
                                                                                dtype=int),
-            frame=np.broadcast_to(np.asarray(frame, dtype=int), (n,)).copy(),
+            frame=np.full(n, frame, dtype=int) if np.ndim(frame) == 0 else
+            np.broadcast_to(np.asarray(frame, dtype=int), (n,)).copy(),
             ambiguous=np.asarray(ambiguous, dtype=bool))
 
     @classmethod
