@@ -4,12 +4,15 @@ OpenRadar (:func:`benchmarks.bench_openradar.modes`, with ``--remove-static``) a
 defaults without static removal, every field of every point, against
 ``tests/data/openradar/points_pinned.json``. A change meant to speed the per-frame path up
 must leave them as they are; a change meant to move them rewrites the file
-(``python -m tests.test_openradar_points``) and says why. The values are this project's
-machine's (numpy's SIMD functions may round the last bit otherwise elsewhere)."""
+(``python -m tests.test_openradar_points``) and says why. The values were written on this
+project's machine; numpy's and scipy's SIMD paths may round a last bit differently on another
+CPU, so integer and flag fields must match exactly and float fields to :data:`RTOL` (a
+speed-up checked on this machine shows the same bytes: ``PIN_BITS=1``)."""
 
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import fields
 from pathlib import Path
 
@@ -29,6 +32,9 @@ PINNED = DATA / "points_pinned.json"
 SETTINGS = {**{f"{name} --remove-static": ("--remove-static", *extra)
                for name, extra in modes(15.0).items()}, "default": ()}
 """The pinned settings by name: ``radar process`` options."""
+RTOL = 1e-9
+"""Relative tolerance of float fields (a moved point moves by far more; 1e-12 absolute
+around zero)."""
 
 
 def clouds() -> dict[str, PointCloud]:
@@ -52,13 +58,19 @@ def as_lists(cloud: PointCloud) -> dict[str, list]:
 
 
 @pytest.mark.parametrize("name", list(SETTINGS))
-def test_points_of_the_real_frame_bit_for_bit(name):
+def test_points_of_the_real_frame_pinned(name):
     pinned = json.loads(PINNED.read_text())[name]
     got = as_lists(clouds()[name])
     assert len(got["range_m"]) == len(pinned["range_m"]) > 0
     for field, values in pinned.items():
-        assert np.array_equal(np.asarray(got[field]), np.asarray(values)), field
-        assert np.asarray(got[field]).tobytes() == np.asarray(values).tobytes(), field
+        g, w = np.asarray(got[field]), np.asarray(values)
+        assert g.shape == w.shape, field
+        if os.environ.get("PIN_BITS") == "1":
+            assert g.tobytes() == w.tobytes(), field
+        elif np.issubdtype(w.dtype, np.floating):
+            np.testing.assert_allclose(g, w, rtol=RTOL, atol=1e-12, err_msg=field)
+        else:
+            assert np.array_equal(g, w), field
 
 
 if __name__ == "__main__":
