@@ -145,6 +145,11 @@ EQUIVALENT: dict[str, Equivalent] = {
         "assign rd_start = pending_q;",
         "rd_start = pending_q without && !rd_active_q: the two never hold together (formal "
         "invariant of corner_turn, proven unbounded: assert !(pending_q && rd_active_q))"),
+    "corner_turn:const:8": Equivalent(
+        "if (t >= {1'b0, NM1}) t = t - {1'b1, NM1};",
+        "modadd subtracting {1'b1, NM1} instead of {1'b0, NM1}: the two differ by 2^B, "
+        "which only changes bit B of the B+1-bit t, and modadd returns t[B-1:0] (survived "
+        "the campaign's corner_turn stages, 27 November 2026)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
