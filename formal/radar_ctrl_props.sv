@@ -10,7 +10,10 @@
 //     start (clutter removal: removal_start; kind, local max, detections, scales:
 //     detect_start; packet words: packet_start) or reset, and the active set is always legal
 //     (kind 0/3, 1..5 detections, 3..8 packet words, scales below 2^12), what the wrapper's
-//     own invariant (pending set always legal) implies.
+//     own invariant (pending set always legal) implies;
+//   - the packet length made active at a packet_start is pend_packet_words of that cycle
+//     (what the top's packetizer takes with a frame's first word), and pend_packet_words is
+//     always legal.
 `default_nettype none
 
 module radar_ctrl_props #(
@@ -44,7 +47,7 @@ module radar_ctrl_props #(
   logic [31:0] s_axil_rdata;
   logic [1:0]  cfg_cfar_kind;
   logic        cfg_clutter_removal, cfg_local_max, irq;
-  logic [15:0] cfg_max_detections, cfg_packet_words;
+  logic [15:0] cfg_max_detections, cfg_packet_words, pend_packet_words;
   logic [NSC*SCW-1:0] cfg_cfar_scale;
 
   radar_ctrl #(.MAX_DETECTIONS(MAXD), .PACKET_WORDS(WORDS), .PACKET_WORDS_MIN(WORDS_MIN),
@@ -58,7 +61,7 @@ module radar_ctrl_props #(
     .s_axil_rvalid, .s_axil_rready, .s_axil_rdata, .s_axil_rresp,
     .removal_start, .detect_start, .packet_start, .frame_done, .packet_done, .drop, .error,
     .cfg_cfar_kind, .cfg_local_max, .cfg_clutter_removal, .cfg_max_detections,
-    .cfg_cfar_scale, .cfg_packet_words, .irq);
+    .cfg_cfar_scale, .cfg_packet_words, .pend_packet_words, .irq);
 
   initial assume (rst);
 
@@ -86,7 +89,7 @@ module radar_ctrl_props #(
   logic          past = 1'b0;
   logic          rs_q, ds_q, ps_q, rst_q, rem_q;
   logic [DW-1:0] det_q;
-  logic [15:0]   words_q;
+  logic [15:0]   words_q, pend_words_q;
   wire  [DW-1:0] det = {cfg_cfar_kind, cfg_local_max, cfg_max_detections, cfg_cfar_scale};
   always_ff @(posedge clk) begin
     past    <= 1'b1;
@@ -97,6 +100,7 @@ module radar_ctrl_props #(
     rem_q   <= cfg_clutter_removal;
     det_q   <= det;
     words_q <= cfg_packet_words;
+    pend_words_q <= pend_packet_words;
   end
 
   always_comb if (past && !rst) begin
@@ -111,9 +115,13 @@ module radar_ctrl_props #(
     if (!rs_q && !rst_q) assert (cfg_clutter_removal == rem_q);
     if (!ds_q && !rst_q) assert (det == det_q);
     if (!ps_q && !rst_q) assert (cfg_packet_words == words_q);
+    // the packet length copied at a packet_start is the pending one of that cycle, which the
+    // top's packetizer takes with a frame's first word
+    if (ps_q && !rst_q) assert (cfg_packet_words == pend_words_q);
     assert (cfg_cfar_kind == 2'd0 || cfg_cfar_kind == 2'd3);
     assert (cfg_max_detections >= 16'd1 && cfg_max_detections <= 16'(MAXD));
     assert (cfg_packet_words >= 16'(WORDS_MIN) && cfg_packet_words <= 16'(WORDS));
+    assert (pend_packet_words >= 16'(WORDS_MIN) && pend_packet_words <= 16'(WORDS));
   end
 
   always_comb if (past && !rst) begin

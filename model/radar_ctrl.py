@@ -204,6 +204,12 @@ class RadarCtrl:
                 if event in FLAGS:
                     self.status |= 1 << FLAGS.index(event)
 
+    def pend_packet_words(self) -> int:
+        """The ``pend_packet_words`` output: the pending ``PACKET.words``, what
+        ``cfg_packet_words`` becomes at the edge after a ``packet_start`` cycle (the top's
+        packetizer takes it with a frame's first word, in such a cycle)."""
+        return _get(REGISTERS["PACKET"], self.pending["PACKET"], "words")
+
     def active_fields(self) -> dict[str, int]:
         """The cfg_* outputs: cfar_kind, local_max, clutter_removal, max_detections,
         packet_words, cfar_scale (the packed table, entry e at bits e * scale_w)."""

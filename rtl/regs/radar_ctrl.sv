@@ -14,6 +14,9 @@
 //     and at no other time (a write accepted in that same cycle waits for the next one):
 //     clutter_removal at removal_start, the detector's set (cfar_kind, local_max,
 //     max_detections, the scales) at detect_start, packet words at packet_start;
+//     pend_packet_words is the pending packet length itself (a register), for a consumer
+//     that takes its setting in the frame-start cycle: what it takes there is what the
+//     copy makes active at the end of that cycle (the packetizer, docs/regs.md);
 //   - the event pulses (frame_done, packet_done, drop, error) feed the saturating counters
 //     FRAMES, PACKETS, DROPS, ERRORS and the sticky write-one-to-clear STATUS flags (an event
 //     in the cycle of the clearing write keeps its flag);
@@ -75,6 +78,9 @@ module radar_ctrl #(
   // scale of range edge index e at bits e*SCALE_W (model.cfar_2d.pack_scale)
   output logic [N_SCALES*SCALE_W-1:0] cfg_cfar_scale,
   output logic [15:0]            cfg_packet_words,
+  // the pending PACKET.words (a register): what cfg_packet_words becomes at the edge after
+  // a packet_start cycle, so the length a frame taken in that cycle gets
+  output logic [15:0]            pend_packet_words,
   output logic                   irq
 );
 
@@ -227,6 +233,7 @@ module radar_ctrl #(
   assign cfg_clutter_removal = active_q.clutter_removal;
   assign cfg_max_detections  = active_q.max_detections;
   assign cfg_packet_words    = active_q.packet_words;
+  assign pend_packet_words   = pend_q.packet_words;
   always_comb begin
     for (int e = 0; e < N_SCALES; e++)
       cfg_cfar_scale[e * SCALE_W +: SCALE_W] = active_sc_q[e * 32 +: SCALE_W];

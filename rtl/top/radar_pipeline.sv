@@ -591,13 +591,14 @@ module radar_pipeline #(
   // ---- output double buffer + TLAST packetizer ------------------------------------------
   logic        pk_framing;
   logic [31:0] pk_framing_count;
+  logic [15:0] pk_packet_words;    // radar_ctrl's pending PACKET.words (below)
 
   axis_packetizer #(
     .NUM_RX(NUM_RX), .DATA_W(DATA_W), .PACKET_WORDS(PACKET_WORDS), .FRAME_WORDS(FRAME_WORDS),
     .NUM_BANKS(OUT_BANKS), .HEADER(HEADER), .INPUT_BACKPRESSURE(1'b1),
     .TLAST_PERIOD((OUTPUT_MODE == 1) ? REC_WORDS : N_DOPPLER)
   ) u_packetizer (
-    .clk, .rst, .cfg_packet_words,
+    .clk, .rst, .cfg_packet_words(pk_packet_words),
     .s_axis_tdata(pk_tdata), .s_axis_tvalid(pk_tvalid), .s_axis_tready(pk_tready),
     .s_axis_tlast(pk_tlast), .s_axis_tuser(df_damaged),
     .m_axis_tdata(m_axis_dma_tdata), .m_axis_tvalid(m_axis_dma_tvalid),
@@ -607,15 +608,18 @@ module radar_pipeline #(
     .frame_count(frames_out), .packet_count(packets_out)
   );
 
-  // Frame boundary at the packetizer's input, as the corner turn's below: high while no word
-  // of a frame has been taken and in the cycle of a frame's last word (the packetizer takes
-  // the length with a frame's first word)
+  // Frame boundary at the packetizer's input, a register: high while no word of the current
+  // frame has been taken (between frames and in the cycle of a frame's first word), low from
+  // the cycle after the first word to the cycle of the last. The packetizer takes the length
+  // with a frame's first word, from radar_ctrl's pending PACKET.words, and the shadow copy
+  // makes that same value active at the end of the cycle (docs/regs.md, "Packetizer: its
+  // input"). No path from the packetizer's TREADY to the copy's enable (issue 30, note 16).
   logic pk_mid_q, pk_frame_start;
   always_ff @(posedge clk) begin
     if (rst) pk_mid_q <= 1'b0;
     else if (pk_tvalid && pk_tready) pk_mid_q <= !pk_frame_end;
   end
-  assign pk_frame_start = (pk_tvalid && pk_tready) ? pk_frame_end : !pk_mid_q;
+  assign pk_frame_start = !pk_mid_q;
 
   // ---- pipeline status --------------------------------------------------------------------
   // Events of the two FFTs: saturation and misplaced/missing TLAST (1-cycle pulses).
@@ -689,7 +693,7 @@ module radar_pipeline #(
   assign ctrl_drop        = ev[7] | ev[6];
   assign ctrl_error       = (|ev[5:0]) | rf_ev_ovf | df_ev_ovf | fft_tlast_event;
 
-  logic [15:0] cfg_packet_words;
+  logic [15:0] cfg_packet_words;   // the active length (ACTIVE_PACKET; unused here)
   // shortest packet: at most 4096 packets a frame (axis_packetizer's PW_MIN)
   localparam int PACKET_WORDS_MIN = ((FRAME_WORDS + 4095) / 4096 > 2)
                                     ? (FRAME_WORDS + 4095) / 4096 : 2;
@@ -712,19 +716,21 @@ module radar_pipeline #(
     .packet_start(pk_frame_start), .frame_done(ctrl_frame_done),
     .packet_done(ctrl_packet_done), .drop(ctrl_drop), .error(ctrl_error),
     .cfg_cfar_kind, .cfg_local_max, .cfg_clutter_removal, .cfg_max_detections,
-    .cfg_cfar_scale, .cfg_packet_words, .irq
+    .cfg_cfar_scale, .cfg_packet_words, .pend_packet_words(pk_packet_words), .irq
   );
 
   // Signals the chain does not need: bin indices (the order is implied), the ping-pong's
   // frame-start / discontinuity marks (its counters report drops), the corner turn's
   // frame-start mark (after static removal) and output frame count, the ping-pong's
   // dropped-sample count (chirps dropped are reported instead), and the static removal's
-  // saturation flag (the model reports it; no status port yet). Waiver: reduced into a
+  // saturation flag (the model reports it; no status port yet), the active packet length
+  // (the packetizer takes the pending one in its frame-start cycle). Waiver: reduced into a
   // deliberately unused bit.
   /* verilator lint_off UNUSEDSIGNAL */
   logic unused_ok;
   assign unused_ok = ^{rf_tuser, df_tuser, sr_tuser, ct_frames_out, pp_drop_samples,
-                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated};
+                       dmg_count, dmg_overflow, dmg_underflow, sr_saturated,
+                       cfg_packet_words};
   /* verilator lint_on UNUSEDSIGNAL */
 
 endmodule

@@ -7,7 +7,8 @@ against ``model/radar_ctrl.py``, through the Python access layer ``host.regs`` a
   writes, W1C status clears, interrupt enables, random event pulses (the three consumers'
   frame starts, frame done, packet, drop, error) between the accesses, resets in mid-test;
   every read against the model, the cfg_* outputs on every clock (each may change only at
-  the edge after its consumer's frame start) and irq whenever no access is in flight.
+  the edge after its consumer's frame start), and ``pend_packet_words`` (the pending packet
+  length) and irq whenever no access is in flight.
 - ``shadow_and_refusal``: directed: settings written in mid-frame show on cfg_* exactly at
   the edge after the next frame start of their consumer, not before and not at another
   consumer's; an out-of-range write (a CFAR kind not built in with a legal max_detections,
@@ -102,6 +103,8 @@ class TB:
                 self.settle = max(self.settle - 1, 0)
             else:
                 assert int(dut.irq.value) == m.irq, f"irq {int(dut.irq.value)} != {m.irq}"
+                pend = int(dut.pend_packet_words.value)
+                assert pend == m.pend_packet_words(), f"pend_packet_words {pend}"
 
     async def reset(self, cycles: int = 3) -> None:
         await FallingEdge(self.dut.clk)
@@ -277,10 +280,13 @@ async def shadow_and_refusal(dut) -> None:
         before = tb.cfg()
         await tb.pulse_cycle(start)                          # the frame-start cycle
         assert tb.cfg() == before
+        pend = int(dut.pend_packet_words.value)              # what the packetizer takes
         await RisingEdge(dut.clk)
         await ReadOnly()                                     # the cycle after it
         after = tb.cfg()
         assert after == m.active_fields()
+        if start == "packet_start":
+            assert after["packet_words"] == pend, "copy != the length taken in the pulse"
         mine = {{"words": "packet_words", "scale": "cfar_scale"}.get(f, f) for _, f in fields}
         assert {n for n in CFG if after[n] != before[n]} <= mine, f"{start} changed others"
         assert after != before or start == "packet_start" and \
