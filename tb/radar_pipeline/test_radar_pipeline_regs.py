@@ -11,7 +11,9 @@ removal switched off, two frames, switched on between frames, two more: the DMA 
 the model's with the removal off for the first two and on from the next frame
 (``dma_packets(removal=...)``), ACTIVE_SETTINGS follows; PACKET.words written while frame 4
 streams into the packetizer: ACTIVE_PACKET keeps the old length until that frame's last
-word, frame 4 is cut with the old length and frames 5 and 6 with the new one (the model
+word, frame 4 is cut with the old length and frame 5 with the new one; a third length set
+as by a write accepted in the last cycle before frame 6's first word (the pending register
+deposited in the cycle of that word) cuts frame 6 and shows in ACTIVE_PACKET (the model
 with ``FrameSettings(packet_words=...)``); the FRAMES / PACKETS counters equal what the DMA
 delivered (and the status ports), no drops or errors; irq rises on frame done when enabled
 and falls when STATUS.frame_done is written 1.
@@ -24,6 +26,7 @@ from pathlib import Path
 
 import cocotb
 import numpy as np
+from cocotb.triggers import FallingEdge
 from test_radar_pipeline import SMALL4, adc_frames, poll, watched
 
 from host import regs
@@ -59,6 +62,24 @@ async def set_removal(tb: PipelineTB, on: bool) -> None:
     await tb.cycles(4)
     assert (await read(tb, "ACTIVE_SETTINGS"))["clutter_removal"] == int(on)
     assert (await read(tb, "CFG_ERRORS"))["count"] == refused
+
+
+async def set_at_first_word(dut, nth: int, words: int) -> None:
+    """Set the pending ``PACKET.words`` to ``words`` in the cycle of the ``nth`` frame's first
+    word the packetizer takes from now on (its beat with ``pk_mid_q`` low), as a write
+    accepted in the cycle before would: that frame is cut with ``words`` and ``ACTIVE_PACKET``
+    shows it after that cycle (docs/regs.md, "Packetizer: its input"). The write's timing
+    through AXI4-Lite cannot be aimed at one clock, so the pending register of ``u_ctrl``
+    is deposited (at the falling edge, where the beat is already decided: the packetizer's
+    TREADY does not depend on the length at a frame's first word of at least 2)."""
+    seen = 0
+    while seen < nth:
+        await FallingEdge(dut.clk)
+        if int(dut.pk_mid_q.value) == 0 and int(dut.pk_tvalid.value) \
+                and int(dut.pk_tready.value):
+            seen += 1
+    pend = int(dut.u_ctrl.pend_q.value)
+    dut.u_ctrl.pend_q.value = (pend & ~0xFFFF) | words   # packet_words: the struct's LSBs
 
 
 def ctrl_model() -> RadarCtrl:
@@ -150,7 +171,7 @@ async def registers_through_axi_lite(dut) -> None:
 
     # packet length written while frame 4 streams into the packetizer: from frame 5 on
     more = adc_frames("small4", SMALL4, 7)[4:]
-    new_words = 96
+    new_words, last_words = 96, 128
     for adc in more:
         await tb.send_frame(adc)
     fw = SMALL4.num_tx * SMALL4.n_range * SMALL4.n_doppler
@@ -161,11 +182,13 @@ async def registers_through_axi_lite(dut) -> None:
     await write(tb, "PACKET", words=new_words)
     assert int(dut.frames_out.value) == 4 and int(dut.pk_mid_q.value) == 1, "not mid-frame"
     assert (await read(tb, "ACTIVE_PACKET"))["words"] == CHAIN.packet_words, "applied mid-frame"
-    n_pk = (packets_per_frame(fw, CHAIN.packet_words)
-            + 2 * packets_per_frame(fw, new_words))
+    hit = cocotb.start_soon(set_at_first_word(dut, 2, last_words))
+    n_pk = (packets_per_frame(fw, CHAIN.packet_words) + packets_per_frame(fw, new_words)
+            + packets_per_frame(fw, last_words))
     late = [await tb.recv_packet(2 * tb.frame_timeout_cycles()) for _ in range(n_pk)]
-    assert (await read(tb, "ACTIVE_PACKET"))["words"] == new_words
-    lengths = [CHAIN.packet_words] * 5 + [new_words] * 2
+    assert hit.done()
+    assert (await read(tb, "ACTIVE_PACKET"))["words"] == last_words
+    lengths = [CHAIN.packet_words] * 5 + [new_words, last_words]
     want = dma_packets([*frames, *more], SMALL4, CHAIN, removal=removal + [True] * 3,
                        settings=FrameSettings(packet_words=lengths))
     assert_packets_equal(late, want[len(got):], "packet length written in mid-frame")
