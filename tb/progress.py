@@ -162,8 +162,8 @@ def cfar_latency(c) -> int:
 
 def fft_latency(n: int, window: bool) -> int:
     """Clocks from the first sample of an ``n``-point ``fft_axis`` frame in to its first bin
-    out (docs/fft_axis.md, "Latency and throughput"): 2N + 2L + 5M + 2, +3 with the window,
+    out (docs/fft_axis.md, "Latency and throughput"): 2N + 2L + 5M + 3, +3 with the window,
     L = log2 N butterfly stages, M the twiddle multipliers of one lane
-    (``model.fft_axis.multipliers_per_lane``)."""
+    (``model.fft_axis.multipliers_per_lane``); the 3 includes the input buffer's clock."""
     stages = n.bit_length() - 1
-    return 2 * n + 2 * stages + 5 * multipliers_per_lane(n) + 2 + 3 * int(window)
+    return 2 * n + 2 * stages + 5 * multipliers_per_lane(n) + 3 + 3 * int(window)

@@ -4,7 +4,9 @@
 // register. A bank slot may be rewritten as soon as it has been read, so continuous frames
 // pass without a gap. wr_ok comes from registers only: the slot compare of the write position
 // it concerns (`wr_addr < rd_ptr_q`) is computed a cycle ahead from wr_step / wr_pos_nxt, so
-// the caller's advance enable does not wait for a comparator.
+// the caller's advance enable does not wait for a comparator; wr_ok_nxt is the same flag for
+// the next cycle (from this cycle's write, step and read), for a caller whose advance enable
+// is itself a register decided a cycle ahead (fft_axis).
 `default_nettype none
 
 module fft_reorder #(
@@ -27,6 +29,9 @@ module fft_reorder #(
   input  logic [$clog2(N)-1:0]    wr_pos_nxt,
   input  logic [WIDTH-1:0]        wr_data,
   output logic                    wr_ok,
+  // wr_ok of the next cycle: from this cycle's registers, wr_en, wr_step / wr_pos_nxt and the
+  // output handshake (ignore it in a reset cycle).
+  output logic                    wr_ok_nxt,
   // Read side (natural order, registered outputs).
   output logic [WIDTH-1:0]        m_axis_tdata,
   output logic                    m_axis_tvalid,
@@ -50,6 +55,7 @@ module fft_reorder #(
   logic [LOG2N-1:0] wr_addr, nxt_addr;
   logic             pop, rd_last, wr_last;
   logic             lt_q, lt_d;              // wr_addr < rd_ptr_q, from registers
+  logic             wb_d, rb_d;
   logic [WIDTH-1:0] m_data_q;
   logic [LOG2N-1:0] m_user_q;
   logic             m_last_q, m_valid_q;
@@ -84,6 +90,9 @@ module fft_reorder #(
     if (pop && rd_last) full_d[rb_q] = 1'b0;
     if (wr_en && wr_last) full_d[wb_q] = 1'b1;
   end
+  assign wb_d      = wb_q ^ (wr_en && wr_last);
+  assign rb_d      = rb_q ^ (pop && rd_last);
+  assign wr_ok_nxt = !full_d[wb_d] || (rb_d == wb_d && lt_d);
 
   always_ff @(posedge clk) begin
     if (wr_en) mem_q[{wb_q, wr_addr}] <= wr_data;
@@ -105,10 +114,10 @@ module fft_reorder #(
     end else begin
       full_q <= full_d;
       lt_q   <= lt_d;
-      if (wr_en && wr_last) wb_q <= ~wb_q;
+      wb_q   <= wb_d;
+      rb_q   <= rb_d;
       if (pop) begin
         rd_ptr_q <= rd_last ? '0 : rd_ptr_q + 1'b1;
-        if (rd_last) rb_q <= ~rb_q;
         m_valid_q <= 1'b1;
       end else if (m_axis_tready) begin
         m_valid_q <= 1'b0;
@@ -134,6 +143,7 @@ module fft_reorder #(
   logic         f_past = 1'b0;
   logic         f_stepped = 1'b0;          // the previous cycle was out of reset
   logic [LOG2N-1:0] f_pos_nxt = '0;       // wr_pos this cycle by the wr_step contract
+  logic         f_ok_nxt = 1'b0;           // last cycle's wr_ok_nxt
   logic [2*N-1:0] f_pend = '0;
   logic [LOG2N-1:0] f_wpos = '0;   // write positions arrive in pipeline order 0..N-1
   logic             f_written, f_unread;
@@ -144,6 +154,7 @@ module fft_reorder #(
     f_past    <= 1'b1;
     f_stepped <= !rst;
     f_pos_nxt <= wr_step ? wr_pos_nxt : wr_pos;
+    f_ok_nxt  <= wr_ok_nxt;
     if (rst) begin
       f_pend <= '0;
       f_wpos <= '0;
@@ -170,6 +181,7 @@ module fft_reorder #(
     if (wr_en) assert (!f_pend[{wb_q, wr_addr}] || (pop && {rb_q, rd_ptr_q} == {wb_q, wr_addr}));
     if (pop) assert (f_pend[{rb_q, rd_ptr_q}]);
     assert (lt_q == (wr_addr < rd_ptr_q));
+    if (f_stepped) assert (wr_ok == f_ok_nxt);
     // bank order invariants
     if (wb_q != rb_q) assert (!full_q[wb_q]);
     if (wb_q == rb_q) assert (full_q[0] == full_q[1]);
