@@ -107,6 +107,11 @@ module fft_twiddle #(
 
   // ---------------------------------------------------------------- stages 1, 2: operands
   logic [DW-1:0]        d1_q, d2_q;   // data in stages 1, 2
+  // each lane's pre-add re + im in stages 1, 2: the data operand of the Gauss product k1
+  // (unused by the four-product form, which synthesis then drops)
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic signed [W:0]    a1_q [NUM_CH], a2_q [NUM_CH];
+  /* verilator lint_on UNUSEDSIGNAL */
   logic [LOG2N-1:0]     pos_q [5];
   logic                 ov_q  [4];
   logic [4:0]           vld_q;
@@ -117,6 +122,19 @@ module fft_twiddle #(
   localparam int NCF = GAUSS ? 3 : 2;
   logic signed [COEF_W-1:0] cf1_q [NCF];
   logic signed [COEF_W-1:0] cf2_q [NUM_CH * NCF];
+
+  // The split form's table (g_split): data operand of product p of a lane (OP_PRE the
+  // pre-add re + im, OP_RE, OP_IM) and its coefficient word within the lane's NCF.
+  //   Gauss: k1 = pre-add * C, k2 = re * (d - C), k3 = im * (-C - d)
+  //   four:  re * C, im * S, im * C, re * S
+  localparam int OP_PRE = 0, OP_RE = 1, OP_IM = 2;
+  function automatic int split_op(int p);
+    if (GAUSS) split_op = p;
+    else       split_op = (p == 1 || p == 2) ? OP_IM : OP_RE;
+  endfunction
+  function automatic int split_cf(int p);
+    split_cf = GAUSS ? p : p % 2;
+  endfunction
 
   // keep: the per-lane copies hold the same bits, which Yosys' opt_merge would merge back
   // into one register feeding every lane's multipliers
@@ -159,8 +177,6 @@ module fft_twiddle #(
     end
 
     if (!SPLIT) begin : g_mul
-      logic signed [W:0]        a1_q [NUM_CH];      // re + im
-      logic signed [W:0]        a2_q [NUM_CH];      // stage 2: each lane's operands
       logic signed [PRW:0]      k1_q [NUM_CH];
       logic signed [PRW-1:0]    k2_q [NUM_CH];
       logic signed [PRW-1:0]    k3_q [NUM_CH];
@@ -168,9 +184,6 @@ module fft_twiddle #(
       always_ff @(posedge clk) begin
         if (en) begin
           for (int ch = 0; ch < NUM_CH; ch++) begin
-            a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
-                      + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
-            a2_q[ch] <= a1_q[ch];
             k1_q[ch] <= (PRW+1)'(a2_q[ch]) * (PRW+1)'(cf2_q[ch*NCF]);
             k2_q[ch] <= PRW'(signed'(d2_q[ch*2*W +: W])) * PRW'(cf2_q[ch*NCF + 1]);
             k3_q[ch] <= PRW'(signed'(d2_q[ch*2*W + W +: W])) * PRW'(cf2_q[ch*NCF + 2]);
@@ -226,12 +239,10 @@ module fft_twiddle #(
   end
 
   if (SPLIT) begin : g_split
-    // Products p of lane ch at ch * NP + p (Gauss: k1, k2, k3 with data operands re + im, re,
-    // im; four: re*C, im*S, im*C, re*S), each (h << LO_W) + l from its data operand's low (l)
-    // and high (h) parts, both registered; the sums as in g_gauss / g_four.
+    // Products p of lane ch at ch * NP + p, each (h << LO_W) + l from its data operand's low
+    // (l) and high (h) parts, both registered; the sums as in g_gauss / g_four. The operand
+    // and coefficient of product p: split_op and split_cf.
     localparam int NP = GAUSS ? 3 : 4;
-    logic signed [W:0]     a1_q [NUM_CH];      // Gauss: re + im
-    logic signed [W:0]     a2_q [NUM_CH];      // stage 2: each lane's operand
     logic signed [LPW-1:0] l_q [NUM_CH * NP];
     logic signed [HPW-1:0] h_q [NUM_CH * NP];
 
@@ -240,14 +251,10 @@ module fft_twiddle #(
       logic signed [COEF_W-1:0] c;
       if (en) begin
         for (int ch = 0; ch < NUM_CH; ch++) begin
-          a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
-                    + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
-          a2_q[ch] <= a1_q[ch];
           for (int p = 0; p < NP; p++) begin
-            // component: Gauss p = 1 re, 2 im; four p = 0, 3 re, 1, 2 im
-            x = GAUSS && p == 0 ? XW'(a2_q[ch])
-              : XW'(signed'(d2_q[ch*2*W + ((GAUSS ? p == 2 : p == 1 || p == 2) ? W : 0) +: W]));
-            c = cf2_q[ch*NCF + (GAUSS ? p : p % 2)];
+            x = split_op(p) == OP_PRE ? XW'(a2_q[ch])
+              : XW'(signed'(d2_q[ch*2*W + (split_op(p) == OP_IM ? W : 0) +: W]));
+            c = cf2_q[ch*NCF + split_cf(p)];
             l_q[ch*NP + p] <= LPW'(signed'({1'b0, x[LO_W-1:0]})) * LPW'(c);
             h_q[ch*NP + p] <= HPW'(signed'(x[XW-1:LO_W])) * HPW'(c);
           end
@@ -284,6 +291,11 @@ module fft_twiddle #(
     if (en) begin
       d1_q     <= in_data;
       d2_q     <= d1_q;
+      for (int ch = 0; ch < NUM_CH; ch++) begin
+        a1_q[ch] <= (W+1)'(signed'(in_data[ch*2*W +: W]))
+                  + (W+1)'(signed'(in_data[ch*2*W + W +: W]));
+        a2_q[ch] <= a1_q[ch];
+      end
       pos_q[0] <= in_pos;
       ov_q[0]  <= in_ov;
       for (int k = 1; k < 5; k++) pos_q[k] <= pos_q[k-1];
