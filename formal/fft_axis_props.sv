@@ -10,11 +10,14 @@
 //     with TLAST set before position N-1 / clear at position N-1 (positions counted here from
 //     the input beats), and never otherwise.
 // Bound: the first output beat needs a whole frame in plus the pipeline (about 40 cycles),
-// beyond the depth z3/yices reach here (12); within the bound the input side, the framing
+// beyond the depth yices reaches here in minutes (20: 7 min); within the bound the input
+// side, the advance copies through the first bubble (a frame's 16 samples in, then an empty
+// input buffer: fft_axis' own cover reaches it at step 18, so the depth must stay above
+// that for the bubble term of the advance to be checked), the framing
 // events and the fft_reorder bank-reuse asserts (active inside) are checked, and the output
 // assertions hold vacuously. The output port itself is fft_reorder's m_axis, proven
 // unbounded in fft_reorder.sby (its covers reach output beats and TLAST).
-// The cover task (depth 18) reaches input beats and both framing events; the covers of a
+// The cover task (depth 20) reaches input beats, both framing events and a bubble; the covers of a
 // stalled input (the reorder buffer full) and fft_reorder's own covers need output beats and
 // are removed from it (chformal): they are reached in fft_reorder.sby.
 // The sby script cuts the stage data (butterfly sums, twiddle products, output rounding and

@@ -339,6 +339,7 @@ module fft_axis #(
     assert (ib_cnt_q <= 2'd2);
     assert (s_axis_tready == (ib_cnt_q != 2'd2 && !fill_q));
     if (bubble) assert (bub_q);
+    cover (bubble);   // first reached at step 18 (N = 16): the bmc depth must exceed it
   end
   for (genvar s = 0; s < LOG2N; s++) begin : g_f_adv
     always_comb if (f_past && !rst) assert (g_stage[s].adv_bf == adv_c);
