@@ -28,14 +28,19 @@ from synth.timing_run import DEVICE, Settings, run_job
 
 # The ECP5's multiplier is a MULT18X18D: the FFTs' twiddle products split their data operands
 # to 18 bits there (fft_twiddle MUL_W, docs/fft_axis.md); the xcup depth keeps the DSP48E2's 27.
+# Yosys' ECP5 mapping leaves the DP16KD's output register unused: the corner turn's frame memory
+# (16384 words, 8 DP16KD deep in 2048 x 9 mode) is split into 8 banks, each with its own fabric
+# output register, the bank chosen after it (buf_sdp_ram BANKS, docs/synth.md note 18).
 ECP5_PARAMS: dict[str, dict[str, int]] = {"fft_axis": {"MUL_W": 18},
+                                          "corner_turn": {"RAM_BANKS": 8},
                                           "radar_pipeline": {"MUL_W": 18}}
 
 
 def timing_sets() -> dict[str, list[Job]]:
     """``ci`` (one small block, the regression's job), ``paper-fpga`` (the blocks and the
     detector of :func:`synth.jobs.job_sets`), ``top`` (the ``paper-fpga`` radar_pipeline),
-    ``all`` (``paper-fpga`` + ``top``); the FFTs and the top with :data:`ECP5_PARAMS`."""
+    ``all`` (``paper-fpga`` + ``top``); the FFTs, the corner turn and the top with
+    :data:`ECP5_PARAMS`."""
     paper = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {}))
              for j in job_sets()["paper-fpga"]]
     blocks = [j for j in paper if j.top != "radar_pipeline"]

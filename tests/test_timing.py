@@ -53,18 +53,23 @@ def test_job_key_changes_with_sources_and_settings(tmp_path: Path) -> None:
 
 def test_ecp5_params_reach_the_ecp5_mapping_only(tmp_path: Path) -> None:
     """The FFTs and the top map their twiddle products to 18-bit operands on the ECP5
-    (MUL_W = 18, docs/fft_axis.md) in the ECP5 wrapper only; the xcup depth reads a wrapper
-    without it; other blocks keep one wrapper."""
+    (MUL_W = 18, docs/fft_axis.md), the corner turn splits its frame memory into 8 banks
+    (RAM_BANKS = 8, docs/synth.md note 18), in the ECP5 wrapper only; the xcup depth reads a
+    wrapper without them; other blocks keep one wrapper."""
     sets = timing_sets()
     for job in sets["paper-fpga"] + sets["top"]:
-        want = {"MUL_W": 18} if job.top in ("fft_axis", "radar_pipeline") else {}
+        want = ({"MUL_W": 18} if job.top in ("fft_axis", "radar_pipeline") else
+                {"RAM_BANKS": 8} if job.top == "corner_turn" else {})
         assert job.ecp5_params == want, job.name
-        assert "MUL_W" not in job.params
+        assert "MUL_W" not in job.params and "RAM_BANKS" not in job.params
     fft = next(j for j in sets["paper-fpga"] if j.top == "fft_axis")
     assert fft.label.endswith(" MUL_W=18 (ECP5)")
     sc = scripts(fft, [], tmp_path)
     assert " wrap.sv\n" in sc["ecp5"] and " wrap_xcup.sv\n" in sc["xcup"]
-    other = next(j for j in sets["paper-fpga"] if j.top == "corner_turn")
+    turn = next(j for j in sets["paper-fpga"] if j.top == "corner_turn")
+    assert turn.label.endswith(" RAM_BANKS=8 (ECP5)")
+    assert " wrap_xcup.sv\n" in scripts(turn, [], tmp_path)["xcup"]
+    other = next(j for j in sets["paper-fpga"] if j.top == "chirp_pingpong")
     assert " wrap.sv\n" in scripts(other, [], tmp_path)["xcup"]
 
 

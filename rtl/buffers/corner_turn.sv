@@ -38,7 +38,12 @@ module corner_turn #(
   // Output order. 0: for TX t, for range bin r (the radar cube, docs/design.md 3.2);
   // 1: for range bin r, for TX t (on-chip detection, docs/detect.md: all TX of a range bin
   // together). The Doppler vector is the same; with NUM_TX = 1 both orders are equal.
-  parameter int READ_ORDER = 0
+  parameter int READ_ORDER = 0,
+  // Frame-memory banks (buf_sdp_ram BANKS): 1, or with a power-of-two NUM_TX a power of two
+  // 2..NUM_TX*N_RANGE*N_DOPPLER/2: the memory split by its top address bits, the bank chosen
+  // after the per-bank output registers (for synthesis that does not use the block RAM's own
+  // output register: the ECP5 timing flow sets 8). Same data and timing at the ports.
+  parameter int RAM_BANKS = 1
 ) (
   input  wire logic                          clk,
   input  wire logic                          rst,
@@ -120,7 +125,7 @@ module corner_turn #(
   logic [B-1:0]      ram_wr_addr, ram_rd_addr;
   logic [WORD_W-1:0] ram_rd_data;
 
-  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(N), .OUT_REG(1'b1)) u_ram (
+  buf_sdp_ram #(.WIDTH(WORD_W), .DEPTH(N), .OUT_REG(1'b1), .BANKS(RAM_BANKS)) u_ram (
     .clk     (clk),
     .wr_en   (ram_wr_en),
     .wr_addr (ram_wr_addr),

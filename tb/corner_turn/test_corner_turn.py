@@ -281,8 +281,10 @@ async def test_reset_during_backpressure_and_output(dut):
 PARAMS = [
     # smallest non-square reorder (B=5, ROT=2: address pattern period 5 frames)
     dict(NUM_TX=1, NUM_RX=1, N_RANGE=4, N_DOPPLER=8),
-    # TDM-MIMO interleave, 4 TX, 512-bit words (B=9, ROT=5: period 9 frames)
-    dict(NUM_TX=4, NUM_RX=16, N_RANGE=8, N_DOPPLER=16),
+    # TDM-MIMO interleave, 4 TX, 512-bit words (B=9, ROT=5: period 9 frames); the frame
+    # memory in 8 banks of 64 words, chosen after the per-bank output registers (the ECP5
+    # timing flow's RAM_BANKS, docs/synth.md note 18)
+    dict(NUM_TX=4, NUM_RX=16, N_RANGE=8, N_DOPPLER=16, RAM_BANKS=8),
     # paper-fpga preset: 1 TX x 4 RX, 64 range bins, 256 chirps (16384 x 128-bit words)
     dict(NUM_TX=1, NUM_RX=4, N_RANGE=64, N_DOPPLER=256),
     # on-chip detection order (r, t, d): bit-permutation addresses, period 7 frames
