@@ -15,11 +15,11 @@ Operators (one textual change on one line of ``rtl/**/*.sv``):
            that miscounts in a corner, a flag dropped from a sticky merge, a comparison wrong
            on a tie, a TLAST term lost), see tools/mutate_ops.py
 
-Lines inside ``ifdef FORMAL`` / ``ifndef SYNTHESIS`` blocks, parameter checks, comments and
-axis_checker instances are never mutated (they are checks, not design). Each mutant runs in
-its own copy of the tree (``rtl``, ``tb``, ``host``, ``model`` copied into a temporary
-folder), so the worktree is never modified and runs are parallel-safe. The sample is
-deterministic for a given ``--seed``.
+Lines inside ``ifdef FORMAL`` / ``ifdef F_<NAME>`` (a proof's own define) / ``ifndef SYNTHESIS``
+blocks, parameter checks, comments and axis_checker instances are never mutated (they are
+checks, not design). Each mutant runs in its own copy of the tree (``rtl``, ``tb``, ``host``,
+``model`` copied into a temporary folder), so the worktree is never modified and runs are
+parallel-safe. The sample is deterministic for a given ``--seed``.
 
     python tools/mutate.py --list frame_align          # every candidate mutant
     python tools/mutate.py -n 40 --seed 1              # 40 mutants spread over modules

@@ -77,7 +77,8 @@ def _design_lines(text: str) -> Iterator[tuple[int, str]]:
         # lint sinks (``assign unused_x = ^{...};``): no behaviour, every mutant equivalent
         if re.match(r"(assign\s+)?unused_\w*\s*=", s):
             continue
-        if re.match(r"`ifdef\s+FORMAL|`ifndef\s+SYNTHESIS", s):
+        # formal-only code: `ifdef FORMAL, a proof's own define (`ifdef F_<NAME>), simulation checks
+        if re.match(r"`ifdef\s+(FORMAL|F_\w+)\b|`ifndef\s+SYNTHESIS", s):
             skip_depth += 1
             continue
         if skip_depth:
