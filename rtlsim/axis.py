@@ -183,6 +183,31 @@ class AxisTB:
         for _ in range(n):
             await RisingEdge(self.dut.clk)
 
+    async def hold_word_through_reset(self, word: np.ndarray, tlast: bool,
+                                      cycles: int = 4) -> None:
+        """A source outside the DUT's reset: assert ``rst``, then present one input word
+        (``word``: one value per 32-bit lane, ``s_axis_tdata`` as ``words_to_bytes`` packs
+        it) with TVALID high and hold it until TREADY, releasing ``rst`` after ``cycles``
+        clocks. Fails if the word is taken while ``rst`` is high (it would be lost with the
+        reset) or not within 64 clocks; leaves TVALID low once it is taken."""
+        d = self.dut
+        d.rst.value = 1
+        await RisingEdge(d.clk)   # the testbench's own source has seen the reset (TVALID low)
+        d.s_axis_tdata.value = int.from_bytes(words_to_bytes(word[np.newaxis]), "little")
+        d.s_axis_tlast.value = int(tlast)
+        d.s_axis_tvalid.value = 1
+        for cyc in range(64):
+            if cyc == cycles:
+                d.rst.value = 0
+            await RisingEdge(d.clk)
+            if d.s_axis_tready.value == 1:
+                taken_in_reset = d.rst.value == 1
+                break
+        else:
+            raise AssertionError("the word held through the reset was never taken")
+        d.s_axis_tvalid.value = 0
+        assert not taken_in_reset, "a word was taken during the reset (and lost with it)"
+
     async def reset(self, cycles: int = 4) -> None:
         """Hold ``rst`` high for ``cycles`` clocks (synchronous, active high)."""
         self.dut.rst.value = 1
