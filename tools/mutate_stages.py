@@ -21,6 +21,7 @@ _Q_PK = ("tb/axis_packetizer/test_axis_packetizer.py::test_axis_packetizer[NUM_R
 _Q_FFT = ("tb/fft_axis/test_fft_axis.py::"
           "test_fft_axis[N16_NUM_CH2_DATA_W12_GUARD_W2_WINDOW1_SCALE_SCH10]")
 _Q_MF = "tb/mark_fifo/test_mark_fifo.py::test_mark_fifo[DEPTH4_WIDTH1]"
+_Q_RS = "tb/axis_reg_slice/test_axis_reg_slice.py::test_axis_reg_slice[DATA_W32_USER_W2]"
 _Q_FS = ("tb/frame_store_axi/test_frame_store_axi.py::test_frame_store_axi[NUM_TX1_NUM_RX1_"
          "N_RANGE8_N_DOPPLER8_TILE_R4_AXI_DATA_W128_MAX_OUTSTANDING4_WFIFO_DEPTH4]")
 _Q_NCI = "tb/nci/test_nci.py"
@@ -37,6 +38,7 @@ _Q_RPFS = ("tb/radar_pipeline/test_radar_pipeline_frame_store.py::"
 CHEAPEST: dict[str, list[str]] = {
     "frame_align": [_Q_FA], "chirp_pingpong": [_Q_CP], "corner_turn": [_Q_CT],
     "axis_packetizer": [_Q_PK], "fft_axis": [_Q_FFT], "mark_fifo": [_Q_MF],
+    "axis_reg_slice": [_Q_RS],
     "frame_store_axi": [_Q_FS], "nci": [_Q_NCI], "cfar_2d": [_Q_CFAR],
     "detect_records": [_Q_REC], "detect_chain": [_Q_DC], "radar_pipeline": [_Q_RP],
     "radar_ctrl": [_Q_RC], "static_removal": [_Q_SR],
@@ -54,6 +56,7 @@ TESTS: dict[str, list[list[str]]] = {
     "buf_sdp_ram": [[_Q_CP, _Q_CT], ["tb/chirp_pingpong", "tb/corner_turn"],
                     [_Q_NCI, _Q_CFAR]],
     "mark_fifo": [[_Q_MF], ["tb/mark_fifo"], [_Q_RP]],
+    "axis_reg_slice": [[_Q_RS], ["tb/axis_reg_slice"], [_Q_RP]],
     "frame_store_axi": _FS,
     "frame_store_fifo": _FS,
     "frame_store_gearbox": _FS,

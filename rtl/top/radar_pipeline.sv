@@ -342,6 +342,25 @@ module radar_pipeline #(
     .chirps_discarded(chirps_discarded)
   );
 
+  // ---- register slice (docs/synth.md note 20) -----------------------------------------------
+  // frame_align passes its sink's TREADY through to the ping-pong in PASS; the range FFT's
+  // input buffer sits far from it in a placed design (the top's critical path was that
+  // handshake across three blocks). Every output of the slice is a register: one clock of
+  // latency, full rate.
+  logic [WORD_W-1:0] rs_tdata;
+  logic              rs_tvalid, rs_tready, rs_tlast;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [0:0]        rs_tuser_unused;  // the stream has no TUSER here (tied 0)
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  axis_reg_slice #(.DATA_W(WORD_W), .USER_W(1)) u_fa_slice (
+    .clk, .rst,
+    .s_axis_tdata(fa_tdata), .s_axis_tvalid(fa_tvalid), .s_axis_tready(fa_tready),
+    .s_axis_tlast(fa_tlast), .s_axis_tuser(1'b0),
+    .m_axis_tdata(rs_tdata), .m_axis_tvalid(rs_tvalid), .m_axis_tready(rs_tready),
+    .m_axis_tlast(rs_tlast), .m_axis_tuser(rs_tuser_unused)
+  );
+
   // ---- range FFT ----------------------------------------------------------------------------
   logic [WORD_W-1:0]          rf_tdata;
   logic                       rf_tvalid, rf_tready, rf_tlast;
@@ -353,8 +372,8 @@ module radar_pipeline #(
     .INVERSE(1'b0), .WINDOW(WINDOW), .SCALE_SCH(RANGE_SCALE_SCH), .MUL_W(MUL_W)
   ) u_range_fft (
     .clk, .rst,
-    .s_axis_tdata(fa_tdata), .s_axis_tvalid(fa_tvalid), .s_axis_tready(fa_tready),
-    .s_axis_tlast(fa_tlast),
+    .s_axis_tdata(rs_tdata), .s_axis_tvalid(rs_tvalid), .s_axis_tready(rs_tready),
+    .s_axis_tlast(rs_tlast),
     .m_axis_tdata(rf_tdata), .m_axis_tvalid(rf_tvalid), .m_axis_tready(rf_tready),
     .m_axis_tlast(rf_tlast), .m_axis_tuser(rf_tuser),
     .event_tlast_unexpected(rf_ev_unexp), .event_tlast_missing(rf_ev_miss),
