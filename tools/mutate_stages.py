@@ -216,6 +216,12 @@ EQUIVALENT: dict[str, Equivalent] = {
         "accumulator word that TX t >= 1 reads was written by TX t-1 of the same Doppler "
         "bin after the reset, so a stray word is always overwritten before it is read "
         "(and with NUM_TX = 1 the register drives nothing)"),
+    "axis_reg_slice:dropfirst:4": Equivalent(
+        "if (in_beat) skid_q <= s_payload;",
+        "the skid's word is also written when the output register takes the input beat "
+        "(out_free): skid_valid_q stays 0 then, skid_q is read only while skid_valid_q is 1, "
+        "and skid_valid_q is set only by the arm !out_free && in_beat, which writes skid_q "
+        "at the same edge; so the extra write is never read"),
     "mark_fifo:const:8": Equivalent(
         "for (int i = 0; i < DEPTH - 0; i++) q[i] <= q[i+1];",
         "the shift loop runs one step further (q[DEPTH-1] <= q[DEPTH], an out-of-range "
