@@ -513,8 +513,12 @@ module radar_pipeline #(
   );
 
   // ---- packetizer input: the cube (mode 0) or the detector's records (mode 1) ------------
-  logic [WORD_W-1:0] pk_tdata;
+  // pu_*: the stream before the register slice in front of the packetizer; pk_*: after it,
+  // the packetizer's own input.
+  logic [WORD_W-1:0] pu_tdata, pk_tdata;
+  logic              pu_tvalid, pu_tready, pu_tlast, pu_last_word, pu_frame_end;
   logic              pk_tvalid, pk_tready, pk_tlast, pk_frame_end;
+  logic [1:0]        pk_tuser;            // {the frame's last word, the frame's damaged mark}
   logic              det_framing_error;   // sticky, detector input TLAST misplaced
   logic              df_frame_end;        // last Doppler word of a frame (below)
   // detector settings (radar_ctrl) and the detector's frame start, where they change
@@ -545,20 +549,17 @@ module radar_pipeline #(
       .frame_start(det_frame_start),
       .s_axis_tdata(df_tdata), .s_axis_tvalid(df_tvalid), .s_axis_tready(df_tready),
       .s_axis_tlast(df_tlast),
-      .m_axis_tdata(pk_tdata), .m_axis_tvalid(pk_tvalid), .m_axis_tready(pk_tready),
-      .m_axis_tlast(pk_tlast),
+      .m_axis_tdata(pu_tdata), .m_axis_tvalid(pu_tvalid), .m_axis_tready(pu_tready),
+      .m_axis_tlast(pu_tlast),
       .status_framing_error(det_framing), .status_truncated(status_truncated),
       .detection_count(detections), .frame_count(record_frames)
     );
     assign det_framing_error = det_framing;
-    // the record stream has TLAST only on the last word of a frame
-    assign pk_frame_end = pk_tvalid && pk_tready && pk_tlast;
   end else begin : g_cube
-    assign pk_tdata          = df_tdata;
-    assign pk_tvalid         = df_tvalid;
-    assign df_tready         = pk_tready;
-    assign pk_tlast          = df_tlast;
-    assign pk_frame_end      = df_frame_end;
+    assign pu_tdata          = df_tdata;
+    assign pu_tvalid         = df_tvalid;
+    assign df_tready         = pu_tready;
+    assign pu_tlast          = df_tlast;
     assign det_framing_error = 1'b0;
     assign status_truncated  = 1'b0;
     assign detections        = '0;
@@ -582,6 +583,25 @@ module radar_pipeline #(
   logic [$clog2(DMG_DEPTH):0] dmg_count;
   assign df_beat      = df_tvalid && df_tready;
   assign df_frame_end = df_beat && (df_word_q == FWORD_W'(CUBE_WORDS - 1));
+  // a frame's last word: the record stream has TLAST only there (mode 1); the cube's TLAST
+  // ends every Doppler vector, so its words are counted (mode 0)
+  assign pu_last_word = (OUTPUT_MODE == 1) ? pu_tlast : (df_word_q == FWORD_W'(CUBE_WORDS - 1));
+  assign pu_frame_end = pu_tvalid && pu_tready && pu_last_word;
+
+  // ---- register slice in front of the packetizer (docs/synth.md note 20) -------------------
+  // The packetizer's TREADY reached the Doppler FFT's advance logic across the chip (the
+  // top's critical path once the slice behind frame_align was in). Each word carries its
+  // frame's damaged mark (the mark FIFO's head when it enters; the head is popped with the
+  // frame's last word here) and whether it is that last word, so the packetizer and the
+  // packet-length shadow below see both with the word itself.
+  axis_reg_slice #(.DATA_W(WORD_W), .USER_W(2)) u_pk_slice (
+    .clk, .rst,
+    .s_axis_tdata(pu_tdata), .s_axis_tvalid(pu_tvalid), .s_axis_tready(pu_tready),
+    .s_axis_tlast(pu_tlast), .s_axis_tuser({pu_last_word, df_damaged}),
+    .m_axis_tdata(pk_tdata), .m_axis_tvalid(pk_tvalid), .m_axis_tready(pk_tready),
+    .m_axis_tlast(pk_tlast), .m_axis_tuser(pk_tuser)
+  );
+  assign pk_frame_end = pk_tvalid && pk_tready && pk_tuser[1];
 
   always_ff @(posedge clk) begin
     if (rst) df_word_q <= '0;
@@ -591,7 +611,7 @@ module radar_pipeline #(
   mark_fifo #(.DEPTH(DMG_DEPTH), .WIDTH(1)) u_damage_marks (
     .clk, .rst,
     .push(fa_frame_done), .push_data(fa_frame_damaged),
-    .pop(pk_frame_end), .head(df_damaged),
+    .pop(pu_frame_end), .head(df_damaged),
     .empty(dmg_empty), .full(dmg_full), .count(dmg_count),
     .overflow(dmg_overflow), .underflow(dmg_underflow)
   );
@@ -599,7 +619,7 @@ module radar_pipeline #(
 `ifndef SYNTHESIS
   always_ff @(posedge clk) begin
     if (!rst) begin
-      assert (!(fa_frame_done && dmg_full && !pk_frame_end))
+      assert (!(fa_frame_done && dmg_full && !pu_frame_end))
         else $error("%m: damage-mark FIFO overflow");
       assert (!(df_beat && dmg_empty))
         else $error("%m: Doppler output of a frame frame_align never sent");
@@ -619,7 +639,7 @@ module radar_pipeline #(
   ) u_packetizer (
     .clk, .rst, .cfg_packet_words(pk_packet_words),
     .s_axis_tdata(pk_tdata), .s_axis_tvalid(pk_tvalid), .s_axis_tready(pk_tready),
-    .s_axis_tlast(pk_tlast), .s_axis_tuser(df_damaged),
+    .s_axis_tlast(pk_tlast), .s_axis_tuser(pk_tuser[0]),
     .m_axis_tdata(m_axis_dma_tdata), .m_axis_tvalid(m_axis_dma_tvalid),
     .m_axis_tready(m_axis_dma_tready), .m_axis_tlast(m_axis_dma_tlast),
     .status_overflow(status_dma_overflow), .status_framing_error(pk_framing),

@@ -68,8 +68,9 @@ def pipeline_latency(tb: PipelineTB) -> int:
     (docs/frame_store.md: 2 F here, F the cube's words); static removal, a vector + 5
     (docs/buffers.md 6); the Doppler FFT; in mode 1 the whole frame through the detector first
     (F words at one a clock, the CFAR's Doppler wrap N_RBINS 2 PD, the NCI, the CFAR's passes
-    over the last rows, the record frame's FRAME_WORDS: docs/detect.md); then the packetizer, a
-    packet's first payload word to its header (``progress.packetizer_latency``)."""
+    over the last rows, the record frame's FRAME_WORDS: docs/detect.md); then the register
+    slice in front of the packetizer and the packetizer, a packet's first payload word to its
+    header (``progress.packetizer_latency``)."""
     window = bool(param("WINDOW", 1))
     cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
     clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + SLICE_LATENCY
@@ -77,7 +78,7 @@ def pipeline_latency(tb: PipelineTB) -> int:
               + (2 * cells if param("FRAME_STORE", 0) else 3)
               + (tb.n_doppler + 5 if param("STATIC_REMOVAL", 0) else 0)
               + progress.fft_latency(tb.n_doppler, window)
-              + progress.packetizer_latency(tb.packet_words))
+              + SLICE_LATENCY + progress.packetizer_latency(tb.packet_words))
     if tb.output_mode == 1:
         cfar = DetectConfig(num_tx=tb.num_tx, num_rx=tb.num_rx, n_range=tb.n_range_bins,
                             n_doppler=tb.n_doppler, guard=(param("GUARD_R"), param("GUARD_D")),
