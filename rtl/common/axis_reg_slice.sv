@@ -6,8 +6,8 @@
 //
 // Use it where a handshake runs between blocks that the placer puts far apart: the slice
 // cuts TVALID -> TREADY loops and long TREADY fan-outs into two register-to-register hops
-// (docs/buffers.md 9; in radar_pipeline between frame_align and the range FFT,
-// docs/synth.md note 20).
+// (docs/buffers.md 9; in radar_pipeline between frame_align and the range FFT, and in front
+// of the packetizer, docs/synth.md note 20).
 //
 // State: the output register (out_valid_q, out_q) and the skid register (skid_valid_q,
 // skid_q), which catches the one beat accepted in the clock the sink stalls. TREADY is
