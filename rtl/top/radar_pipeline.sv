@@ -578,14 +578,15 @@ module radar_pipeline #(
   localparam int DMG_DEPTH = (OUTPUT_MODE == 1) ? 8 : 4;
   localparam int FWORD_W   = $clog2(CUBE_WORDS + 1);
   logic [FWORD_W-1:0]         df_word_q;    // Doppler output word within its frame
-  logic                       df_beat, df_damaged;
+  logic                       df_beat, df_last_word, df_damaged;
   logic                       dmg_empty, dmg_full, dmg_overflow, dmg_underflow;
   logic [$clog2(DMG_DEPTH):0] dmg_count;
   assign df_beat      = df_tvalid && df_tready;
-  assign df_frame_end = df_beat && (df_word_q == FWORD_W'(CUBE_WORDS - 1));
+  assign df_last_word = df_word_q == FWORD_W'(CUBE_WORDS - 1);
+  assign df_frame_end = df_beat && df_last_word;
   // a frame's last word: the record stream has TLAST only there (mode 1); the cube's TLAST
   // ends every Doppler vector, so its words are counted (mode 0)
-  assign pu_last_word = (OUTPUT_MODE == 1) ? pu_tlast : (df_word_q == FWORD_W'(CUBE_WORDS - 1));
+  assign pu_last_word = (OUTPUT_MODE == 1) ? pu_tlast : df_last_word;
   assign pu_frame_end = pu_tvalid && pu_tready && pu_last_word;
 
   // ---- register slice in front of the packetizer (docs/synth.md note 20) -------------------
