@@ -380,6 +380,25 @@ module radar_pipeline #(
     .event_overflow(rf_ev_ovf)
   );
 
+  // ---- register slice (docs/synth.md note 21) -----------------------------------------------
+  // The corner turn's TREADY (a compare of its read and write counters) reached back through
+  // the range FFT's output reorder handshake to its last butterfly stage (note 20's critical
+  // path). A slice between them ends that path at a register. The frame store's input is
+  // behind the same slice.
+  logic [WORD_W-1:0] cs_tdata;
+  logic              cs_tvalid, cs_tready, cs_tlast;
+  /* verilator lint_off UNUSEDSIGNAL */
+  logic [0:0]        cs_tuser_unused;  // the range-bin index is not carried (tied 0)
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  axis_reg_slice #(.DATA_W(WORD_W), .USER_W(1)) u_rf_slice (
+    .clk, .rst,
+    .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
+    .s_axis_tlast(rf_tlast), .s_axis_tuser(1'b0),
+    .m_axis_tdata(cs_tdata), .m_axis_tvalid(cs_tvalid), .m_axis_tready(cs_tready),
+    .m_axis_tlast(cs_tlast), .m_axis_tuser(cs_tuser_unused)
+  );
+
   // ---- corner turn (frame buffer) -------------------------------------------------------
   logic [WORD_W-1:0] ct_tdata;
   logic              ct_tvalid, ct_tready, ct_tlast;
@@ -393,8 +412,8 @@ module radar_pipeline #(
       .N_LOOPS(N_LOOPS), .DATA_W(DATA_W), .READ_ORDER(OUTPUT_MODE)
     ) u_corner_turn (
       .clk, .rst,
-      .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
-      .s_axis_tlast(rf_tlast),
+      .s_axis_tdata(cs_tdata), .s_axis_tvalid(cs_tvalid), .s_axis_tready(cs_tready),
+      .s_axis_tlast(cs_tlast),
       .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
       .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
       .status_framing_error(ct_framing), .framing_error_count(ct_framing_count),
@@ -441,8 +460,8 @@ module radar_pipeline #(
       .AXI_ID_W(AXI_ID_W), .MEM_BASE(MEM_BASE)
     ) u_frame_store (
       .clk, .rst,
-      .s_axis_tdata(rf_tdata), .s_axis_tvalid(rf_tvalid), .s_axis_tready(rf_tready),
-      .s_axis_tlast(rf_tlast),
+      .s_axis_tdata(cs_tdata), .s_axis_tvalid(cs_tvalid), .s_axis_tready(cs_tready),
+      .s_axis_tlast(cs_tlast),
       .m_axis_tdata(ct_tdata), .m_axis_tvalid(ct_tvalid), .m_axis_tready(ct_tready),
       .m_axis_tlast(ct_tlast), .m_axis_tuser(ct_tuser),
       .m_axi_mem_awid, .m_axi_mem_awaddr, .m_axi_mem_awlen, .m_axi_mem_awsize,

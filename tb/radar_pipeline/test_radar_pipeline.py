@@ -63,9 +63,9 @@ def pipeline_latency(tb: PipelineTB) -> int:
     """Clocks from a frame's last ADC sample to its first DMA word: the documented latencies of
     the blocks on the way, added. The ping-pong's chirp, N_SAMPLES + 2, frame_align's register
     and the register slice behind it (docs/buffers.md 1, 4, 9); the range FFT
-    (``progress.fft_latency``, docs/fft_axis.md); the corner turn, 3 clocks after a frame's
-    last word on chip (docs/buffers.md 2), about a frame plus a strip in external memory
-    (docs/frame_store.md: 2 F here, F the cube's words); static removal, a vector + 5
+    (``progress.fft_latency``, docs/fft_axis.md) and the register slice behind it; the corner
+    turn, 3 clocks after a frame's last word on chip (docs/buffers.md 2), about a frame plus a
+    strip in external memory (docs/frame_store.md: 2 F here, F the cube's words); static removal, a vector + 5
     (docs/buffers.md 6); the Doppler FFT; in mode 1 the whole frame through the detector first
     (F words at one a clock, the CFAR's Doppler wrap N_RBINS 2 PD, the NCI, the CFAR's passes
     over the last rows, the record frame's FRAME_WORDS: docs/detect.md); then the register
@@ -74,7 +74,7 @@ def pipeline_latency(tb: PipelineTB) -> int:
     window = bool(param("WINDOW", 1))
     cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
     clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + SLICE_LATENCY
-              + progress.fft_latency(tb.n_range, window)
+              + progress.fft_latency(tb.n_range, window) + SLICE_LATENCY
               + (2 * cells if param("FRAME_STORE", 0) else 3)
               + (tb.n_doppler + 5 if param("STATIC_REMOVAL", 0) else 0)
               + progress.fft_latency(tb.n_doppler, window)
