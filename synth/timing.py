@@ -11,6 +11,7 @@ Usage (from the repository root, through ``tools/venv-run``)::
 
     python -m synth.timing                        # paper-fpga blocks and detector
     python -m synth.timing --set top              # the paper-fpga radar_pipeline top
+    python -m synth.timing --set full             # the full preset's blocks, where they fit
     python -m synth.timing --only range_fft --seeds 1,2,3   # seed spread of one block
 """
 
@@ -39,14 +40,17 @@ ECP5_PARAMS: dict[str, dict[str, int]] = {"fft_axis": {"MUL_W": 18},
 def timing_sets() -> dict[str, list[Job]]:
     """``ci`` (one small block, the regression's job), ``paper-fpga`` (the blocks and the
     detector of :func:`synth.jobs.job_sets`), ``top`` (the ``paper-fpga`` radar_pipeline),
-    ``all`` (``paper-fpga`` + ``top``); the FFTs, the corner turn and the top with
-    :data:`ECP5_PARAMS`."""
-    paper = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {}))
-             for j in job_sets()["paper-fpga"]]
+    ``all`` (``paper-fpga`` + ``top``), ``full`` (the ``full`` preset's blocks and detector,
+    :func:`synth.jobs.job_sets` ``full-blocks``: those that do not fit the ECP5-85 are
+    reported so after synthesis, :func:`synth.timing_run.fit_problem`); the FFTs, the corner
+    turn and the top with :data:`ECP5_PARAMS`."""
+    sets = job_sets()
+    paper = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {})) for j in sets["paper-fpga"]]
     blocks = [j for j in paper if j.top != "radar_pipeline"]
     top = [j for j in paper if j.top == "radar_pipeline"]
+    full = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {})) for j in sets["full-blocks"]]
     ci = [Job("ci/mark_fifo", "mark_fifo", {"DEPTH": 4, "WIDTH": 1})]
-    return {"ci": ci, "paper-fpga": blocks, "top": top, "all": blocks + top}
+    return {"ci": ci, "paper-fpga": blocks, "top": top, "all": blocks + top, "full": full}
 
 
 def main(argv: list[str] | None = None) -> int:

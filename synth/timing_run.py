@@ -33,6 +33,9 @@ from synth.yosys_run import _wait, yosys_command
 WRAP = "timing_wrap"
 XCUP_WRAP = "wrap_xcup.sv"   # the wrapper without the ECP5-only parameters (Job.ecp5_params)
 DEVICE = ["--85k", "--speed", "8", "--package", "CABGA756"]
+# What the LFE5U-85F holds (nextpnr's utilisation report of that device): a job whose
+# synthesized netlist needs more is reported as not fitting instead of being placed.
+CAPACITY = {"MULT18X18D": 156, "DP16KD": 208, "TRELLIS_FF": 83640, "LUT4": 83640}
 
 
 @dataclass(frozen=True)
@@ -147,6 +150,20 @@ def scripts(job: Job, files: list[Path], cwd: Path, abs_paths: bool = False) -> 
     }
 
 
+def fit_problem(stat: dict) -> str:
+    """Why a ``synth_ecp5`` netlist (Yosys ``stat -json``) cannot fit the LFE5U-85F, or "" when
+    it may: multipliers, block RAMs or flip-flops over the device's count, or look-up tables
+    over it counting only what surely takes one (each LUT4 and both halves of each CCU2C
+    carry; distributed RAM and the muxes not counted, so it is a lower bound)."""
+    cells = stat.get("design", {}).get("num_cells_by_type", {})
+    need = {"MULT18X18D": cells.get("MULT18X18D", 0), "DP16KD": cells.get("DP16KD", 0),
+            "TRELLIS_FF": cells.get("TRELLIS_FF", 0),
+            "LUT4": cells.get("LUT4", 0) + 2 * cells.get("CCU2C", 0)}
+    over = [f"{need[k]} {k}{' (at least)' if k == 'LUT4' else ''} of {CAPACITY[k]}"
+            for k in CAPACITY if need[k] > CAPACITY[k]]
+    return ("does not fit the LFE5U-85F: " + ", ".join(over)) if over else ""
+
+
 def _step(name: str, cmd: list[str], cwd: Path, t_end: float, out: JobOutput) -> None:
     """Run one step (log ``cwd/<name>.log``), raising RuntimeError on failure or timeout."""
     nice = ["nice", "-n", "10"] if shutil.which("nice") else []
@@ -190,6 +207,9 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         if job.ecp5_params:
             (d / XCUP_WRAP).write_text(wrapper(job, ports))
         _step("ecp5", [*yosys, "-q", "ecp5.ys"], d, t_end, res)
+        misfit = fit_problem(json.loads((d / "ecp5_stat.json").read_text()))
+        if misfit:
+            raise RuntimeError(misfit)
         _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
         if xcup:
             _step("xcup", [*yosys, "-q", "xcup.ys"], d, t_end, res)

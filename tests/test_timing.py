@@ -14,7 +14,7 @@ import pytest
 from synth.jobs import Job
 from synth.timing import main, timing_sets
 from synth.timing_report import lut_depth, parse_nextpnr, short_cell
-from synth.timing_run import Settings, job_key, parse_ports, scripts, wrapper
+from synth.timing_run import Settings, fit_problem, job_key, parse_ports, scripts, wrapper
 
 PORTS = """module mark_fifo (
 input [0:0] clk,
@@ -131,6 +131,21 @@ def test_timing_sets_cover_the_paper_blocks() -> None:
             "detect_chain"} <= tops
     assert [j.top for j in sets["top"]] == ["radar_pipeline"]
     assert [j.top for j in sets["ci"]] == ["mark_fifo"]
+    full = {j.name: j for j in sets["full"]}
+    assert full["full/range_doppler_fft"].params["NUM_CH"] == 16
+    assert full["full/range_doppler_fft"].ecp5_params == {"MUL_W": 18}
+
+
+def test_fit_problem_names_what_the_device_lacks() -> None:
+    def stat(**cells: int) -> dict:
+        return {"design": {"num_cells_by_type": cells}}
+    assert fit_problem(stat(LUT4=20000, CCU2C=6000, MULT18X18D=136, DP16KD=174,
+                            TRELLIS_FF=25000)) == ""
+    msg = fit_problem(stat(LUT4=1000, MULT18X18D=320, DP16KD=208))
+    assert msg == "does not fit the LFE5U-85F: 320 MULT18X18D of 156"
+    # a look-up-table count over the device: each CCU2C takes two
+    msg = fit_problem(stat(LUT4=60000, CCU2C=12000, DP16KD=300))
+    assert "300 DP16KD of 208" in msg and "84000 LUT4 (at least) of 83640" in msg
 
 
 @pytest.mark.slow
