@@ -65,12 +65,12 @@ def pipeline_latency(tb: PipelineTB) -> int:
     and the register slice behind it (docs/buffers.md 1, 4, 9); the range FFT
     (``progress.fft_latency``, docs/fft_axis.md) and the register slice behind it; the corner
     turn, 3 clocks after a frame's last word on chip (docs/buffers.md 2), about a frame plus a
-    strip in external memory (docs/frame_store.md: 2 F here, F the cube's words); static removal, a vector + 5
-    (docs/buffers.md 6); the Doppler FFT; in mode 1 the whole frame through the detector first
-    (F words at one a clock, the CFAR's Doppler wrap N_RBINS 2 PD, the NCI, the CFAR's passes
-    over the last rows, the record frame's FRAME_WORDS: docs/detect.md); then the register
-    slice in front of the packetizer and the packetizer, a packet's first payload word to its
-    header (``progress.packetizer_latency``)."""
+    strip in external memory (docs/frame_store.md: 2 F here, F the cube's words); static
+    removal, a vector + 5 (docs/buffers.md 6); the Doppler FFT; in mode 1 the whole frame
+    through the detector first (F words at one a clock, the CFAR's Doppler wrap N_RBINS 2 PD,
+    the NCI, the CFAR's passes over the last rows, the record frame's FRAME_WORDS:
+    docs/detect.md); then the register slice in front of the packetizer and the packetizer, a
+    packet's first payload word to its header (``progress.packetizer_latency``)."""
     window = bool(param("WINDOW", 1))
     cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
     clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + SLICE_LATENCY
