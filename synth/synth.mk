@@ -18,6 +18,8 @@
 #                                          LUT6 depth of every paper-fpga block, each port
 #                                          registered; table in $(OUT)/timing/timing.md
 #   make timing TIMING_SET=top             the paper-fpga radar_pipeline top (TIMING_SET=all: both)
+#   make timing TIMING_SET=full            the full preset's blocks; a block that does not fit
+#                                          the ECP5-85 is reported so after synthesis
 #   TIMING_J=2 TIMING_TIMEOUT=3600 TIMING_FREQ=100 TIMING_SEEDS=1,2,3 TIMING_ONLY=range_fft
 #   TIMING_PLACER=heap|static|sa TIMING_ROUTER=router1|router2   nextpnr's placer and router;
 #                                          the top: TIMING_PLACER=static TIMING_TIMEOUT=7200

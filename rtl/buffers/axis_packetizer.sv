@@ -135,6 +135,8 @@ module axis_packetizer #(
   // Per-bank packet descriptor, written by the input side when the packet is complete.
   typedef struct packed {
     logic [LEN_W-1:0] len;       // payload words stored
+    logic [LEN_W-1:0] last_idx;  // len - 1, the packet's last payload index (stored so the
+                                 // read side's end test is an equality, no subtractor)
     logic [LEN_W-1:0] drops;     // payload words dropped
     logic [SEQ_W-1:0] seq;       // packet number within the frame
     logic [NP_W-1:0]  npkt;      // packets of its frame
@@ -146,7 +148,7 @@ module axis_packetizer #(
   } desc_t;
 
   // (plain vectors: Yosys mis-reads an unpacked array of packed structs, formal/README)
-  localparam int DESC_W = 2 * LEN_W + SEQ_W + NP_W + 32 + 4;  // $bits(desc_t)
+  localparam int DESC_W = 3 * LEN_W + SEQ_W + NP_W + 32 + 4;  // $bits(desc_t)
   logic [DESC_W-1:0] desc_q [NUM_BANKS];
   logic [NUM_BANKS-1:0] full_q;            // bank holds a complete packet not yet fully read
 
@@ -249,7 +251,7 @@ module axis_packetizer #(
   assign issue_crc  = issue && crc_due_q;
   assign issue_hdr  = issue && !crc_due_q && HEADER && !hdr_sent_q;
   assign issue_data = issue && !crc_due_q && !issue_hdr;
-  assign rd_last    = (LEN_W'(rd_idx_q) == rd_desc.len - 1'b1);
+  assign rd_last    = (LEN_W'(rd_idx_q) == rd_desc.last_idx);
   assign ram_rd_en   = issue_data;
   assign ram_rd_addr = {rd_bank_q, rd_idx_q};
 
@@ -298,16 +300,20 @@ module axis_packetizer #(
   // Descriptor of the packet that closes with this input word
   desc_t new_desc;
   always_comb begin
-    new_desc         = '0;
-    new_desc.len     = cnt_next;
-    new_desc.drops   = drop_next;
-    new_desc.seq     = seq_q;
-    new_desc.npkt    = dv_np_q;
-    new_desc.frame   = frame_q;
-    new_desc.last    = frame_end;
-    new_desc.ovf     = ovf_q || (beat && !space);
-    new_desc.framing = framing_q || tlast_err;
-    new_desc.damaged = wr_dmg_q || (beat && s_axis_tuser[0]);
+    new_desc          = '0;
+    new_desc.len      = cnt_next;
+    // len - 1: a packet that stores a word also stores its closing word (only this side sets
+    // its bank full, at the close, so space does not go away while a packet is open), so a
+    // written descriptor has store = 1 and len - 1 = wr_cnt_q
+    new_desc.last_idx = wr_cnt_q;
+    new_desc.drops    = drop_next;
+    new_desc.seq      = seq_q;
+    new_desc.npkt     = dv_np_q;
+    new_desc.frame    = frame_q;
+    new_desc.last     = frame_end;
+    new_desc.ovf      = ovf_q || (beat && !space);
+    new_desc.framing  = framing_q || tlast_err;
+    new_desc.damaged  = wr_dmg_q || (beat && s_axis_tuser[0]);
   end
 
   // ---------------------------------------------------------------------------------------
@@ -475,6 +481,7 @@ module axis_packetizer #(
       if (fw_zero_q) assert (pos_q == '0);
       else assert (pos_hit_q == (LEN_W'(pos_q) == pw_q - 1'b1));
       assert (32'(wr_cnt_q) <= 32'(pos_q));
+      if (wr_cnt_q != '0) assert (space);  // (new_desc.last_idx)
       assert (seq_q <= SEQ_W'(NPKT - 1));
       assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
       if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));
@@ -493,6 +500,7 @@ module axis_packetizer #(
           assert (f_d.seq <= SEQ_W'(NPKT - 1));
           assert (f_d.last == (f_d.seq == SEQ_W'(NPKT - 1)));
           assert (f_d.len != '0 && f_d.len <= LEN_W'(PACKET_WORDS));
+          assert (f_d.last_idx == f_d.len - 1'b1);
           if (INPUT_BACKPRESSURE) begin
             assert (f_d.drops == '0);
             assert (f_d.len == (f_d.last ? LEN_W'(LAST_LEN) : LEN_W'(PACKET_WORDS)));
