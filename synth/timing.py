@@ -44,11 +44,12 @@ def timing_sets() -> dict[str, list[Job]]:
     :func:`synth.jobs.job_sets` ``full-blocks``: those that do not fit the ECP5-85 are
     reported so after synthesis, :func:`synth.timing_run.fit_problem`); the FFTs, the corner
     turn and the top with :data:`ECP5_PARAMS`."""
-    sets = job_sets()
-    paper = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {})) for j in sets["paper-fpga"]]
+    sets = {name: [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {})) for j in jobs]
+            for name, jobs in job_sets().items()}
+    paper = sets["paper-fpga"]
     blocks = [j for j in paper if j.top != "radar_pipeline"]
     top = [j for j in paper if j.top == "radar_pipeline"]
-    full = [replace(j, ecp5_params=ECP5_PARAMS.get(j.top, {})) for j in sets["full-blocks"]]
+    full = sets["full-blocks"]
     ci = [Job("ci/mark_fifo", "mark_fifo", {"DEPTH": 4, "WIDTH": 1})]
     return {"ci": ci, "paper-fpga": blocks, "top": top, "all": blocks + top, "full": full}
 
