@@ -56,7 +56,7 @@ def timing_sets() -> dict[str, list[Job]]:
 
 def main(argv: list[str] | None = None) -> int:
     """Command line entry: run (or reuse) the jobs, write ``OUT/timing.md``; exit 1 if a job
-    failed."""
+    failed (a job that does not fit the device is a result, not a failure)."""
     sets = timing_sets()
     ap = argparse.ArgumentParser(prog="python -m synth.timing",
                                  description="ECP5 place and route + xcup logic depth per "
@@ -93,13 +93,14 @@ def main(argv: list[str] | None = None) -> int:
         res = run_job(job, files_for(job.top, files), out / "jobs",
                       Settings(args.freq, seed, args.router, args.placer), args.timeout,
                       xcup=not args.no_xcup)
-        row = Row(job.name, job.label, seconds=res.seconds, error=res.error)
-        if not res.error:
+        row = Row(job.name, job.label, seconds=res.seconds, error=res.error, misfit=res.misfit)
+        if not (res.error or res.misfit):
             row = job_row(job.name, job.label, res.dir)
         state = "cached" if res.cached else f"{res.seconds:.0f} s"
-        print(f"timing: {job.name}: " + (f"FAILED {res.error}" if res.error else
-              f"{row.fmax_mhz:.1f} MHz, {row.lut4} LUT4, xcup {row.xlut} LUT6 levels ({state})"),
-              flush=True)
+        print(f"timing: {job.name}: " + (
+            f"FAILED {res.error}" if res.error else f"{res.misfit} ({state})" if res.misfit else
+            f"{row.fmax_mhz:.1f} MHz, {row.lut4} LUT4, xcup {row.xlut} LUT6 levels ({state})"),
+            flush=True)
         return row
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:

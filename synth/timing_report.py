@@ -41,6 +41,7 @@ class Row:
     xend: str = ""
     seconds: float = 0.0
     error: str = ""
+    misfit: str = ""   # the netlist does not fit the device: why (synth.timing_run.fit_problem)
 
 
 def short_cell(name: str) -> str:
@@ -162,7 +163,8 @@ def job_row(name: str, label: str, job_dir: Path) -> Row:
 
 
 def markdown(rows: list[Row], freq_mhz: float, header: str) -> str:
-    """The ``make timing`` table: one line per job, failed jobs with their error."""
+    """The ``make timing`` table: one line per job, failed jobs with their error, jobs whose
+    netlist does not fit the device with what it lacks."""
     lines = [header, "",
              "| job | parameters | LUT4 | FF | EBR | MULT18 | ECP5 Fmax MHz | "
              f">= {freq_mhz:g} | critical path (start -> end) | LUT4 levels (+carry) | "
@@ -171,6 +173,10 @@ def markdown(rows: list[Row], freq_mhz: float, header: str) -> str:
     for r in rows:
         if r.error:
             lines.append(f"| {r.name} | {r.label} | | | | | | | failed: {r.error} | | | | "
+                         f"{r.seconds:.0f} |")
+            continue
+        if r.misfit:
+            lines.append(f"| {r.name} | {r.label} | | | | | | does not fit | {r.misfit} | | | | "
                          f"{r.seconds:.0f} |")
             continue
         ok = "yes" if r.fmax_mhz >= freq_mhz else "**no**"

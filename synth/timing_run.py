@@ -61,6 +61,7 @@ class JobOutput:
     seconds: float = 0.0
     cached: bool = False
     error: str = ""
+    misfit: str = ""   # why the netlist cannot fit the device (fit_problem): a result, not an error
     steps: dict[str, float] = field(default_factory=dict)  # step -> wall seconds
 
 
@@ -85,10 +86,11 @@ def _pnr_args(settings: Settings) -> list[str]:
 
 def job_key(job: Job, files: list[Path], settings: Settings) -> str:
     """SHA-256 of everything the job's result depends on: the text of ``files`` (the RTL it
-    reads), the Yosys scripts, the wrapper generator and the nextpnr arguments."""
+    reads), the Yosys scripts, the wrapper generator, the nextpnr arguments and the device's
+    :data:`CAPACITY` (a cached "does not fit" holds only for the same device)."""
     h = hashlib.sha256()
     h.update(json.dumps([scripts(job, files, Path("."), abs_paths=True), _pnr_args(settings),
-                         inspect.getsource(wrapper)]).encode())
+                         inspect.getsource(wrapper), CAPACITY]).encode())
     for f in files:
         h.update(f.name.encode())
         h.update(f.read_bytes())
@@ -182,14 +184,17 @@ def _step(name: str, cmd: list[str], cwd: Path, t_end: float, out: JobOutput) ->
 def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
             timeout: float, xcup: bool = True) -> JobOutput:
     """Run (or reuse) one job in ``out_dir/<name>/``; ``done.json`` marks a complete run with
-    the key of its inputs, so a rerun with the same key does nothing."""
+    the key of its inputs, so a rerun with the same key does nothing. A netlist that cannot fit
+    the device (:func:`fit_problem`) is a complete run too: ``misfit`` says why, recorded in
+    ``done.json`` and reused like any result; nextpnr and the xcup depth are not run for it."""
     d = out_dir / job.name.replace("/", "__")
     res = JobOutput(job, d)
     key = job_key(job, files, settings)
     done = d / "done.json"
-    if done.exists() and json.loads(done.read_text()).get("key") == key:
+    if done.exists() and (stamp := json.loads(done.read_text())).get("key") == key:
         res.cached = True
-        res.seconds = json.loads(done.read_text()).get("seconds", 0.0)
+        res.seconds = stamp.get("seconds", 0.0)
+        res.misfit = stamp.get("misfit", "")
         return res
     d.mkdir(parents=True, exist_ok=True)
     done.unlink(missing_ok=True)
@@ -207,15 +212,17 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         if job.ecp5_params:
             (d / XCUP_WRAP).write_text(wrapper(job, ports))
         _step("ecp5", [*yosys, "-q", "ecp5.ys"], d, t_end, res)
-        misfit = fit_problem(json.loads((d / "ecp5_stat.json").read_text()))
-        if misfit:
-            raise RuntimeError(misfit)
-        _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
-        if xcup:
-            _step("xcup", [*yosys, "-q", "xcup.ys"], d, t_end, res)
+        for stale in ("report.json", "xcup.json"):   # a misfit leaves no earlier result behind
+            (d / stale).unlink(missing_ok=True)
+        res.misfit = fit_problem(json.loads((d / "ecp5_stat.json").read_text()))
+        if not res.misfit:
+            _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
+            if xcup:
+                _step("xcup", [*yosys, "-q", "xcup.ys"], d, t_end, res)
     except RuntimeError as e:
         res.error = str(e)
     res.seconds = time.monotonic() - t0
     if not res.error:
-        done.write_text(json.dumps({"key": key, "seconds": res.seconds, "steps": res.steps}))
+        done.write_text(json.dumps({"key": key, "seconds": res.seconds, "steps": res.steps,
+                                    **({"misfit": res.misfit} if res.misfit else {})}))
     return res

