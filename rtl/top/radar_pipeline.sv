@@ -323,22 +323,6 @@ module radar_pipeline #(
   );
   assign chirps_in = pp_chirps_out;
 
-  // ---- register slice (docs/synth.md note 23) -----------------------------------------------
-  // frame_align's TREADY is combinational from the ping-pong's TUSER marks and its own
-  // counters; placed apart, that handshake was the top's critical path (75.9 MHz). Every
-  // output of the slice is a register: one clock of latency, full rate.
-  logic [WORD_W-1:0] ps_tdata;
-  logic              ps_tvalid, ps_tready, ps_tlast;
-  logic [1:0]        ps_tuser;
-
-  axis_reg_slice #(.DATA_W(WORD_W), .USER_W(2)) u_pp_slice (
-    .clk, .rst,
-    .s_axis_tdata(pp_tdata), .s_axis_tvalid(pp_tvalid), .s_axis_tready(pp_tready),
-    .s_axis_tlast(pp_tlast), .s_axis_tuser(pp_tuser),
-    .m_axis_tdata(ps_tdata), .m_axis_tvalid(ps_tvalid), .m_axis_tready(ps_tready),
-    .m_axis_tlast(ps_tlast), .m_axis_tuser(ps_tuser)
-  );
-
   // ---- frame alignment (zero-fills frames that lost chirps) --------------------------------
   localparam int FRAME_CHIRPS = NUM_TX * N_LOOPS;
   logic [WORD_W-1:0] fa_tdata;
@@ -349,8 +333,8 @@ module radar_pipeline #(
     .NUM_RX(NUM_RX), .DATA_W(DATA_W), .N_RANGE(N_SAMPLES), .FRAME_CHIRPS(FRAME_CHIRPS)
   ) u_frame_align (
     .clk, .rst,
-    .s_axis_tdata(ps_tdata), .s_axis_tvalid(ps_tvalid), .s_axis_tready(ps_tready),
-    .s_axis_tlast(ps_tlast), .s_axis_tuser(ps_tuser),
+    .s_axis_tdata(pp_tdata), .s_axis_tvalid(pp_tvalid), .s_axis_tready(pp_tready),
+    .s_axis_tlast(pp_tlast), .s_axis_tuser(pp_tuser),
     .m_axis_tdata(fa_tdata), .m_axis_tvalid(fa_tvalid), .m_axis_tready(fa_tready),
     .m_axis_tlast(fa_tlast),
     .frame_done(fa_frame_done), .frame_done_damaged(fa_frame_damaged),

@@ -61,9 +61,8 @@ refusing one holds the top up as a stalled DMA does (idle, never refused, on chi
 
 def pipeline_latency(tb: PipelineTB) -> int:
     """Clocks from a frame's last ADC sample to its first DMA word: the documented latencies of
-    the blocks on the way, added. The ping-pong's chirp, N_SAMPLES + 2, the register slice
-    behind it, frame_align's register and the register slice behind that (docs/buffers.md 1,
-    4, 9); the range FFT
+    the blocks on the way, added. The ping-pong's chirp, N_SAMPLES + 2, frame_align's register
+    and the register slice behind it (docs/buffers.md 1, 4, 9); the range FFT
     (``progress.fft_latency``, docs/fft_axis.md) and the register slice behind it; the corner
     turn, 3 clocks after a frame's last word on chip (docs/buffers.md 2), about a frame plus a
     strip in external memory (docs/frame_store.md: 2 F here, F the cube's words); static
@@ -74,7 +73,7 @@ def pipeline_latency(tb: PipelineTB) -> int:
     packet's first payload word to its header (``progress.packetizer_latency``)."""
     window = bool(param("WINDOW", 1))
     cells = tb.num_tx * tb.n_range_bins * tb.n_doppler
-    clocks = (param("N_SAMPLES", tb.n_range) + 2 + SLICE_LATENCY + 1 + SLICE_LATENCY
+    clocks = (param("N_SAMPLES", tb.n_range) + 2 + 1 + SLICE_LATENCY
               + progress.fft_latency(tb.n_range, window) + SLICE_LATENCY
               + (2 * cells if param("FRAME_STORE", 0) else 3)
               + (tb.n_doppler + 5 if param("STATIC_REMOVAL", 0) else 0)
