@@ -171,12 +171,9 @@ def markdown(rows: list[Row], freq_mhz: float, header: str) -> str:
              "xcup LUT6 levels (+carry) | xcup path | s |",
              "|---|---|---:|---:|---:|---:|---:|---|---|---:|---:|---|---:|"]
     for r in rows:
-        if r.error:
-            lines.append(f"| {r.name} | {r.label} | | | | | | | failed: {r.error} | | | | "
-                         f"{r.seconds:.0f} |")
-            continue
-        if r.misfit:
-            lines.append(f"| {r.name} | {r.label} | | | | | | does not fit | {r.misfit} | | | | "
+        if r.error or r.misfit:
+            fit, why = ("", f"failed: {r.error}") if r.error else ("does not fit", r.misfit)
+            lines.append(f"| {r.name} | {r.label} | | | | | | {fit} | {why} | | | | "
                          f"{r.seconds:.0f} |")
             continue
         ok = "yes" if r.fmax_mhz >= freq_mhz else "**no**"

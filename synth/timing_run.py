@@ -197,7 +197,8 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         res.misfit = stamp.get("misfit", "")
         return res
     d.mkdir(parents=True, exist_ok=True)
-    done.unlink(missing_ok=True)
+    for stale in ("done.json", "report.json", "xcup.json"):   # nothing of an earlier run is read
+        (d / stale).unlink(missing_ok=True)
     yosys = yosys_command()
     t0 = time.monotonic()
     t_end = t0 + timeout
@@ -212,8 +213,6 @@ def run_job(job: Job, files: list[Path], out_dir: Path, settings: Settings,
         if job.ecp5_params:
             (d / XCUP_WRAP).write_text(wrapper(job, ports))
         _step("ecp5", [*yosys, "-q", "ecp5.ys"], d, t_end, res)
-        for stale in ("report.json", "xcup.json"):   # a misfit leaves no earlier result behind
-            (d / stale).unlink(missing_ok=True)
         res.misfit = fit_problem(json.loads((d / "ecp5_stat.json").read_text()))
         if not res.misfit:
             _step("pnr", [*nextpnr_command(), *_pnr_args(settings)], d, t_end, res)
