@@ -59,6 +59,7 @@ module fft_axis #(
   localparam int W     = DATA_W + 1 + GUARD_W;   // internal bits per component
   localparam int DW    = NUM_CH * 2 * W;
   localparam int ODW   = NUM_CH * 2 * DATA_W;
+  localparam int CV_W  = fft_pkg::round_w(W, GUARD_W);   // the rounded output's bits
   localparam int CNT_W = LOG2N + 2;              // samples in flight < 4N
 
   // ---------------------------------------------------------------- parameter checks
@@ -273,8 +274,8 @@ module fft_axis #(
     cv_ov = st_ov[LOG2N];
     for (int c = 0; c < 2 * NUM_CH; c++) begin
       v = fft_pkg::round_conv(64'(signed'(st_data[LOG2N][c*W +: W])), GUARD_W);
-      cv_ov = cv_ov | fft_pkg::sat_ov(v, DATA_W);
-      cv_d[c*DATA_W +: DATA_W] = DATA_W'(fft_pkg::sat_val(v, DATA_W));
+      cv_ov = cv_ov | fft_pkg::sat_ov(v, DATA_W, CV_W);
+      cv_d[c*DATA_W +: DATA_W] = DATA_W'(fft_pkg::sat_val(v, DATA_W, CV_W));
     end
   end
 

@@ -23,22 +23,52 @@ package fft_pkg;
     end
   endfunction
 
-  // True when v does not fit a w-bit two's complement number, i.e. v > 2^(w-1) - 1 or
-  // v < -2^(w-1): its bits w-1..63 are not all equal (bit tests, no magnitude comparator:
-  // a comparator against the limits would be a carry chain after the rounding's).
-  function automatic logic sat_ov(input logic signed [63:0] v, input int unsigned w);
-    logic [63:0] top;
-    top = v >>> (w - 1);
-    sat_ov = (top != '0) && (top != '1);
+  // Bits of round_conv(v, k)'s result for an n-bit v: the quotient's n - k bits and one more
+  // for the rounding increment (k = 0: v itself).
+  function automatic int unsigned round_w(input int unsigned n, input int unsigned k);
+    round_w = (k == 0) ? n : n - k + 1;
   endfunction
 
-  // v clipped to the w-bit two's complement range (result in the low w bits): the limit of
-  // v's sign when it does not fit.
+  // Whether v, an n-bit two's complement value held in 64 bits (bits n..63 copies of bit n-1),
+  // lies above the w-bit range (v > 2^(w-1) - 1: sign clear, bits w-1..n-1 not all 0) or below
+  // it (v < -2^(w-1): sign set, bits w-1..n-1 not all 1). Bit tests, no magnitude comparator
+  // (a comparator against a limit is a carry chain after the rounding's); only bits below n
+  // are read.
+  function automatic logic sat_hi(input logic signed [63:0] v, input int unsigned w,
+                                  input int unsigned n);
+    logic [63:0] mask;
+    if (n <= w) begin
+      sat_hi = 1'b0;
+    end else begin
+      mask = (64'd1 << (n - w + 1)) - 64'd1;
+      sat_hi = (((v >>> (w - 1)) & mask) != '0) && (((v >>> (n - 1)) & 64'd1) == '0);
+    end
+  endfunction
+  function automatic logic sat_lo(input logic signed [63:0] v, input int unsigned w,
+                                  input int unsigned n);
+    logic [63:0] mask;
+    if (n <= w) begin
+      sat_lo = 1'b0;
+    end else begin
+      mask = (64'd1 << (n - w + 1)) - 64'd1;
+      sat_lo = (((v >>> (w - 1)) & mask) != mask) && (((v >>> (n - 1)) & 64'd1) != '0);
+    end
+  endfunction
+
+  // True when v (n bits, as above) does not fit w bits.
+  function automatic logic sat_ov(input logic signed [63:0] v, input int unsigned w,
+                                  input int unsigned n);
+    sat_ov = sat_hi(v, w, n) || sat_lo(v, w, n);
+  endfunction
+
+  // v (n bits, as above) clipped to the w-bit two's complement range (result in the low w
+  // bits). Each limit is a constant chosen by its own condition, so a register loading the
+  // result takes the limits on its synchronous set / reset pins instead of a multiplexer.
   function automatic logic signed [63:0] sat_val(input logic signed [63:0] v,
-                                                 input int unsigned w);
-    if (!sat_ov(v, w)) sat_val = v;
-    else if (v[63]) sat_val = -(64'sd1 <<< (w - 1));
-    else sat_val = (64'sd1 <<< (w - 1)) - 64'sd1;
+                                                 input int unsigned w, input int unsigned n);
+    if (sat_hi(v, w, n)) sat_val = (64'sd1 <<< (w - 1)) - 64'sd1;
+    else if (sat_lo(v, w, n)) sat_val = -(64'sd1 <<< (w - 1));
+    else sat_val = v;
   endfunction
 endpackage
 

@@ -44,6 +44,7 @@ module fft_sdf_bf #(
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int FW = NUM_CH * 2 * (W + 1);   // exact sums / differences
+  localparam int RND_W = fft_pkg::round_w(W + 1, SCALE ? 1 : 0);   // rounded sum's bits
   localparam int MW = FW + LOG2N + 1;         // delay line word: data, index, overflow
   localparam int DB = $clog2(D);              // index bit selecting the butterfly half
   localparam int PW = (D > 1) ? $clog2(D) : 1;
@@ -171,8 +172,8 @@ module fft_sdf_bf #(
       ov = ov1_q;
       for (int c = 0; c < 2 * NUM_CH; c++) begin
         v  = fft_pkg::round_conv(64'(signed'(full_q[c*(W+1) +: W+1])), SCALE ? 1 : 0);
-        ov = ov | fft_pkg::sat_ov(v, W);
-        out_data_q[c*W +: W] <= W'(fft_pkg::sat_val(v, W));
+        ov = ov | fft_pkg::sat_ov(v, W, RND_W);
+        out_data_q[c*W +: W] <= W'(fft_pkg::sat_val(v, W, RND_W));
       end
       out_ov_q  <= ov;
       out_pos_q <= pos1_q;

@@ -61,6 +61,7 @@ module fft_twiddle #(
 
   localparam int DW = NUM_CH * 2 * W;
   localparam int PRW = W + COEF_W;   // product width
+  localparam int Y_W = fft_pkg::round_w(PRW + 2, COEF_FRAC);   // the rounded product's bits
   // Three real multipliers per lane (Gauss) when the pre-added operand re + im (W+1 bits)
   // fits a DSP48E2 A port (27 bits), else four. Same exact products, so the same bits.
   localparam bit GAUSS = (W + 1 <= 27);
@@ -316,9 +317,9 @@ module fft_twiddle #(
     for (int ch = 0; ch < NUM_CH; ch++) begin
       yr = fft_pkg::round_conv(64'(yr4_q[ch]), COEF_FRAC);
       yi = fft_pkg::round_conv(64'(yi4_q[ch]), COEF_FRAC);
-      y_ov = y_ov | fft_pkg::sat_ov(yr, W) | fft_pkg::sat_ov(yi, W);
-      y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W));
-      y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W));
+      y_ov = y_ov | fft_pkg::sat_ov(yr, W, Y_W) | fft_pkg::sat_ov(yi, W, Y_W);
+      y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W, Y_W));
+      y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W, Y_W));
     end
   end
 
