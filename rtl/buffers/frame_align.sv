@@ -67,13 +67,18 @@ module frame_align #(
   logic [CHP_W-1:0] chirp_q;      // chirps emitted in the current frame
   logic             in_first_q;   // next input beat is the first sample of a chirp
   logic             discard_q;    // after the fill, discard input up to a frame start
+  // Look-ahead flags, each updated with the counter it stands for (formal: equal to its
+  // compare), so the handshake decisions start one register away instead of behind a compare
+  logic             smp_last_q;   // smp_q == N_RANGE - 1
+  logic             chirp_last_q; // chirp_q == FRAME_CHIRPS - 1
+  logic             begun_q;      // chirp_q != 0
   logic [31:0]      dmg_cnt_q, fill_cnt_q, disc_cnt_q;
 
   // Decisions on the first sample of an input chirp
   logic sof, gap, frame_begun, at_first, need_fill, need_discard, disc_stop;
   assign sof          = s_axis_tuser[0];
   assign gap          = s_axis_tuser[1];
-  assign frame_begun  = chirp_q != '0;
+  assign frame_begun  = begun_q;
   assign at_first     = s_axis_tvalid && in_first_q;
   // chirps of the current frame were lost (gap) or its end never came (early frame start),
   // or the frame's start chirp itself was lost: fill up with zeros so nothing goes missing
@@ -84,8 +89,8 @@ module frame_align #(
   assign disc_stop    = at_first && sof;
 
   logic chirp_end, frame_end;
-  assign chirp_end = smp_q == SMP_W'(N_RANGE - 1);
-  assign frame_end = chirp_end && (chirp_q == CHP_W'(FRAME_CHIRPS - 1));
+  assign chirp_end = smp_last_q;
+  assign frame_end = smp_last_q && chirp_last_q;
 
   always_comb begin
     s_axis_tready = 1'b0;
@@ -115,14 +120,17 @@ module frame_align #(
 
   always_ff @(posedge clk) begin
     if (rst) begin
-      state_q    <= PASS;
-      smp_q      <= '0;
-      chirp_q    <= '0;
-      in_first_q <= 1'b1;
-      discard_q  <= 1'b0;
-      dmg_cnt_q  <= '0;
-      fill_cnt_q <= '0;
-      disc_cnt_q <= '0;
+      state_q      <= PASS;
+      smp_q        <= '0;
+      chirp_q      <= '0;
+      smp_last_q   <= 1'b0;  // N_RANGE >= 2
+      chirp_last_q <= FRAME_CHIRPS == 1;
+      begun_q      <= 1'b0;
+      in_first_q   <= 1'b1;
+      discard_q    <= 1'b0;
+      dmg_cnt_q    <= '0;
+      fill_cnt_q   <= '0;
+      disc_cnt_q   <= '0;
     end else begin
       if (in_beat) in_first_q <= s_axis_tlast;
       unique case (state_q)
@@ -134,9 +142,9 @@ module frame_align #(
             state_q <= DISCARD;
           end
         end
-        FILL: begin
-          if (out_beat && chirp_end && fill_cnt_q != '1) fill_cnt_q <= fill_cnt_q + 32'd1;
-          if (out_beat && frame_end) begin
+        FILL: begin  // m_axis_tvalid is high throughout: a beat is m_axis_tready
+          if (m_axis_tready && chirp_end && fill_cnt_q != '1) fill_cnt_q <= fill_cnt_q + 32'd1;
+          if (m_axis_tready && frame_end) begin
             state_q <= discard_q ? DISCARD : PASS;
             if (dmg_cnt_q != '1) dmg_cnt_q <= dmg_cnt_q + 32'd1;
           end
@@ -148,8 +156,13 @@ module frame_align #(
         default: state_q <= PASS;
       endcase
       if (out_beat) begin
-        smp_q <= chirp_end ? '0 : smp_q + 1'b1;
-        if (chirp_end) chirp_q <= frame_end ? '0 : chirp_q + 1'b1;
+        smp_q      <= chirp_end ? '0 : smp_q + 1'b1;
+        smp_last_q <= !chirp_end && smp_q == SMP_W'(N_RANGE - 2);
+        if (chirp_end) begin
+          chirp_q      <= frame_end ? '0 : chirp_q + 1'b1;
+          chirp_last_q <= frame_end ? FRAME_CHIRPS == 1 : chirp_q == CHP_W'(FRAME_CHIRPS - 2);
+          begun_q      <= !frame_end;
+        end
       end
     end
   end
@@ -188,6 +201,9 @@ module frame_align #(
     assert (smp_q <= SMP_W'(N_RANGE - 1));
     assert (chirp_q <= CHP_W'(FRAME_CHIRPS - 1));
     assert (m_axis_tlast == (smp_q == SMP_W'(N_RANGE - 1)));
+    assert (smp_last_q == (smp_q == SMP_W'(N_RANGE - 1)));
+    assert (chirp_last_q == (chirp_q == CHP_W'(FRAME_CHIRPS - 1)));
+    assert (begun_q == (chirp_q != '0));
     if (state_q == PASS) assert (in_beat == out_beat);
     if (state_q == FILL) assert (m_axis_tvalid && m_axis_tdata == '0 && !s_axis_tready);
     if (state_q == DISCARD) assert (!m_axis_tvalid);
