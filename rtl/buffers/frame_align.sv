@@ -157,10 +157,10 @@ module frame_align #(
       endcase
       if (out_beat) begin
         smp_q      <= chirp_end ? '0 : smp_q + 1'b1;
-        smp_last_q <= !chirp_end && smp_q == SMP_W'(N_RANGE - 2);
+        smp_last_q <= smp_q == SMP_W'(N_RANGE - 2);  // (false at a chirp's end)
         if (chirp_end) begin
           chirp_q      <= frame_end ? '0 : chirp_q + 1'b1;
-          chirp_last_q <= frame_end ? FRAME_CHIRPS == 1 : chirp_q == CHP_W'(FRAME_CHIRPS - 2);
+          chirp_last_q <= FRAME_CHIRPS == 1 || chirp_q == CHP_W'(FRAME_CHIRPS - 2);
           begun_q      <= !frame_end;
         end
       end
@@ -208,6 +208,7 @@ module frame_align #(
     if (state_q == FILL) assert (m_axis_tvalid && m_axis_tdata == '0 && !s_axis_tready);
     if (state_q == DISCARD) assert (!m_axis_tvalid);
     // input and output chirps stay aligned: PASS forwards whole chirps
+    assert (f_in_pos <= SMP_W'(N_RANGE - 1));
     assert (in_first_q == (f_in_pos == '0));
     if (state_q == PASS) assert (smp_q == f_in_pos);
     if (state_q == FILL) assert (in_first_q);
