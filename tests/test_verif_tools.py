@@ -3,7 +3,9 @@ CI mutant subset: realistic one-line RTL bugs that the regression must kill."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
+import json
 import os
 import re
 import sys
@@ -110,6 +112,42 @@ def test_mutant_applies_after_lines_moved(tmp_path: Path) -> None:
     (tmp_path / m.path).write_text("// a new first line\n" + (REPO / m.path).read_text())
     mutate.apply(m, tmp_path)
     assert (tmp_path / m.path).read_text().splitlines()[m.line] == m.after
+
+
+def _row(m, verdict: str = "killed", **change) -> dict:
+    return {**dataclasses.asdict(m), "ident": m.ident, "verdict": verdict, "seconds": 1,
+            **change}
+
+
+def test_a_verdict_whose_line_changed_is_stale(tmp_path: Path, capsys) -> None:
+    """A recorded verdict counts for the mutant whose line it recorded: an RTL edit renumbers
+    a module's mutants (frame_align's look-ahead flags did), so a verdict follows its line to
+    its new identifier, and one whose line changed must not stand in for today's mutant, in
+    ``--resume`` or in ``--report``."""
+    a, b, c, d = mutate.candidates("frame_store_fifo")[:4]
+    current = [_row(a), _row(b, "survived", after="  " + b.after + "  ")]  # spaces only
+    changed = _row(c, after=c.after + " // elsewhere", before="x <= y;")
+    renumbered = _row(d, ident="frame_store_fifo:rel:999", line=1)  # d's line, another name
+    cur, stale = mutate.split_stale([*current, changed, renumbered])
+    def by_ident(rows: list[dict]) -> list[dict]:
+        return sorted(rows, key=lambda r: r["ident"])
+
+    assert by_ident(cur) == by_ident([*current, {**renumbered, "ident": d.ident,
+                                                 "index": d.index, "line": d.line}])
+    assert stale == [changed]
+    assert mutate.split_stale([_row(d, "survived"), renumbered])[0] == [_row(d, "survived")]
+    # --report leaves the stale out; --merge: a current verdict wins over a stale one
+    res, other = tmp_path / "res.json", tmp_path / "other.json"
+    res.write_text(json.dumps([*current, changed]))
+    other.write_text(json.dumps([_row(c, "survived")]))
+    assert mutate.main(["--report", "--json", str(res)]) == 0
+    out = capsys.readouterr().out
+    assert "| frame_store_fifo | 2 | 1 | 0 | 1 |" in out and "stale verdicts" in out
+    assert mutate.main(["--report", "--json", str(res), "--merge", str(other)]) == 0
+    out = capsys.readouterr().out
+    assert "| frame_store_fifo | 3 | 1 | 0 | 2 |" in out and "stale" not in out
+    assert {r["ident"]: r["verdict"] for r in json.loads(res.read_text())}[c.ident] == \
+        "survived"
 
 
 def test_coverage_table_and_parse(tmp_path: Path) -> None:

@@ -57,7 +57,8 @@ finally:
     sys.path.pop(0)
 
 __all__ = ["CHEAPEST", "EQUIVALENT", "NEW_OPS", "TESTS", "Mutant", "apply", "candidates",
-           "candidates_text", "ci_mutants", "main", "report", "run_mutant", "sample", "save"]
+           "candidates_text", "ci_mutants", "main", "report", "run_mutant", "sample", "save",
+           "split_stale"]
 
 
 def report(results: list[tuple[Mutant, str, float]]) -> str:
@@ -97,6 +98,40 @@ def report(results: list[tuple[Mutant, str, float]]) -> str:
             lines += [f"- `{m.ident}`" + (f" (equivalent: {why})" if why else ""),
                       "```diff", m.diff().rstrip(), "```"]
     return "\n".join(lines)
+
+
+def _text(line: str) -> str:
+    return " ".join(line.split())
+
+
+def split_stale(rows: list[dict]) -> tuple[list[dict], list[dict]]:
+    """Verdicts of a results file split into (current, stale). Identifiers are numbered per
+    module and operator, so one RTL edit renumbers its neighbours: a verdict whose identifier
+    names a candidate with the recorded line (before and after the mutation, whitespace
+    collapsed) is current; one whose line is now another candidate's (the same module,
+    operator and text, exactly one such candidate) is current under that candidate's
+    identifier; any other is stale, its line changed or gone, and says nothing about today's
+    RTL: ``--resume`` runs that mutant again and ``--report`` leaves it out. Where two current
+    verdicts name one identifier, the one recorded under it wins."""
+    pool = [m for mod in {r["module"] for r in rows} if mod in TESTS for m in candidates(mod)]
+    by_id = {m.ident: m for m in pool}
+    by_text: dict[tuple, list[Mutant]] = {}
+    for m in pool:
+        by_text.setdefault((m.module, m.op, _text(m.before), _text(m.after)), []).append(m)
+    direct: dict[str, dict] = {}
+    moved: dict[str, dict] = {}
+    stale = []
+    for r in rows:
+        key = (r["module"], r["op"], _text(r["before"]), _text(r["after"]))
+        m = by_id.get(r["ident"])
+        if m is not None and key == (m.module, m.op, _text(m.before), _text(m.after)):
+            direct[r["ident"]] = r
+        elif len(by_text.get(key, [])) == 1:
+            m = by_text[key][0]
+            moved[m.ident] = {**r, **asdict(m), "ident": m.ident}
+        else:
+            stale.append(r)
+    return list({**moved, **direct}.values()), stale
 
 
 def save(path: Path, m: Mutant, verdict: str, secs: float) -> None:
@@ -164,13 +199,21 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         done = json.loads(args.json.read_text())
         if args.merge:
-            by_id = {r["ident"]: r for f in args.merge for r in json.loads(f.read_text())}
-            by_id.update({r["ident"]: r for r in done})
+            # for one identifier a current verdict wins over a stale one, then --json's own
+            merged = [r for f in args.merge for r in json.loads(f.read_text())]
+            cur, old = split_stale(merged + done)
+            by_id = {r["ident"]: r for r in old}
+            by_id.update({r["ident"]: r for r in cur if r in merged})
+            by_id.update({r["ident"]: r for r in cur if r in done})
             done = list(by_id.values())
             args.json.write_text(json.dumps(done, indent=1))
+        done, stale = split_stale(done)
         fields = set(Mutant.__dataclass_fields__)
         print(report([(Mutant(**{k: v for k, v in r.items() if k in fields}), r["verdict"],
                        r["seconds"]) for r in done]))
+        if stale:
+            print(f"\n{len(stale)} stale verdicts (their line changed since, not counted): "
+                  + " ".join(sorted(r["ident"] for r in stale)))
         return 0
     if args.ci:
         chosen = ci_mutants()
@@ -189,7 +232,7 @@ def main(argv: list[str] | None = None) -> int:
         chosen = sample(modules, args.n, args.seed)
     results: list[tuple[Mutant, str, float]] = []
     if args.resume and args.json.exists():
-        done = {r["ident"]: r for r in json.loads(args.json.read_text())}
+        done = {r["ident"]: r for r in split_stale(json.loads(args.json.read_text()))[0]}
         results = [(m, done[m.ident]["verdict"], done[m.ident]["seconds"]) for m in chosen
                    if m.ident in done]
         chosen = [m for m in chosen if m.ident not in done]
