@@ -148,6 +148,10 @@ def test_a_verdict_whose_line_changed_is_stale(tmp_path: Path, capsys) -> None:
     assert "| frame_store_fifo | 3 | 1 | 0 | 2 |" in out and "stale" not in out
     assert {r["ident"]: r["verdict"] for r in json.loads(res.read_text())}[c.ident] == \
         "survived"
+    # a renumbered verdict is written back under its new identifier
+    res.write_text(json.dumps([renumbered]))
+    assert mutate.main(["--report", "--json", str(res), "--merge", str(other)]) == 0
+    assert sorted(r["ident"] for r in json.loads(res.read_text())) == sorted([c.ident, d.ident])
 
 
 def test_coverage_table_and_parse(tmp_path: Path) -> None:

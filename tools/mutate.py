@@ -200,11 +200,11 @@ def main(argv: list[str] | None = None) -> int:
         done = json.loads(args.json.read_text())
         if args.merge:
             # for one identifier a current verdict wins over a stale one, then --json's own
-            merged = [r for f in args.merge for r in json.loads(f.read_text())]
-            cur, old = split_stale(merged + done)
-            by_id = {r["ident"]: r for r in old}
-            by_id.update({r["ident"]: r for r in cur if r in merged})
-            by_id.update({r["ident"]: r for r in cur if r in done})
+            cur_m, old_m = split_stale([r for f in args.merge for r in json.loads(f.read_text())])
+            cur_d, old_d = split_stale(done)
+            by_id = {r["ident"]: r for r in old_m + old_d}
+            for rows in (cur_m, cur_d):
+                by_id.update({r["ident"]: r for r in rows})
             done = list(by_id.values())
             args.json.write_text(json.dumps(done, indent=1))
         done, stale = split_stale(done)

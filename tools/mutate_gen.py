@@ -222,7 +222,7 @@ def candidates_text(module: str, rel: str, text: str) -> list[Mutant]:
                 j += 1
     # register left out of reset
     for j in sorted(reset_block):
-        m = re.match(r"^(\s*)(\w+)\s*<=.*;\s*$", lines[j])
+        m = re.match(r"^(\s*)(\w+)\s*<=[^/]*;\s*(//.*)?$", lines[j])  # a comment may follow
         if m:
             add("noreset", j, f"{m.group(1)}// (mutant: {m.group(2)} not reset)")
     # the operators of tools/mutate_ops.py: a text an earlier operator produced is left out

@@ -243,7 +243,7 @@ EQUIVALENT: dict[str, Equivalent] = {
         "assign full = (cnt_q >= CW'(DEPTH));",
         "full = cnt_q >= DEPTH instead of ==: cnt_q never exceeds DEPTH (a push while full "
         "is refused unless a pop leaves in the same cycle), so the two agree"),
-    "frame_align:noreset:6": Equivalent(
+    "frame_align:noreset:7": Equivalent(
         "// (mutant: discard_q not reset)",
         "discard_q left out of reset (as frame_align:const:6): it is read only in FILL, and "
         "FILL is entered only from PASS through the arm that writes discard_q"),

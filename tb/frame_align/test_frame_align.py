@@ -296,6 +296,34 @@ async def reset_mid_stream(dut) -> None:
 
 
 @cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
+async def reset_mid_chirp_then_midframe_entry(dut) -> None:
+    """A reset lands after the first samples of an input chirp, and the ADC then resumes with
+    a chirp that has no frame start: the reset makes the next sample a chirp's first, so that
+    chirp is discarded (counted) and the frames after it pass (mutant frame_align:noreset:5,
+    in_first_q left out of reset, forwarded it)."""
+    tb = TB(dut)
+    await tb.reset()
+    d = tb.dut
+    taken = 0
+    while taken < max(1, tb.n_range // 2):  # the first half of a frame-start chirp, no TLAST
+        d.s_axis_tvalid.value = 1
+        d.s_axis_tdata.value = taken + 1
+        d.s_axis_tlast.value = 0
+        d.s_axis_tuser.value = 1 if taken == 0 else 0
+        await RisingEdge(d.clk)
+        taken += int(d.s_axis_tready.value)
+    d.s_axis_tvalid.value = 0
+    await tb.reset()
+    tb.sink.clear()
+    tb.done.clear()
+    chirps, sof, gap = tb.sequence(2, faults=False)
+    seq = ([tb.chirp(), *chirps], [False, *sof], [False, *gap])
+    await tb.send(*seq)
+    await tb.check(*seq, "entry after a reset mid-chirp")
+    assert tb.counters() == (0, 0, 1), tb.counters()
+
+
+@cocotb.test(timeout_time=TEST_LIMIT_US, timeout_unit="us")
 async def stall_cross_with_losses(dut) -> None:
     """Stall regimes crossed (tb/stall_regimes.py: CI subset, all 16 pairs with
     STALL_CROSS=full), each pair from reset with random chirp losses: output chirps, frame
