@@ -171,7 +171,7 @@ module axis_packetizer #(
   logic             ovf_q, framing_q;
   logic [31:0]      drop_cnt_q, framing_cnt_q, frame_cnt_q, packet_cnt_q;
 
-  logic             beat, space, store, frame_end, pkt_end, tlast_err, npkt_ok;
+  logic             beat, space, store, frame_end, pkt_end, tlast_bad, tlast_err, npkt_ok;
   logic [LEN_W-1:0] cnt_next, drop_next;
 
   assign pw            = fw_zero_q ? LEN_W'(cfg_packet_words) : pw_q;
@@ -189,8 +189,9 @@ module axis_packetizer #(
                                  : (LEN_W'(POS_W'(pos_q + 1'b1)) + 1'b1 == pw);
   assign cnt_next      = wr_cnt_q + LEN_W'(store);
   assign drop_next     = wr_drop_q + LEN_W'(beat && !space);
-  assign tlast_err     = (TLAST_PERIOD > 0) && beat &&
+  assign tlast_bad     = (TLAST_PERIOD > 0) &&
                          (s_axis_tlast != (tl_pos_q == TLP_W'(TLP - 1)));
+  assign tlast_err     = beat && tlast_bad;
 
   assign ram_wr_en   = store;
   assign ram_wr_addr = {wr_bank_q, wr_cnt_q[POS_W-1:0]};
@@ -297,23 +298,25 @@ module axis_packetizer #(
   assign m_axis_tdata = fifo_tdata[WORD_W-1:0];
   assign m_axis_tlast = fifo_tdata[WORD_W];
 
-  // Descriptor of the packet that closes with this input word
+  // Descriptor of the packet that closes with this input word. It is written only on a beat
+  // that stores (a packet that stores a word also stores its closing word: only this side
+  // sets its bank full, at the close, so space does not go away while a packet is open;
+  // formal: wr_cnt_q != 0 -> space, and a write has beat && store), so its fields take
+  // beat = store = space = 1: none reads the input handshake (timing: the TREADY decision,
+  // behind the packet-count check, stays out of the descriptor's data)
   desc_t new_desc;
   always_comb begin
     new_desc          = '0;
-    new_desc.len      = cnt_next;
-    // len - 1: a packet that stores a word also stores its closing word (only this side sets
-    // its bank full, at the close, so space does not go away while a packet is open), so a
-    // written descriptor has store = 1 and len - 1 = wr_cnt_q
-    new_desc.last_idx = wr_cnt_q;
-    new_desc.drops    = drop_next;
+    new_desc.len      = wr_cnt_q + 1'b1;  // cnt_next with store
+    new_desc.last_idx = wr_cnt_q;         // len - 1
+    new_desc.drops    = wr_drop_q;        // drop_next without a drop
     new_desc.seq      = seq_q;
     new_desc.npkt     = dv_np_q;
     new_desc.frame    = frame_q;
     new_desc.last     = frame_end;
-    new_desc.ovf      = ovf_q || (beat && !space);
-    new_desc.framing  = framing_q || tlast_err;
-    new_desc.damaged  = wr_dmg_q || (beat && s_axis_tuser[0]);
+    new_desc.ovf      = ovf_q;
+    new_desc.framing  = framing_q || tlast_bad;
+    new_desc.damaged  = wr_dmg_q || s_axis_tuser[0];
   end
 
   // ---------------------------------------------------------------------------------------
@@ -482,6 +485,8 @@ module axis_packetizer #(
       else assert (pos_hit_q == (LEN_W'(pos_q) == pw_q - 1'b1));
       assert (32'(wr_cnt_q) <= 32'(pos_q));
       if (wr_cnt_q != '0) assert (space);  // (new_desc.last_idx)
+      // a descriptor is written only with a word stored (new_desc's fields take beat = 1)
+      if (beat && pkt_end && (wr_cnt_q != '0 || store)) assert (store);
       assert (seq_q <= SEQ_W'(NPKT - 1));
       assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
       if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));
