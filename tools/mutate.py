@@ -100,8 +100,11 @@ def report(results: list[tuple[Mutant, str, float]]) -> str:
     return "\n".join(lines)
 
 
-def _text(line: str) -> str:
-    return " ".join(line.split())
+def _key(row: dict) -> tuple[str, str, str, str]:
+    """A verdict's or mutant's line: module, operator, and the line before and after the
+    mutation with whitespace collapsed."""
+    return (row["module"], row["op"], " ".join(row["before"].split()),
+            " ".join(row["after"].split()))
 
 
 def split_stale(rows: list[dict]) -> tuple[list[dict], list[dict]]:
@@ -117,14 +120,14 @@ def split_stale(rows: list[dict]) -> tuple[list[dict], list[dict]]:
     by_id = {m.ident: m for m in pool}
     by_text: dict[tuple, list[Mutant]] = {}
     for m in pool:
-        by_text.setdefault((m.module, m.op, _text(m.before), _text(m.after)), []).append(m)
+        by_text.setdefault(_key(asdict(m)), []).append(m)
     direct: dict[str, dict] = {}
     moved: dict[str, dict] = {}
     stale = []
     for r in rows:
-        key = (r["module"], r["op"], _text(r["before"]), _text(r["after"]))
+        key = _key(r)
         m = by_id.get(r["ident"])
-        if m is not None and key == (m.module, m.op, _text(m.before), _text(m.after)):
+        if m is not None and key == _key(asdict(m)):
             direct[r["ident"]] = r
         elif len(by_text.get(key, [])) == 1:
             m = by_text[key][0]

@@ -172,6 +172,7 @@ module axis_packetizer #(
   logic [31:0]      drop_cnt_q, framing_cnt_q, frame_cnt_q, packet_cnt_q;
 
   logic             beat, space, store, frame_end, pkt_end, tlast_bad, tlast_err, npkt_ok;
+  logic             desc_we;   // the closing word's descriptor is written
   logic [LEN_W-1:0] cnt_next, drop_next;
 
   assign pw            = fw_zero_q ? LEN_W'(cfg_packet_words) : pw_q;
@@ -192,6 +193,7 @@ module axis_packetizer #(
   assign tlast_bad     = (TLAST_PERIOD > 0) &&
                          (s_axis_tlast != (tl_pos_q == TLP_W'(TLP - 1)));
   assign tlast_err     = beat && tlast_bad;
+  assign desc_we       = beat && pkt_end && (wr_cnt_q != '0 || store);
 
   assign ram_wr_en   = store;
   assign ram_wr_addr = {wr_bank_q, wr_cnt_q[POS_W-1:0]};
@@ -333,7 +335,7 @@ module axis_packetizer #(
     p2_last_q     <= p_last_q;
     p2_hdr_word_q <= p_hdr_word_q;
     if (p2_hdr_q || p2_data_q) crc_q <= crc_next;
-    if (beat && pkt_end && (wr_cnt_q != '0 || store)) desc_q[wr_bank_q] <= new_desc;
+    if (desc_we) desc_q[wr_bank_q] <= new_desc;
   end
 
   always_ff @(posedge clk) begin
@@ -486,7 +488,7 @@ module axis_packetizer #(
       assert (32'(wr_cnt_q) <= 32'(pos_q));
       if (wr_cnt_q != '0) assert (space);  // (new_desc.last_idx)
       // a descriptor is written only with a word stored (new_desc's fields take beat = 1)
-      if (beat && pkt_end && (wr_cnt_q != '0 || store)) assert (store);
+      if (desc_we) assert (store);
       assert (seq_q <= SEQ_W'(NPKT - 1));
       assert ({1'b0, pos_q} <= (POS_W+1)'(PACKET_WORDS - 1));
       if (seq_q == SEQ_W'(NPKT - 1)) assert ({1'b0, pos_q} <= (POS_W+1)'(LAST_LEN - 1));
