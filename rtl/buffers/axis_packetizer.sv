@@ -206,7 +206,11 @@ module axis_packetizer #(
   logic [3:0]       dv_i_q;
   logic             dv_busy_q, dv_ge;
   assign dv_ge   = (dv_rem_q >= dv_div_q);
-  assign npkt_ok = !dv_busy_q && (dv_op_q == pw);
+  // (dv_op_q == pw) with the first-word select last: fw_zero_q picks between two compares
+  // of registers and the live setting, not the operand of one compare (timing: the select
+  // reaches s_axis_tready through one LUT, not through the 16-bit compare)
+  assign npkt_ok = !dv_busy_q && (fw_zero_q ? (dv_op_q == LEN_W'(cfg_packet_words))
+                                            : (dv_op_q == pw_q));
   always_ff @(posedge clk) begin
     if (rst) begin
       dv_op_q   <= LEN_W'(PACKET_WORDS);

@@ -122,6 +122,7 @@ module fft_axis #(
   logic [1:0]       ib_cnt_q, ib_cnt_d;
   logic             ib_rdy_q;    // s_axis_tready
   logic             s_fire, ib_ne, ib_pop;
+  logic             smp_q;       // (ib_ne || fill_q): a sample enters on the next advance
   logic [LOG2N-1:0] s_cnt_q;     // position of the next input beat in its vector, 0..N_IN-1
 
   // last pipeline register (output conversion) and the reorder buffer write side
@@ -166,6 +167,15 @@ module fft_axis #(
     end else begin
       adv_c    <= adv_d;
       ib_rdy_q <= ib_cnt_d != 2'd2 && !fill_d;
+    end
+  end
+  // the window's select of the position and valid, a register (timing: the buffer count's
+  // compare is not ahead of the window's coefficient ROM)
+  always_ff @(posedge clk) begin
+    if (rst) begin
+      smp_q <= 1'b0;
+    end else begin
+      smp_q <= ib_cnt_d != 2'd0 || fill_d;
     end
   end
 
@@ -213,8 +223,8 @@ module fft_axis #(
     .clk, .rst, .en(adv_w),
     // (the window reads in_vld and in_pos only when it advances, and then a sample enters
     // exactly when the buffer holds one or a fill zero is due: both from registers)
-    .in_data(fill_q ? '0 : ib0_q), .in_vld(fill_q || ib_ne),
-    .in_pos((ib_ne || fill_q) ? in_cnt_q : ph_cnt_q),
+    .in_data(fill_q ? '0 : ib0_q), .in_vld(smp_q),
+    .in_pos(smp_q ? in_cnt_q : ph_cnt_q),
     .out_data(st_data[0]), .out_vld(st_vld[0]), .out_pos(st_pos[0])
   );
   assign st_ov[0] = 1'b0;
@@ -339,6 +349,7 @@ module fft_axis #(
     assert (adv_w == adv_c && adv_o == adv_c && adv_r == adv_c);
     assert (ib_cnt_q <= 2'd2);
     assert (s_axis_tready == (ib_cnt_q != 2'd2 && !fill_q));
+    assert (smp_q == (ib_ne || fill_q));
     if (bubble) assert (bub_q);
     cover (bubble);   // first reached at step 18 (N = 16): the bmc depth must exceed it
   end
