@@ -81,19 +81,22 @@ def ccache_env() -> dict[str, str]:
 
 def run_stages(root: Path, env: dict[str, str], stages: list[list[str]],
                timeout: float, budgets: list[float] | None = None,
-               times: list[float] | None = None) -> str:
+               times: list[float] | None = None, failed_first: bool = False) -> str:
     """Run the pytest ``stages`` in the tree at ``root`` until one fails: "killed" (a stage
     failed), "timeout" (a stage overran its budget: ``timeout`` seconds, times
     :data:`SLOW_STAGE` for the slow testbenches; with ``budgets``, the larger of
     ``timeout`` and ``budgets[i]`` for stage ``i``) or "survived". The seconds of each
-    stage run are appended to ``times``."""
+    stage run are appended to ``times``. With ``failed_first`` (a tree that runs mutant after
+    mutant: the schemata) pytest keeps its cache in ``root`` and runs the tests that failed
+    last first (``--ff``): a mutant is often killed by the test that killed the one before,
+    so a kill comes sooner; the verdict does not depend on the order."""
     for i, stage in enumerate(stages):
         slow = any(big in t for t in stage for big in SLOW_TBS)
         # with budgets (the schemata: builds done once, before) no allowance for builds
         limit = max(timeout, budgets[i]) if budgets else timeout * (SLOW_STAGE if slow else 1)
         t0 = time.monotonic()
-        cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p",
-               "no:cacheprovider", *stage]
+        order = ["--ff"] if failed_first else ["-p", "no:cacheprovider"]
+        cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", *order, *stage]
         # own process group: a timeout ends pytest and the simulator it started
         proc = subprocess.Popen(cmd, cwd=root, env=env, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, start_new_session=True)

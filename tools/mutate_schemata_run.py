@@ -123,7 +123,7 @@ def run_schemata(mutants: list[Mutant], timeout: float, quick: bool
         for m in held:
             t0 = time.monotonic()
             verdict = run_stages(root, {**env, "RTLSIM_PLUSARGS": f"+MUTANT={sch.ids[m.ident]}"},
-                                 stages, timeout, budgets)
+                                 stages, timeout, budgets, failed_first=True)
             yield m, verdict, time.monotonic() - t0
         for m in classic:
             yield m, *run_mutant(m, timeout, quick=quick)
