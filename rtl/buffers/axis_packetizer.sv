@@ -206,11 +206,11 @@ module axis_packetizer #(
   logic [3:0]       dv_i_q;
   logic             dv_busy_q, dv_ge;
   assign dv_ge   = (dv_rem_q >= dv_div_q);
-  // (dv_op_q == pw) with the first-word select last: fw_zero_q picks between two compares
-  // of registers and the live setting, not the operand of one compare (timing: the select
-  // reaches s_axis_tready through one LUT, not through the 16-bit compare)
-  assign npkt_ok = !dv_busy_q && (fw_zero_q ? (dv_op_q == LEN_W'(cfg_packet_words))
-                                            : (dv_op_q == pw_q));
+  // (dv_op_q == pw): past a frame's first word dv_op_q equals pw_q (the divider takes pw
+  // every clock, and pw_q changes only at a first word, to that clock's pw; asserted below),
+  // so only the first word compares, against the live setting (timing: no compare of pw_q
+  // ahead of s_axis_tready)
+  assign npkt_ok = !dv_busy_q && (!fw_zero_q || dv_op_q == LEN_W'(cfg_packet_words));
   always_ff @(posedge clk) begin
     if (rst) begin
       dv_op_q   <= LEN_W'(PACKET_WORDS);
@@ -433,6 +433,10 @@ module axis_packetizer #(
               && (INPUT_BACKPRESSURE || 32'(cfg_packet_words) == PACKET_WORDS))
         else $error("%m: cfg_packet_words=%0d not in %0d..%0d", cfg_packet_words, PW_MIN,
                     PACKET_WORDS);
+    // npkt_ok's premise: the divider's operand is the frame's length past its first word
+    if (!rst && !fw_zero_q)
+      assert (dv_op_q == pw_q)
+        else $error("%m: divider operand %0d, frame length %0d", dv_op_q, pw_q);
   end
 `endif
 `endif
