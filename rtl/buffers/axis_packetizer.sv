@@ -172,22 +172,33 @@ module axis_packetizer #(
   logic [31:0]      drop_cnt_q, framing_cnt_q, frame_cnt_q, packet_cnt_q;
 
   logic             beat, space, store, frame_end, pkt_end, tlast_bad, tlast_err, npkt_ok;
+  // next state of the registers s_axis_tready depends on (tready_q, after the output side)
+  logic [NUM_BANKS-1:0] full_d;
+  logic [BANK_W-1:0] wr_bank_d;
+  logic             fw_zero_d, frame_end_d, pos_hit_d, dv_busy_d, tready_q;
   logic             desc_we;   // the closing word's descriptor is written
   logic [LEN_W-1:0] cnt_next, drop_next;
 
   assign pw            = fw_zero_q ? LEN_W'(cfg_packet_words) : pw_q;
   assign space         = !full_q[wr_bank_q];
-  // a packet closes only once its frame's packet count is known
-  assign s_axis_tready = INPUT_BACKPRESSURE ? space && (npkt_ok || !pkt_end) : 1'b1;
   assign beat          = s_axis_tvalid && s_axis_tready;
   assign store         = beat && space;
   assign frame_end     = frame_end_q;
-  // (a frame's first word is at position 0: a packet end there only for a length of 1)
-  assign pkt_end       = (fw_zero_q ? (LEN_W'(cfg_packet_words) == LEN_W'(1)) : pos_hit_q) ||
-                         frame_end;
-  // pos_hit_q after this beat: position 0 (packet end) or pos_q + 1 against the length pw
-  assign pos_hit_next  = pkt_end ? (pw == LEN_W'(1))
-                                 : (LEN_W'(POS_W'(pos_q + 1'b1)) + 1'b1 == pw);
+  // (a frame's first word is at position 0: a packet end there only with the frame's end,
+  // the length being at least PW_MIN >= 2, asserted below)
+  assign pkt_end       = (!fw_zero_q && pos_hit_q) || frame_end;
+  // pos_hit_q after this beat: position 0 (packet end; lengths are >= 2) or pos_q + 1
+  // against the length pw
+  assign pos_hit_next  = !pkt_end && (LEN_W'(POS_W'(pos_q + 1'b1)) + 1'b1 == pw);
+
+  // s_axis_tready: space in the bank to write, and a packet closes only once its frame's
+  // packet count is known (npkt_ok). Past a frame's first word npkt_ok is !dv_busy_q
+  // (dv_op_q == pw_q there, asserted below); at the first word no packet closes unless the
+  // frame is one word long. So from the first word on TREADY is a function of registers,
+  // ready_of(...), and tready_q takes it from their next state (timing, docs/synth.md note
+  // 26: the decision is a register, not a LUT tree the slice in front of the input waits on).
+  // A frame of one word closes its packet at the first word, which compares the live
+  // setting: there TREADY stays combinational.
   assign cnt_next      = wr_cnt_q + LEN_W'(store);
   assign drop_next     = wr_drop_q + LEN_W'(beat && !space);
   assign tlast_bad     = (TLAST_PERIOD > 0) &&
@@ -211,6 +222,7 @@ module axis_packetizer #(
   // so only the first word compares, against the live setting (timing: no compare of pw_q
   // ahead of s_axis_tready)
   assign npkt_ok = !dv_busy_q && (!fw_zero_q || dv_op_q == LEN_W'(cfg_packet_words));
+  assign dv_busy_d = (dv_op_q != pw) || (dv_busy_q && dv_i_q != '0);
   always_ff @(posedge clk) begin
     if (rst) begin
       dv_op_q   <= LEN_W'(PACKET_WORDS);
@@ -219,19 +231,20 @@ module axis_packetizer #(
       dv_rem_q  <= '0;
       dv_div_q  <= '0;
       dv_i_q    <= '0;
-    end else if (dv_op_q != pw) begin
-      dv_op_q   <= pw;
-      dv_rem_q  <= 32'(FRAME_WORDS) + 32'(pw) - 32'd1;
-      dv_div_q  <= 32'(pw) << (NP_W - 1);
-      dv_np_q   <= '0;
-      dv_i_q    <= 4'(NP_W - 1);
-      dv_busy_q <= 1'b1;
-    end else if (dv_busy_q) begin
-      if (dv_ge) dv_rem_q <= dv_rem_q - dv_div_q;
-      dv_np_q   <= {dv_np_q[NP_W-2:0], dv_ge};
-      dv_div_q  <= dv_div_q >> 1;
-      dv_i_q    <= dv_i_q - 1'b1;
-      dv_busy_q <= (dv_i_q != '0);
+    end else begin
+      dv_busy_q <= dv_busy_d;
+      if (dv_op_q != pw) begin
+        dv_op_q   <= pw;
+        dv_rem_q  <= 32'(FRAME_WORDS) + 32'(pw) - 32'd1;
+        dv_div_q  <= 32'(pw) << (NP_W - 1);
+        dv_np_q   <= '0;
+        dv_i_q    <= 4'(NP_W - 1);
+      end else if (dv_busy_q) begin
+        if (dv_ge) dv_rem_q <= dv_rem_q - dv_div_q;
+        dv_np_q   <= {dv_np_q[NP_W-2:0], dv_ge};
+        dv_div_q  <= dv_div_q >> 1;
+        dv_i_q    <= dv_i_q - 1'b1;
+      end
     end
   end
 
@@ -326,6 +339,35 @@ module axis_packetizer #(
   end
 
   // ---------------------------------------------------------------------------------------
+  // s_axis_tready as a register (the decision: the input side's comment)
+  function automatic logic ready_of(input logic sp, input logic fz, input logic busy,
+                                    input logic hit, input logic fe);
+    ready_of = sp && (!busy || !((!fz && hit) || fe));
+  endfunction
+  // A packet that closes with a word stored or stored before fills its bank (desc_we); a
+  // bank the input side sets is not the one the output side clears (the set first).
+  assign full_d      = (full_q | (desc_we ? NUM_BANKS'(1) << wr_bank_q : '0))
+                       & ~((issue_data && rd_last) ? NUM_BANKS'(1) << rd_bank_q : '0);
+  assign wr_bank_d   = wr_bank_q + BANK_W'(desc_we);
+  assign fw_zero_d   = beat ? frame_end : fw_zero_q;
+  assign frame_end_d = beat ? (frame_end ? (FRAME_WORDS == 1)
+                                         : (fw_q == FWC_W'(FRAME_WORDS - 2)))
+                            : frame_end_q;
+  assign pos_hit_d   = beat ? pos_hit_next : pos_hit_q;
+  always_ff @(posedge clk) begin
+    if (rst) tready_q <= 1'b1;  // (the reset state: banks free, divider idle)
+    else     tready_q <= ready_of(!full_d[wr_bank_d], fw_zero_d, dv_busy_d, pos_hit_d,
+                                  frame_end_d);
+  end
+  if (!INPUT_BACKPRESSURE) begin : g_tready_one
+    assign s_axis_tready = 1'b1;
+  end else if (FRAME_WORDS == 1) begin : g_tready_comb
+    assign s_axis_tready = space && npkt_ok;
+  end else begin : g_tready_reg
+    assign s_axis_tready = tready_q;
+  end
+
+  // ---------------------------------------------------------------------------------------
   // Registers
   always_ff @(posedge clk) begin
     p_hdr_q      <= issue_hdr;
@@ -369,13 +411,16 @@ module axis_packetizer #(
       hdr_sent_q    <= 1'b0;
       crc_due_q     <= 1'b0;
     end else begin
+      // the bank ring and the look-ahead flags (their next state above, for tready_q)
+      full_q      <= full_d;
+      wr_bank_q   <= wr_bank_d;
+      fw_zero_q   <= fw_zero_d;
+      frame_end_q <= frame_end_d;
+      pos_hit_q   <= pos_hit_d;
       // input side
       if (beat) begin
         tl_pos_q <= (tl_pos_q == TLP_W'(TLP - 1) || frame_end) ? '0 : tl_pos_q + 1'b1;
         fw_q     <= frame_end ? '0 : fw_q + 1'b1;
-        fw_zero_q   <= frame_end;
-        frame_end_q <= frame_end ? (FRAME_WORDS == 1) : (fw_q == FWC_W'(FRAME_WORDS - 2));
-        pos_hit_q   <= pos_hit_next;
         if (fw_zero_q) pw_q <= pw;
         if (!space) begin
           ovf_q <= 1'b1;
@@ -395,10 +440,6 @@ module axis_packetizer #(
             frame_q     <= frame_q + 1'b1;
             frame_cnt_q <= frame_cnt_q + 1'b1;
           end
-          if (wr_cnt_q != '0 || store) begin  // (cnt_next != 0)
-            full_q[wr_bank_q] <= 1'b1;
-            wr_bank_q         <= wr_bank_q + 1'b1;
-          end
         end else begin
           pos_q     <= pos_q + 1'b1;
           wr_cnt_q  <= cnt_next;
@@ -414,7 +455,6 @@ module axis_packetizer #(
           rd_idx_q          <= '0;
           hdr_sent_q        <= 1'b0;
           crc_due_q         <= HEADER;
-          full_q[rd_bank_q] <= 1'b0;
           rd_bank_q         <= rd_bank_q + 1'b1;
           packet_cnt_q      <= packet_cnt_q + 1'b1;
         end else begin
@@ -437,6 +477,10 @@ module axis_packetizer #(
     if (!rst && !fw_zero_q)
       assert (dv_op_q == pw_q)
         else $error("%m: divider operand %0d, frame length %0d", dv_op_q, pw_q);
+    // tready_q is the decision on the registers (with the run-time length changing)
+    if (!rst && INPUT_BACKPRESSURE && FRAME_WORDS > 1)
+      assert (s_axis_tready == (space && (npkt_ok || !pkt_end)))
+        else $error("%m: registered TREADY %0b differs from its decision", s_axis_tready);
   end
 `endif
 `endif
@@ -488,6 +532,9 @@ module axis_packetizer #(
       // the packet plan below is the one of PACKET_WORDS (the run-time length fixed there)
       assume (cfg_packet_words == 16'(PACKET_WORDS));
       assert (pw_q == LEN_W'(PACKET_WORDS) && dv_op_q == LEN_W'(PACKET_WORDS));
+      // the registered TREADY is the decision on the current registers
+      if (INPUT_BACKPRESSURE)
+        assert (s_axis_tready == (space && (npkt_ok || !pkt_end)));
       assert (!dv_busy_q && dv_np_q == NP_W'(NPKT));
       assert (32'(fw_q) == 32'(seq_q) * PACKET_WORDS + 32'(pos_q));
       assert (fw_zero_q == (fw_q == '0) && frame_end_q == (fw_q == FWC_W'(FRAME_WORDS - 1)));

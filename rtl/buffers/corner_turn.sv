@@ -141,6 +141,7 @@ module corner_turn #(
   logic [SH_W-1:0] wr_shift_q;   // k*ROT mod B for the frame being written
   logic            pending_q;    // a completely written frame waits for the reader
   logic            framing_q;
+  logic            framing_ev_q; // a misplaced/missing TLAST was taken last clock
   logic [31:0]     framing_cnt_q, frames_in_q, frames_out_q;
   logic            wr_beat, wr_frame_end, chirp_end, wr_free;
 
@@ -324,6 +325,7 @@ module corner_turn #(
       wr_shift_q    <= '0;
       pending_q     <= 1'b0;
       framing_q     <= 1'b0;
+      framing_ev_q  <= 1'b0;
       framing_cnt_q <= '0;
       frames_in_q   <= '0;
       frames_out_q  <= '0;
@@ -331,12 +333,15 @@ module corner_turn #(
       rd_shift_q    <= '0;
       rd_active_q   <= 1'b0;
     end else begin
+      // The framing flag and counter follow the beat by one clock (docs/synth.md note 26:
+      // the counter sits by the status logic, far from the input handshake).
+      framing_ev_q <= wr_beat && (s_axis_tlast != chirp_end);
+      if (framing_ev_q) begin
+        framing_q <= 1'b1;
+        if (framing_cnt_q != '1) framing_cnt_q <= framing_cnt_q + 1'b1;
+      end
       if (wr_beat) begin
         wr_cnt_q <= wr_frame_end ? '0 : wr_cnt_q + 1'b1;
-        if (s_axis_tlast != chirp_end) begin
-          framing_q <= 1'b1;
-          if (framing_cnt_q != '1) framing_cnt_q <= framing_cnt_q + 1'b1;
-        end
         if (wr_frame_end) begin
           pending_q   <= 1'b1;
           wr_shift_q  <= next_shift(wr_shift_q);
