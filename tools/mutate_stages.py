@@ -153,6 +153,16 @@ EQUIVALENT: dict[str, Equivalent] = {
         "modadd subtracting {1'b1, NM1} instead of {1'b0, NM1}: the two differ by 2^B, "
         "which only changes bit B of the B+1-bit t, and modadd returns t[B-1:0] (survived "
         "the campaign's corner_turn stages, 27 November 2026)"),
+    "corner_turn:noreset:4": Equivalent(
+        "// (mutant: rs_q not reset)",
+        "the read stride rs_q left out of reset: it is read only on a read issue, which needs "
+        "rd_active_q (cleared by reset), and the only way to set rd_active_q, rd_start, loads "
+        "rs_q from ws_q in the same clock (survived the campaign, 28 November 2026, 417 s)"),
+    "corner_turn:noreset:8": Equivalent(
+        "// (mutant: rj_q not reset)",
+        "the read jump rj_q left out of reset: as corner_turn:noreset:4, it is read only on a "
+        "read issue and loaded from wj_q by rd_start, the only way to set rd_active_q "
+        "(survived the campaign, 28 November 2026, 571 s)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
