@@ -163,6 +163,13 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the read jump rj_q left out of reset: as corner_turn:noreset:4, it is read only on a "
         "read issue and loaded from wj_q by rd_start, the only way to set rd_active_q "
         "(survived the campaign, 28 November 2026, 571 s)"),
+    "corner_turn:noreset:14": Equivalent(
+        "// (mutant: wr_shift_q not reset)",
+        "the write rotation wr_shift_q left out of reset: the in-place scheme holds from any "
+        "starting rotation s < RB (input i written at rotl(i, s), read j at rotl(j, s + ROT) "
+        "= rotl(rotl(j, ROT), s): read j returns input rotl(j, ROT) whatever s), and the "
+        "register only ever holds 0 or a value of next_shift, both < RB (the proof asserts "
+        "it); survived the campaign, 28 November 2026, 352 s"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
