@@ -170,6 +170,16 @@ EQUIVALENT: dict[str, Equivalent] = {
         "= rotl(rotl(j, ROT), s): read j returns input rotl(j, ROT) whatever s), and the "
         "register only ever holds 0 or a value of next_shift, both < RB (the proof asserts "
         "it); survived the campaign, 28 November 2026, 352 s"),
+    "corner_turn:noreset:22": Equivalent(
+        "// (mutant: rd_shift_q not reset)",
+        "the read rotation rd_shift_q left out of reset: as corner_turn:noreset:4, it is read "
+        "only by reads, which need rd_active_q, and rd_start (the only way to set it) loads "
+        "rd_shift_q from wr_shift_q in the same clock (survived the campaign, 28 November 2026)"),
+    "corner_turn:noreset:5": Equivalent(
+        "// (mutant: ra_q not reset)",
+        "the read address ra_q left out of reset: as corner_turn:noreset:4, it is read only "
+        "by reads, which need rd_active_q, and rd_start (the only way to set it) loads ra_q "
+        "with 0 in the same clock (survived the campaign, 28 November 2026)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
