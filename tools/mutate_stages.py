@@ -158,6 +158,11 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the read stride rs_q left out of reset: it is read only on a read issue, which needs "
         "rd_active_q (cleared by reset), and the only way to set rd_active_q, rd_start, loads "
         "rs_q from ws_q in the same clock (survived the campaign, 28 November 2026, 417 s)"),
+    "corner_turn:noreset:5": Equivalent(
+        "// (mutant: ra_q not reset)",
+        "the read address ra_q left out of reset: as corner_turn:noreset:4, it is read only "
+        "by reads, which need rd_active_q, and rd_start (the only way to set it) loads ra_q "
+        "with 0 in the same clock (survived the campaign, 28 November 2026)"),
     "corner_turn:noreset:8": Equivalent(
         "// (mutant: rj_q not reset)",
         "the read jump rj_q left out of reset: as corner_turn:noreset:4, it is read only on a "
@@ -175,11 +180,6 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the read rotation rd_shift_q left out of reset: as corner_turn:noreset:4, it is read "
         "only by reads, which need rd_active_q, and rd_start (the only way to set it) loads "
         "rd_shift_q from wr_shift_q in the same clock (survived the campaign, 28 November 2026)"),
-    "corner_turn:noreset:5": Equivalent(
-        "// (mutant: ra_q not reset)",
-        "the read address ra_q left out of reset: as corner_turn:noreset:4, it is read only "
-        "by reads, which need rd_active_q, and rd_start (the only way to set it) loads ra_q "
-        "with 0 in the same clock (survived the campaign, 28 November 2026)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "

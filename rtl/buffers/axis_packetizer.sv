@@ -186,7 +186,10 @@ module axis_packetizer #(
   assign frame_end     = frame_end_q;
   // (a frame's first word is at position 0: a packet end there only with the frame's end,
   // the length being at least PW_MIN >= 2, asserted below)
-  assign pkt_end       = (!fw_zero_q && pos_hit_q) || frame_end;
+  function automatic logic pkt_end_of(input logic fz, input logic hit, input logic fe);
+    pkt_end_of = (!fz && hit) || fe;
+  endfunction
+  assign pkt_end       = pkt_end_of(fw_zero_q, pos_hit_q, frame_end);
   // pos_hit_q after this beat: position 0 (packet end; lengths are >= 2) or pos_q + 1
   // against the length pw
   assign pos_hit_next  = !pkt_end && (LEN_W'(POS_W'(pos_q + 1'b1)) + 1'b1 == pw);
@@ -342,7 +345,7 @@ module axis_packetizer #(
   // s_axis_tready as a register (the decision: the input side's comment)
   function automatic logic ready_of(input logic sp, input logic fz, input logic busy,
                                     input logic hit, input logic fe);
-    ready_of = sp && (!busy || !((!fz && hit) || fe));
+    ready_of = sp && (!busy || !pkt_end_of(fz, hit, fe));
   endfunction
   // A packet that closes with a word stored or stored before fills its bank (desc_we); a
   // bank the input side sets is not the one the output side clears (the set first).

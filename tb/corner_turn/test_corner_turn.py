@@ -7,6 +7,7 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
+from cocotb.triggers import RisingEdge
 
 from model import corner_turn as ct
 from rtlsim.axis import AxisTB, bursty_pause, no_pause, random_pause
@@ -170,8 +171,6 @@ async def test_reset_after_framing_error(dut):
     """A reset in the clock after a misplaced TLAST: the error is not counted after it, and
     the next frame turns clean (mutation campaign corner_turn:noreset:17: the registered
     framing event left out of reset counted it once the reset ended)."""
-    from cocotb.triggers import RisingEdge
-
     tb = TB(dut)
     await tb.reset()
     a, b = tb.random_frame(), tb.random_frame()
