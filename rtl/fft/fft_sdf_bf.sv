@@ -148,7 +148,12 @@ module fft_sdf_bf #(
   logic [LOG2N-1:0] pos1_q, out_pos_q;
   logic             ov1_q, vld1_q;
   logic [DW-1:0]    out_data_q;  // stage 2: rounded, saturated
-  logic             out_ov_q, out_vld_q;
+  logic             out_vld_q;
+  // stage 2's overflow flag, registered per lane (out_ovl_q: the lane's re or im saturated)
+  // beside stage 1's (out_ovi_q) and OR-ed after the registers: out_ov is the same bit in the
+  // same cycle, without a path from every lane's rounding through one OR into one register
+  logic [NUM_CH-1:0] out_ovl_q;
+  logic              out_ovi_q;
 
   always_ff @(posedge clk) begin
     if (en) begin
@@ -167,15 +172,16 @@ module fft_sdf_bf #(
 
   always_ff @(posedge clk) begin
     logic signed [63:0] v;
-    logic               ov;
+    logic [NUM_CH-1:0]  ov;
     if (en) begin
-      ov = ov1_q;
-      for (int c = 0; c < 2 * NUM_CH; c++) begin
+      ov = '0;
+      for (int c = 0; c < 2 * NUM_CH; c++) begin   // component c of lane c / 2 (re, im)
         v  = fft_pkg::round_conv(64'(signed'(full_q[c*(W+1) +: W+1])), SCALE ? 1 : 0);
-        ov = ov | fft_pkg::sat_ov(v, W, RND_W);
+        ov[c / 2] = ov[c / 2] | fft_pkg::sat_ov(v, W, RND_W);
         out_data_q[c*W +: W] <= W'(fft_pkg::sat_val(v, W, RND_W));
       end
-      out_ov_q  <= ov;
+      out_ovl_q <= ov;
+      out_ovi_q <= ov1_q;
       out_pos_q <= pos1_q;
     end
   end
@@ -198,7 +204,7 @@ module fft_sdf_bf #(
   assign out_data = out_data_q;
   assign out_vld  = out_vld_q;
   assign out_pos  = out_pos_q;
-  assign out_ov   = out_ov_q;
+  assign out_ov   = out_ovi_q | (|out_ovl_q);
   assign out_pos_ahead = head_pos;   // -> pos1_q -> out_pos_q
 endmodule
 

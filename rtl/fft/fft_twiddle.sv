@@ -148,8 +148,13 @@ module fft_twiddle #(
   end
 
   // ---------------------------------------------------------------- stage 5: round, sat
-  logic [DW-1:0] y_d, y5_q;
-  logic          y_ov, ov5_q;
+  // The overflow flag is registered per lane (ovl5_q: the lane's rounded product saturated)
+  // beside the input's flag (ovi5_q) and OR-ed after the registers: out_ov is the same bit in
+  // the same cycle, and no path runs from the rounding's carry chains through an OR of every
+  // lane (the lanes are placed far apart) into one register.
+  logic [DW-1:0]     y_d, y5_q;
+  logic [NUM_CH-1:0] y_ov, ovl5_q;
+  logic              ovi5_q;
 
   // Products (stage 3) and the exact sums yr = re*C + im*S, yi = im*C - re*S (forward;
   // the inverse has S -> -S), full precision before the rounding (stage 4): two forms,
@@ -306,18 +311,19 @@ module fft_twiddle #(
         yi4_q[ch] <= yi_full[ch];
       end
       y5_q     <= y_d;
-      ov5_q    <= ov_q[3] | y_ov;
+      ovi5_q   <= ov_q[3];
+      ovl5_q   <= y_ov;
     end
   end
 
   always_comb begin
     logic signed [63:0] yr, yi;
     y_d  = '0;
-    y_ov = 1'b0;
+    y_ov = '0;
     for (int ch = 0; ch < NUM_CH; ch++) begin
       yr = fft_pkg::round_conv(64'(yr4_q[ch]), COEF_FRAC);
       yi = fft_pkg::round_conv(64'(yi4_q[ch]), COEF_FRAC);
-      y_ov = y_ov | fft_pkg::sat_ov(yr, W, Y_W) | fft_pkg::sat_ov(yi, W, Y_W);
+      y_ov[ch] = fft_pkg::sat_ov(yr, W, Y_W) | fft_pkg::sat_ov(yi, W, Y_W);
       y_d[ch*2*W +: W]     = W'(fft_pkg::sat_val(yr, W, Y_W));
       y_d[ch*2*W + W +: W] = W'(fft_pkg::sat_val(yi, W, Y_W));
     end
@@ -334,7 +340,7 @@ module fft_twiddle #(
   assign out_data = y5_q;
   assign out_vld  = vld_q[4];
   assign out_pos  = pos_q[4];
-  assign out_ov   = ov5_q;
+  assign out_ov   = ovi5_q | (|ovl5_q);
 endmodule
 
 `default_nettype wire

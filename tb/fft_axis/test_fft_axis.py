@@ -413,7 +413,8 @@ async def test_reset_mid_output(dut) -> None:
 # four-multiplier form, all others use three, Gauss); no window with stage 0 unscaled, so
 # full-scale input reaches the twiddle at full scale (its pre-add re + im needs W+1 bits),
 # with the twiddle products split for 18-bit multipliers (MUL_W=18: W = 21 in two partial
-# products each, as on the ECP5); two lanes with zero fill, also split.
+# products each, as on the ECP5), two lanes so a twiddle saturates in a lane other than the
+# first (each lane has its own overflow register); two lanes with zero fill, also split.
 # FFT_AXIS_FULL=1 adds the largest N = 4096 and
 # N = 32 (two more builds).
 PARAMS = [
@@ -423,7 +424,7 @@ PARAMS = [
     dict(N=256, NUM_CH=1),
     dict(N=1024, NUM_CH=1, WINDOW=1),
     dict(N=16, NUM_CH=1, DATA_W=24, GUARD_W=2, INVERSE=1),
-    dict(N=16, NUM_CH=1, SCALE_SCH=0b1110, MUL_W=18),
+    dict(N=16, NUM_CH=2, SCALE_SCH=0b1110, MUL_W=18),
     # zero fill: 15 of 16 samples with their own 15-point window, two lanes; 50 of 64, the
     # positive half only (a real ADC's range FFT)
     dict(N=16, NUM_CH=2, WINDOW=1, N_IN=15, MUL_W=18),
