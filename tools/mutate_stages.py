@@ -180,6 +180,11 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the read rotation rd_shift_q left out of reset: as corner_turn:noreset:4, it is read "
         "only by reads, which need rd_active_q, and rd_start (the only way to set it) loads "
         "rd_shift_q from wr_shift_q in the same clock (survived the campaign, 28 November 2026)"),
+    "corner_turn:rel:8": Equivalent(
+        "for (int a = 0; a <= B; a++) wr_perm_q[a] <= SH_W'(a);",
+        "the reset loop of the bit permutation one step longer: its last step writes "
+        "wr_perm_q[B], outside the B-entry array, and a write to an index out of range "
+        "changes nothing (IEEE 1800 7.4.6) (survived the campaign, 28 November 2026, 138 s)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
@@ -234,6 +239,17 @@ EQUIVALENT: dict[str, Equivalent] = {
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only in FILL, and FILL is entered only "
         "from PASS through the arm that writes discard_q, so the reset value is never read"),
+    "nci:dropfirst:1": Equivalent(
+        "assign last_tx = (t_q == BT'(NUM_TX - 1));",
+        "last_tx without its NUM_TX == 1 term: with one TX, t_q (one bit) is reset to 0 and "
+        "only ever loaded with 0 (last_tx is then true), so t_q == 0 == NUM_TX - 1 always "
+        "(survived the campaign, 28 November 2026)"),
+    "nci:last:0": Equivalent(
+        "last_q[1] <= 1'b0;",
+        "last_q never set: the accumulator RAM then also stores the last TX's sum, at a "
+        "Doppler bin whose next read is by TX 0 of the next range bin, which adds zero "
+        "(first_q) instead, and TX 1 reads the word TX 0 wrote; with NUM_TX = 1 the RAM is "
+        "not built (survived the campaign, 28 November 2026)"),
     "nci:noreset:0": Equivalent(
         "// (mutant: v_q not reset)",
         "v_q (a beat in pipeline stage k) left out of reset, the successor of step 2's "
@@ -243,6 +259,38 @@ EQUIVALENT: dict[str, Equivalent] = {
         "accumulator word that TX t >= 1 reads was written by TX t-1 of the same Doppler "
         "bin after the reset, so a stray word is always overwritten before it is read "
         "(and with NUM_TX = 1 the register drives nothing)"),
+    "nci:rel:2": Equivalent(
+        "for (int c = 0; c <= 2 * NUM_RX; c++) begin",
+        "the squares' loop one step longer: its last step writes sq2_q[2 * NUM_RX], outside "
+        "the array, and a write to an index out of range changes nothing (IEEE 1800 7.4.6) "
+        "(survived the campaign, 28 November 2026)"),
+    "nci:rel:6": Equivalent(
+        "for (int k = 0; k <= 64; k++) t[k] = t3_q[k];",
+        "the copy into the adder tree one step longer: t[64] is outside the 64-entry array, "
+        "so the extra write changes nothing (IEEE 1800 7.4.6) (survived the campaign, "
+        "28 November 2026)"),
+    "nci:rel:7": Equivalent(
+        "for (int w = 32; w > 1; w = w / 2)",
+        "the adder tree without its last level (t[0] + t[1]): t[1] is then the sum of the "
+        "lane-pair sums 32..63, and with NUM_RX <= 64 (checked at elaboration) there are at "
+        "most 32 pairs, so those terms are constant zero and t[0] is already the total "
+        "(survived the campaign, 28 November 2026)"),
+    "nci:rel:8": Equivalent(
+        "for (int k = 0; k <= w; k++) t[k] = t[2 * k] + t[2 * k + 1];",
+        "each level of the adder tree one sum longer: the extra sum lands in t[w], and the "
+        "next level reads only t[0 .. w - 1] (and the result t[0]), so it is never read "
+        "(survived the campaign, 28 November 2026)"),
+    "nci:rel:9": Equivalent(
+        "if (NUM_TX >= 1) begin : g_acc",
+        "the accumulator RAM built for one TX too: with NUM_TX = 1 every word is its "
+        "cell's last TX (no write: wr_en needs !last_q) and its first (first_q: the sum adds "
+        "zero, not the RAM's word), so the RAM's contents are never used (survived the "
+        "campaign, 28 November 2026)"),
+    "nci:tie:0": Equivalent(
+        "assign last_tx = (NUM_TX == 1) || (t_q >= BT'(NUM_TX - 1));",
+        "last_tx as t_q >= NUM_TX - 1 instead of ==: t_q counts up from 0 and returns to 0 "
+        "at last_tx, so it never exceeds NUM_TX - 1 and the two agree (survived the "
+        "campaign, 28 November 2026)"),
     "axis_reg_slice:dropfirst:4": Equivalent(
         "if (in_beat) skid_q <= s_payload;",
         "the skid's word is also written when the output register takes the input beat "
