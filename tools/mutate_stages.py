@@ -180,11 +180,26 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the read rotation rd_shift_q left out of reset: as corner_turn:noreset:4, it is read "
         "only by reads, which need rd_active_q, and rd_start (the only way to set it) loads "
         "rd_shift_q from wr_shift_q in the same clock (survived the campaign, 28 November 2026)"),
+    "corner_turn:rel:0": Equivalent(
+        "if (t > (SH_W+1)'(RB)) t = t - (SH_W+1)'(RB);",
+        "next_shift keeping t = RB instead of wrapping it to 0: with RB a power of two the "
+        "SH_W-bit result is 0 either way; otherwise the register holds RB where it held 0, "
+        "and rotl(x, RB) = x = rotl(x, 0) and next_shift(RB) = ROT = next_shift(0), so every "
+        "address is the same (the formal proof's bound, shift < B, would reject the value RB) "
+        "(survived the campaign, 28 November 2026)"),
     "corner_turn:rel:8": Equivalent(
         "for (int a = 0; a <= B; a++) wr_perm_q[a] <= SH_W'(a);",
         "the reset loop of the bit permutation one step longer: its last step writes "
         "wr_perm_q[B], outside the B-entry array, and a write to an index out of range "
         "changes nothing (IEEE 1800 7.4.6) (survived the campaign, 28 November 2026, 138 s)"),
+    "corner_turn:rel:15": Equivalent(
+        "if (t > {1'b0, NM1}) t = t - {1'b0, NM1};",
+        "modadd keeping t = N-1 instead of wrapping it to 0: a sum of exactly N-1 is an "
+        "address = 0 (mod N-1), which only word 0 (loaded directly, never by a sum) and word "
+        "N-1 (placed at N-1 by its own arm, or never written with N_LOOPS < N_DOPPLER) have; "
+        "the stride and jump engine's sums are j * M^k or 2^m * NUM_TX * J0 * M^k mod N-1, "
+        "never 0: N-1 is odd and coprime with M, and j, NUM_TX * J0 < N-1 (survived the "
+        "campaign, 28 November 2026)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
