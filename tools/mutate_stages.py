@@ -200,6 +200,39 @@ EQUIVALENT: dict[str, Equivalent] = {
         "the stride and jump engine's sums are j * M^k or 2^m * NUM_TX * J0 * M^k mod N-1, "
         "never 0: N-1 is odd and coprime with M, and j, NUM_TX * J0 < N-1 (survived the "
         "campaign, 28 November 2026)"),
+    "corner_turn:sticky:1": Equivalent(
+        "pending_q <= wr_frame_end; if (wr_frame_end) begin",
+        "pending_q loaded with wr_frame_end on every write beat instead of set at a frame's "
+        "end: a write beat needs s_axis_tready, which is low while pending_q is set, so the "
+        "load only ever runs with pending_q clear and writes 0 over 0 or the same 1 "
+        "(survived the campaign, 28 November 2026, 213 s)"),
+    "corner_turn:tie:0": Equivalent(
+        "assign rd_vec_end = (rd_cnt_q[BD-1:0] >= BD'(N_LOOPS - 1));",
+        "rd_vec_end as >= instead of ==: the read counter's Doppler bits count from 0 and "
+        "return to 0 at rd_vec_end (rd_next), so they never exceed N_LOOPS - 1 (survived "
+        "the campaign, 28 November 2026)"),
+    "corner_turn:tie:1": Equivalent(
+        "assign wr_frame_end = (wr_cnt_q >= WR_LAST);",
+        "wr_frame_end as >= instead of ==: the write counter counts from 0 and returns to 0 "
+        "at wr_frame_end, so it never exceeds WR_LAST (survived the campaign, 28 November "
+        "2026)"),
+    "corner_turn:tie:2": Equivalent(
+        "for (int c = 0; c < B; c++) if (wr_perm_q[a] >= SH_W'(c)) wr_perm_q[a] <= sigma(c);",
+        "the permutation update for every c <= wr_perm_q[a] instead of c == wr_perm_q[a]: "
+        "the loop runs c upwards and the last nonblocking assignment wins, which is the one "
+        "at c == wr_perm_q[a] (< B, so the loop reaches it) (survived the campaign, "
+        "28 November 2026)"),
+    "corner_turn:tie:3": Equivalent(
+        "wa_q <= (wr_cnt_q >= B'(N - 2)) ? NM1 : modadd(wa_q, ws_q);",
+        "the last word's slot for wr_cnt_q >= N-2 instead of == N-2: the only larger count, "
+        "N-1, is the frame's last word, whose beat loads wa_q with 0 in the frame-end arm "
+        "below (and with N_LOOPS < N_DOPPLER neither is written) (survived the campaign, "
+        "28 November 2026)"),
+    "corner_turn:tie:5": Equivalent(
+        "wt_q <= (wt_q >= BT'(NUM_TX - 1)) ? '0 : wt_q + 1'b1;",
+        "the TX bank counter wraps at >= NUM_TX - 1 instead of ==: it counts from 0 and "
+        "wraps there, so it never exceeds NUM_TX - 1 (survived the campaign, 28 November "
+        "2026)"),
     "chirp_pingpong:const:6": Equivalent(
         "discard_q <= 1'b1;",
         "discard_q reset to 1 instead of 0: it is read only through ovf_drop while pos_q != 0 "
